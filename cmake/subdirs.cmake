@@ -1,0 +1,33 @@
+# add_present_subdirectories(): adds every immediate subdirectory that has a CMakeLists.txt, in name
+# order, so each component (and each tool or test suite) owns its own build file.
+function(add_present_subdirectories)
+  file(GLOB children LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/*)
+  list(SORT children)
+  foreach(child ${children})
+    if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${child} AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${child}/CMakeLists.txt)
+      add_subdirectory(${child})
+    endif()
+  endforeach()
+endfunction()
+
+include(/usr/lib/cmake/doctest/doctest.cmake OPTIONAL RESULT_VARIABLE _exc_doctest_cmake)
+if(NOT _exc_doctest_cmake)
+  find_file(_exc_doctest_cmake doctest.cmake PATHS ${doctest_DIR} REQUIRED)
+  include(${_exc_doctest_cmake})
+endif()
+
+# exc_add_doctest(target SOURCES ... [LIBS ...] [ENV ...]): one doctest executable; each TEST_CASE
+# becomes its own ctest test, named exactly as the case (names start with the component:
+# "hal/codec rejects stale counter"), so `ctest -R ^hal` runs one area.
+function(exc_add_doctest target)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;ENV" ${ARGN})
+  add_executable(${target} ${ARG_SOURCES})
+  target_link_libraries(${target} PRIVATE doctest::doctest exc_test_support ${ARG_LIBS})
+  target_compile_definitions(${target} PRIVATE
+    EXC_SOURCE_DIR="${EXC_SOURCE_DIR}" EXC_MACHINE_FILE="${EXC_MACHINE_FILE}"
+    EXC_BINARY_DIR="${CMAKE_BINARY_DIR}")
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 600)
+  endif()
+  doctest_discover_tests(${target} PROPERTIES TIMEOUT ${ARG_TIMEOUT} ENVIRONMENT "${ARG_ENV}")
+endfunction()

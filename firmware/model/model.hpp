@@ -1,0 +1,28 @@
+#pragma once
+// The constant multibody description built once from a Machine (Pinocchio's Model): the 12-link tree
+// of paper Table 1 with home transforms M_i, screws S_i, spatial inertias J_i, and the 4 cut pins of
+// Table 2. Link frames are those of the machine file ('frames'); every front pin axis is y.
+#include "machine.hpp"
+
+namespace exc {
+
+struct LoopCut {
+  int link_p = 0, link_s = 0;   // JointIndex of P_l and S_l (Table 2)
+  Vec3 point_p, point_s;        // the pin, in the frame of P_l and of S_l
+};
+
+struct Model {
+  Machine machine;                         // the description it was built from
+  std::array<int, kNumJoints> parent;      // JointIndex of lambda(k), -1 for the base
+  std::array<SE3, kNumJoints> home;        // M_i: parent frame -> frame i at q_i = 0
+  std::array<Twist, kNumJoints> screw;     // S_i in frame i
+  std::array<bool, kNumJoints> prismatic;
+  std::array<Mat6, kNumJoints> inertia;    // J_i about the frame origin, (w, v) ordering
+  std::array<LoopCut, kNumLoops> loops;
+  Vec3 tip_in_bucket;                      // T in the bucket frame
+  Vec6 base_acceleration;                  // Vd_0 = (0, 0, 0, 0, 0, +g): gravity (model.md s.3)
+};
+
+Model build_model(const Machine& machine);
+
+}  // namespace exc

@@ -1,0 +1,38 @@
+#pragma once
+// Every buffer the algorithms write (Pinocchio's Data): built once from a Model, reused each step.
+// All members are fixed-size; after construction nothing allocates.
+#include "model.hpp"
+#include "model_status.hpp"
+
+namespace exc {
+
+struct Workspace {
+  explicit Workspace(const Model& model);
+
+  // Tree state (12 joints), filled by loop closure from q_a (and qd_a).
+  Vec12 q = Vec12::Zero(), qd = Vec12::Zero(), qdd = Vec12::Zero();
+
+  // Kinematics of the tree: pose of each link in the base (swing-axis ground origin = world),
+  // relative transforms f_{lambda(i),i}, body twists and accelerations, body wrenches.
+  std::array<SE3, kNumJoints> X_Wi;
+  std::array<SE3, kNumJoints> f_parent;
+  std::array<Twist, kNumJoints> V, Vd;
+  std::array<Wrench, kNumJoints> F;
+  Vec12 tau_r = Vec12::Zero();
+
+  // Loop closure and its derivatives (model.md s.4).
+  Mat8x12 H = Mat8x12::Zero();   // dh/dq
+  Mat12x4 Psi = Mat12x4::Zero(); // qd = Psi qd_a (eq. 16a)
+  Vec12 gamma = Vec12::Zero();   // qdd = Psi qdd_a + gamma
+  Vec8 F_c = Vec8::Zero();       // loop reaction forces (eq. 7a, 7e)
+  Mat12 M_r = Mat12::Zero();     // tree mass matrix (when computed)
+  ModelReport report;            // last loop-closure outcome (status, loop, conditioning)
+
+  // Tip kinematics in the swing plane (x: horizontal along the boom direction, z: up).
+  Vec2 rho = Vec2::Zero(), rhod = Vec2::Zero();
+  Vec2 rhodd_bias = Vec2::Zero();  // Jd_t qd_a, so rhodd = J_t qdd_a + rhodd_bias
+  Mat2x4 J_t = Mat2x4::Zero();     // d rho / d q_a
+  Vec3 tip_world = Vec3::Zero();
+};
+
+}  // namespace exc

@@ -1,0 +1,42 @@
+#pragma once
+// Counts heap allocations made by the calling thread while a counter is alive. malloc, calloc,
+// realloc, aligned_alloc, posix_memalign and memalign are interposed in allocation_counter.cpp, so
+// operator new, Eigen's aligned allocator and any C library call that allocates are all seen.
+#include <cstddef>
+
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+#include <Eigen/Core>
+#endif
+
+namespace exc::test {
+
+class AllocationCounter {
+ public:
+  AllocationCounter();
+  ~AllocationCounter();
+  AllocationCounter(const AllocationCounter&) = delete;
+  AllocationCounter& operator=(const AllocationCounter&) = delete;
+  // Allocations by this thread since construction.
+  std::size_t count() const;
+
+ private:
+  std::size_t start_;
+};
+
+// Forbids Eigen heap use for its lifetime (test builds define EIGEN_RUNTIME_NO_MALLOC, so a
+// dynamic-size temporary inside the scope fails an assertion at the line that made it).
+class EigenNoMallocScope {
+ public:
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+  EigenNoMallocScope() { Eigen::internal::set_is_malloc_allowed(false); }
+  ~EigenNoMallocScope() { Eigen::internal::set_is_malloc_allowed(true); }
+#endif
+  EigenNoMallocScope(const EigenNoMallocScope&) = delete;
+  EigenNoMallocScope& operator=(const EigenNoMallocScope&) = delete;
+};
+
+// Whether the malloc interposition is active in this executable (a sanity check for the tests that
+// rely on it: an allocation must be seen).
+bool allocation_counting_works();
+
+}  // namespace exc::test
