@@ -1,0 +1,106 @@
+#pragma once
+// Telemetry without breaking the 1 kHz loop (realtime_tools' RealtimePublisher idea, LCM flavour).
+// The loop calls publish(channel, msg): it stamps the per-channel sequence number, encodes the
+// message with the lcm-gen encoder into a preallocated buffer and pushes the bytes into a lock-free
+// ring. It never calls LCM (whose C++ publish(channel, &msg) allocates on every call), never locks,
+// never blocks and never allocates. A telemetry thread drains the ring and hands the raw bytes to
+// lcm_publish, and publishes the path's own counters on EXC_TELEMETRY_STATS about once a second.
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "telemetry/lcm_output.hpp"
+#include "telemetry/spsc_ring.hpp"
+#include "telemetry/telemetry_channels.hpp"
+
+namespace exc::telemetry {
+
+struct TelemetryConfig {
+  // LCM provider, opened by start() unless `shared_output` is given.
+  std::string lcm_url = "file://run.lcm?mode=w";
+  // Use this already open provider instead (several publishers into one log).
+  std::shared_ptr<LcmOutput> shared_output;
+  // Appended to every channel name: "/pid" gives EXC_STATE/pid.
+  std::string channel_suffix;
+  // How often the telemetry thread publishes telemetry_stats_t.
+  std::chrono::milliseconds stats_period{1000};
+  // How long the telemetry thread sleeps when the ring is empty.
+  std::chrono::microseconds idle_sleep{500};
+};
+
+struct TelemetryCounters {
+  std::uint64_t enqueued = 0;           // messages pushed into the ring by the loop
+  std::uint64_t published = 0;          // messages handed to LCM successfully
+  std::uint64_t dropped_overflow = 0;   // oldest messages overwritten because the ring was full
+  std::uint64_t dropped_too_large = 0;  // messages whose encoding did not fit a ring slot
+  std::uint64_t publish_errors = 0;     // lcm_publish calls that failed
+};
+
+class TelemetryPublisher {
+ public:
+  // 1 KiB slots hold every exlcm type (timing_t, the largest, is 593 bytes); 1024 slots buffer
+  // about a quarter of a second of the loop's ~4 messages per cycle.
+  using Ring = SpscRing<1024, 1024>;
+
+  explicit TelemetryPublisher(TelemetryConfig config);
+  ~TelemetryPublisher();  // stop()
+  TelemetryPublisher(const TelemetryPublisher&) = delete;
+  TelemetryPublisher& operator=(const TelemetryPublisher&) = delete;
+
+  // Opens the provider (unless shared) and starts the telemetry thread. On failure returns false
+  // and sets `error`; publish() still works (messages stay in the ring, the oldest dropped).
+  bool start(std::string* error);
+  // Drains what is left in the ring, publishes the final counters, joins the thread and releases
+  // the provider (a log file not shared with another publisher is closed).
+  void stop();
+
+  // Real-time safe. Sets msg.seq to this channel's next sequence number (0, 1, 2, ...) and
+  // enqueues its encoding. Returns false if it was refused (encoding larger than a slot).
+  template <class Msg>
+  bool publish(Channel channel, Msg msg) {
+    const auto index = static_cast<std::size_t>(channel);
+    if (index >= channel_count) return false;
+    msg.seq = static_cast<std::int64_t>(next_sequence_[index]++);
+    const int size = msg.encode(encode_buffer_.data(), 0, static_cast<int>(Ring::slot_bytes));
+    if (size < 0) {
+      ring_.note_too_large();
+      return false;
+    }
+    return ring_.push(static_cast<std::uint16_t>(index), encode_buffer_.data(),
+                      static_cast<std::size_t>(size));
+  }
+
+  TelemetryCounters counters() const;
+  // The full LCM channel name, suffix included.
+  const std::string& channel_name(Channel channel) const {
+    return channel_names_[static_cast<std::size_t>(channel)];
+  }
+
+ private:
+  void run();
+  void drain();
+  void publish_stats();
+
+  TelemetryConfig config_;
+  std::array<std::string, channel_count> channel_names_;
+  std::unique_ptr<Ring> ring_storage_;  // ~1 MiB: on the heap, allocated once at construction
+  Ring& ring_;
+  // Loop-side state (producer thread only).
+  std::array<std::uint64_t, channel_count> next_sequence_{};
+  alignas(8) std::array<std::uint8_t, Ring::slot_bytes> encode_buffer_{};
+  // Telemetry-thread state.
+  std::shared_ptr<LcmOutput> output_;
+  std::unique_ptr<Ring::Message> message_;
+  std::thread thread_;
+  std::atomic<bool> stop_requested_{false};
+  std::atomic<std::uint64_t> published_{0};
+  std::atomic<std::uint64_t> publish_errors_{0};
+  std::int64_t last_utime_ = 0;
+  std::int64_t stats_sequence_ = 0;
+};
+
+}  // namespace exc::telemetry
