@@ -51,23 +51,27 @@ void TelemetryPublisher::stop() {
 
 void TelemetryPublisher::run() {
   auto next_stats = std::chrono::steady_clock::now() + config_.stats_period;
+  const std::size_t burst = config_.max_burst > 0 ? config_.max_burst : 1;
   while (!stop_requested_.load(std::memory_order_relaxed)) {
-    drain();
+    drain(burst);
     const auto now = std::chrono::steady_clock::now();
     if (now >= next_stats) {
       publish_stats();
       next_stats = now + config_.stats_period;
     }
-    std::this_thread::sleep_for(config_.idle_sleep);
+    std::this_thread::sleep_for(config_.wake_period);
   }
-  // The loop has stopped publishing (stop() is called after the last publish): take everything.
-  drain();
+  // The loop has stopped publishing (stop() is called after the last publish): take everything,
+  // still in bursts.
+  while (drain(burst) == burst) std::this_thread::sleep_for(config_.wake_period);
   publish_stats();
 }
 
-void TelemetryPublisher::drain() {
+std::size_t TelemetryPublisher::drain(std::size_t limit) {
   Ring::Message& message = *message_;
-  while (ring_.pop(message)) {
+  std::size_t taken = 0;
+  while (taken < limit && ring_.pop(message)) {
+    ++taken;
     if (message.tag >= channel_count) continue;
     last_utime_ = utime_of(message.bytes, message.size);
     if (output_->publish(channel_names_[message.tag].c_str(), message.bytes, message.size)) {
@@ -76,6 +80,7 @@ void TelemetryPublisher::drain() {
       publish_errors_.fetch_add(1, std::memory_order_relaxed);
     }
   }
+  return taken;
 }
 
 void TelemetryPublisher::publish_stats() {
