@@ -1,0 +1,149 @@
+// plot-run end to end: a small two-controller log written by the publisher, exported by
+// excavator-log, drawn by plot-run. Checks the files, not the pixels: every figure exists, is a
+// PNG of the documented size (1200 x 700) and not trivially small, and the report embeds them.
+#include <doctest/doctest.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include "exlcm/controller_state_t.hpp"
+#include "exlcm/machine_state_t.hpp"
+#include "exlcm/timing_t.hpp"
+#include "telemetry/telemetry_publisher.hpp"
+
+namespace fs = std::filesystem;
+using exc::telemetry::Channel;
+using exc::telemetry::LcmOutput;
+using exc::telemetry::TelemetryConfig;
+using exc::telemetry::TelemetryPublisher;
+
+namespace {
+
+// A made-up run: sinusoidal references, an error that is larger for "pid", a saw-tooth soil force.
+void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale) {
+  const double pi = std::acos(-1.0);
+  for (std::int64_t k = 0; k < 2000; ++k) {
+    const double t = k * 1e-3;
+    exlcm::machine_state_t state{};
+    exlcm::controller_state_t ctrl{};
+    state.utime = ctrl.utime = k * 1000;
+    for (int j = 0; j < 4; ++j) {
+      ctrl.q_desired[j] = (j == 0 ? 0.0 : 2.0) + 0.3 * std::sin(2 * pi * 0.5 * t + j);
+      ctrl.error[j] = error_scale * 0.01 * std::sin(2 * pi * 2 * t + j);
+      state.q_active[j] = ctrl.q_desired[j] + ctrl.error[j];
+    }
+    state.soil_force[0] = 4e4 * std::fmod(t, 0.25) / 0.25;
+    state.soil_force[1] = -2e4 * std::fmod(t, 0.25) / 0.25;
+    for (int i = 0; i < 6; ++i) {
+      ctrl.theta_true[i] = 1000.0 * (i + 1);
+      ctrl.theta_hat[i] = ctrl.theta_true[i] * (1 - std::exp(-t));
+    }
+    publisher.publish(Channel::state, state);
+    publisher.publish(Channel::controller, ctrl);
+    std::this_thread::sleep_for(std::chrono::microseconds(200));
+  }
+  exlcm::timing_t timing{};
+  timing.utime = 2000 * 1000;
+  timing.stage = 0;
+  timing.count = 2000;
+  timing.bin_width_us = 10;
+  for (int b = 0; b < 64; ++b) timing.bins[b] = b < 20 ? 100 * std::exp(-0.3 * (b - 8) * (b - 8)) : 0;
+  timing.p99_us = 150;
+  timing.max_us = 190;
+  publisher.publish(Channel::timing, timing);
+}
+
+// Width and height from a PNG's IHDR chunk; false if the file is not a PNG.
+bool png_size(const fs::path& path, std::uint32_t* width, std::uint32_t* height) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[24] = {};
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return false;
+  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (!std::equal(signature, signature + 8, header)) return false;
+  if (std::string(reinterpret_cast<char*>(header + 12), 4) != "IHDR") return false;
+  auto be32 = [&](int at) {
+    return std::uint32_t(header[at]) << 24 | std::uint32_t(header[at + 1]) << 16 |
+           std::uint32_t(header[at + 2]) << 8 | std::uint32_t(header[at + 3]);
+  };
+  *width = be32(16);
+  *height = be32(20);
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("tools/plot-run draws every figure and the report from a small recorded log") {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) {
+    MESSAGE("SKIPPED: matplotlib is missing (Debian package python3-matplotlib)");
+    return;
+  }
+  const fs::path dir = fs::temp_directory_path() / ("exc-plot-run-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log_path = dir / "run.lcm";
+  {
+    std::string error;
+    auto output = LcmOutput::open("file://" + log_path.string() + "?mode=w", &error);
+    REQUIRE_MESSAGE(output, error);
+    for (const auto& [suffix, scale] : {std::pair<const char*, double>{"/pid", 5.0},
+                                        std::pair<const char*, double>{"/adaptive", 1.0}}) {
+      TelemetryConfig config;
+      config.shared_output = output;
+      config.channel_suffix = suffix;
+      TelemetryPublisher publisher(config);
+      REQUIRE(publisher.start(&error));
+      publish_synthetic_run(publisher, scale);
+      publisher.stop();
+      CHECK(publisher.counters().dropped_overflow == 0);
+    }
+  }
+  {
+    std::ofstream summary(dir / "summary.json");
+    summary << R"({"pid": {"rms_error_arm_m": 0.05, "p99_us": 150},)"
+            << R"( "adaptive": {"rms_error_arm_m": 0.01, "p99_us": 160}})";
+  }
+  const std::string csv_dir = (dir / "csv").string();
+  const std::string out_dir = (dir / "report").string();
+  const std::string export_command = std::string(EXC_EXCAVATOR_LOG) + " export " +
+                                     log_path.string() + " --csv " + csv_dir + " >/dev/null";
+  REQUIRE(std::system(export_command.c_str()) == 0);
+  CHECK(fs::exists(fs::path(csv_dir) / "EXC_STATE__pid.csv"));
+  CHECK(fs::exists(fs::path(csv_dir) / "EXC_CONTROLLER__adaptive.csv"));
+  const std::string plot_command = std::string(EXC_PLOT_RUN) + " " + csv_dir + " --out " +
+                                   out_dir + " --summary " + (dir / "summary.json").string();
+  REQUIRE(std::system(plot_command.c_str()) == 0);
+
+  std::ifstream report_file(fs::path(out_dir) / "report.md");
+  REQUIRE(report_file.good());
+  std::stringstream report;
+  report << report_file.rdbuf();
+  CHECK(report.str().find("rms_error_arm_m") != std::string::npos);
+  CHECK(report.str().find("| quantity | pid | adaptive |") != std::string::npos);
+  // The RMS of a sine over whole periods is its amplitude / sqrt(2): 0.05 and 0.01 here.
+  CHECK(report.str().find("| arm (m) | 0.03536 | 0.007071 |") != std::string::npos);
+  for (const char* name :
+       {"tracking_swing.png", "tracking_boom.png", "tracking_arm.png", "tracking_bucket.png",
+        "tracking_error.png", "soil_force.png", "soil_estimates.png", "loop_timing.png"}) {
+    CAPTURE(std::string(name));
+    const fs::path png = fs::path(out_dir) / name;
+    REQUIRE(fs::exists(png));
+    // A 1200 x 700 figure with axes, lines and text is tens of kilobytes; an empty canvas is ~5.
+    CHECK(fs::file_size(png) > 15000);
+    std::uint32_t width = 0;
+    std::uint32_t height = 0;
+    REQUIRE(png_size(png, &width, &height));
+    CHECK(width == 1200);
+    CHECK(height == 700);
+    CHECK(report.str().find(std::string("(") + name + ")") != std::string::npos);
+  }
+  if (std::getenv("EXC_KEEP_PLOTS") == nullptr) fs::remove_all(dir);
+}
