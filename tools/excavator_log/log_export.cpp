@@ -122,6 +122,11 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
         });
     if (!known) channel.type_name = "unknown";
   }
+  std::error_code ec;
+  if (summary->events == 0 && std::filesystem::file_size(log_path, ec) > 0 && !ec) {
+    *error = log_path + ": not an LCM log (no event found where LCM's log reader expects one)";
+    return false;
+  }
   return true;
 }
 
