@@ -1,5 +1,5 @@
-// plot-run end to end: a small two-controller log written by the publisher, exported by
-// excavator-log, drawn by plot-run. Checks the files, not the pixels: every figure exists, is a
+// plot-run end to end: a small two-controller log written by the publisher, exported and drawn by
+// `excavator-log report` (export to CSV, then plot-run). Checks the files, not the pixels: every figure exists, is a
 // PNG of the documented size (1200 x 700) and not trivially small, and the report embeds them.
 #include <doctest/doctest.h>
 
@@ -111,16 +111,15 @@ TEST_CASE("tools/plot-run draws every figure and the report from a small recorde
     summary << R"({"pid": {"rms_error_arm_m": 0.05, "p99_us": 150},)"
             << R"( "adaptive": {"rms_error_arm_m": 0.01, "p99_us": 160}})";
   }
-  const std::string csv_dir = (dir / "csv").string();
+  // excavator-log report = excavator-log export into out/csv, then plot-run on it.
   const std::string out_dir = (dir / "report").string();
-  const std::string export_command = std::string(EXC_EXCAVATOR_LOG) + " export " +
-                                     log_path.string() + " --csv " + csv_dir + " >/dev/null";
-  REQUIRE(std::system(export_command.c_str()) == 0);
+  const std::string csv_dir = (dir / "report" / "csv").string();
+  const std::string command = std::string(EXC_EXCAVATOR_LOG) + " report " + log_path.string() +
+                              " --out " + out_dir + " --summary " +
+                              (dir / "summary.json").string() + " >/dev/null";
+  REQUIRE(std::system(command.c_str()) == 0);
   CHECK(fs::exists(fs::path(csv_dir) / "EXC_STATE__pid.csv"));
   CHECK(fs::exists(fs::path(csv_dir) / "EXC_CONTROLLER__adaptive.csv"));
-  const std::string plot_command = std::string(EXC_PLOT_RUN) + " " + csv_dir + " --out " +
-                                   out_dir + " --summary " + (dir / "summary.json").string();
-  REQUIRE(std::system(plot_command.c_str()) == 0);
 
   std::ifstream report_file(fs::path(out_dir) / "report.md");
   REQUIRE(report_file.good());

@@ -2,9 +2,12 @@
 // file:// provider output) with LCM's log reader.
 //   excavator-log info run.lcm            channels, types, counts, duration
 //   excavator-log export run.lcm --csv DIR  one CSV per channel
+//   excavator-log report run.lcm --out DIR [--summary JSON]  CSV, then plot-run's figures and report
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "log_export.hpp"
@@ -23,6 +26,27 @@ void print_summary(const std::string& log_path, const exc::log::LogSummary& summ
                 static_cast<unsigned long long>(channel.messages), rate,
                 static_cast<unsigned long long>(channel.undecodable));
   }
+}
+
+// plot-run: the one built next to this program (build tree), else the one on PATH (installed).
+std::string plot_run_program() {
+#ifdef EXC_PLOT_RUN
+  if (std::filesystem::exists(EXC_PLOT_RUN)) return EXC_PLOT_RUN;
+#endif
+  return "plot-run";
+}
+
+// Single quotes for the shell, so that paths with spaces survive.
+std::string shell_quoted(const std::string& text) {
+  std::string quoted = "'";
+  for (const char c : text) {
+    if (c == '\'') {
+      quoted += "'\\''";
+    } else {
+      quoted += c;
+    }
+  }
+  return quoted + "'";
 }
 
 }  // namespace
@@ -45,6 +69,18 @@ int main(int argc, char** argv) {
   exporter->add_option("--csv", csv_dir, "Output directory for the CSV files (created)")
       ->required();
 
+  std::string report_log;
+  std::string report_dir;
+  std::string summary_json;
+  std::string title = "Excavator run report";
+  CLI::App* reporter = app.add_subcommand(
+      "report", "Export the log to DIR/csv, then draw the figures and DIR/report.md with plot-run");
+  reporter->add_option("log", report_log, "LCM log file")->required();
+  reporter->add_option("--out", report_dir, "Output directory (csv/ and the report)")->required();
+  reporter->add_option("--summary", summary_json, "JSON summary table to include in the report")
+      ->check(CLI::ExistingFile);
+  reporter->add_option("--title", title, "Report title");
+
   CLI11_PARSE(app, argc, argv);
 
   exc::log::LogSummary summary;
@@ -55,6 +91,22 @@ int main(int argc, char** argv) {
       return 1;
     }
     print_summary(info_log, summary);
+    return 0;
+  }
+  if (reporter->parsed()) {
+    const std::string csv = (std::filesystem::path(report_dir) / "csv").string();
+    if (!exc::log::export_log_to_csv(report_log, csv, &summary, &error)) {
+      std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
+      return 1;
+    }
+    std::string command = shell_quoted(plot_run_program()) + " " + shell_quoted(csv) + " --out " +
+                          shell_quoted(report_dir) + " --title " + shell_quoted(title);
+    if (!summary_json.empty()) command += " --summary " + shell_quoted(summary_json);
+    const int status = std::system(command.c_str());
+    if (status != 0) {
+      std::fprintf(stderr, "excavator-log: plot-run failed (%s)\n", command.c_str());
+      return 1;
+    }
     return 0;
   }
   if (!exc::log::export_log_to_csv(export_log, csv_dir, &summary, &error)) {
