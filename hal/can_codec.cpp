@@ -1,0 +1,192 @@
+#include "hal/can_codec.hpp"
+
+#include <cmath>
+
+namespace exc::hal {
+namespace {
+
+// Table for CRC-8 polynomial 0x1D, built at compile time from the bitwise definition.
+struct Crc8Table {
+  std::uint8_t entry[256];
+  constexpr Crc8Table() : entry{} {
+    for (int i = 0; i < 256; ++i) {
+      std::uint8_t crc = static_cast<std::uint8_t>(i);
+      for (int bit = 0; bit < 8; ++bit) {
+        crc = static_cast<std::uint8_t>((crc & 0x80) ? ((crc << 1) ^ 0x1D) : (crc << 1));
+      }
+      entry[i] = crc;
+    }
+  }
+};
+constexpr Crc8Table kCrc8Table;
+
+std::uint64_t load_le64(const CanFrame& frame) {
+  std::uint64_t word = 0;
+  for (int i = 7; i >= 0; --i) word = (word << 8) | frame.data[i];
+  return word;
+}
+
+void store_le64(CanFrame& frame, std::uint64_t word) {
+  for (int i = 0; i < 8; ++i) {
+    frame.data[i] = static_cast<std::uint8_t>(word & 0xFF);
+    word >>= 8;
+  }
+}
+
+std::uint64_t mask_of(unsigned length) { return length >= 64 ? ~0ULL : ((1ULL << length) - 1); }
+
+}  // namespace
+
+std::uint8_t crc8_sae_j1850(const std::uint8_t* bytes, std::size_t length) {
+  std::uint8_t crc = 0xFF;
+  for (std::size_t i = 0; i < length; ++i) crc = kCrc8Table.entry[crc ^ bytes[i]];
+  return static_cast<std::uint8_t>(crc ^ 0xFF);
+}
+
+std::uint8_t frame_checksum(std::uint32_t id, const std::uint8_t* payload, std::size_t payload_bytes_before_crc) {
+  std::uint8_t crc = 0xFF;
+  crc = kCrc8Table.entry[crc ^ static_cast<std::uint8_t>(id & 0xFF)];
+  crc = kCrc8Table.entry[crc ^ static_cast<std::uint8_t>((id >> 8) & 0xFF)];
+  for (std::size_t i = 0; i < payload_bytes_before_crc; ++i) crc = kCrc8Table.entry[crc ^ payload[i]];
+  return static_cast<std::uint8_t>(crc ^ 0xFF);
+}
+
+std::uint64_t read_raw_bits(const CanFrame& frame, unsigned start, unsigned length) {
+  return (load_le64(frame) >> start) & mask_of(length);
+}
+
+void write_raw_bits(CanFrame& frame, unsigned start, unsigned length, std::uint64_t raw) {
+  const std::uint64_t mask = mask_of(length) << start;
+  std::uint64_t word = load_le64(frame);
+  word = (word & ~mask) | ((raw << start) & mask);
+  store_le64(frame, word);
+}
+
+EncodeReport encode_signal(CanFrame& frame, const SignalSpec& signal, double value) {
+  EncodeReport report;
+  if (!std::isfinite(value)) {
+    report.non_finite = 1;
+    value = signal.min > 0 ? signal.min : (signal.max < 0 ? signal.max : 0.0);
+  }
+  if (value < signal.min) {
+    value = signal.min;
+    report.saturated = 1;
+  } else if (value > signal.max) {
+    value = signal.max;
+    report.saturated = 1;
+  }
+  std::int64_t raw = std::llround((value - signal.offset) / signal.factor);
+  // Rounding at a range end must not step outside what the field can hold.
+  const std::int64_t raw_min = signal.is_signed ? -(std::int64_t{1} << (signal.length - 1)) : 0;
+  const std::int64_t raw_max = signal.is_signed ? (std::int64_t{1} << (signal.length - 1)) - 1
+                                                : static_cast<std::int64_t>(mask_of(signal.length));
+  if (raw < raw_min) raw = raw_min;
+  if (raw > raw_max) raw = raw_max;
+  write_raw_bits(frame, signal.start, signal.length, static_cast<std::uint64_t>(raw));
+  return report;
+}
+
+double decode_signal(const CanFrame& frame, const SignalSpec& signal) {
+  const std::uint64_t raw = read_raw_bits(frame, signal.start, signal.length);
+  std::int64_t value = static_cast<std::int64_t>(raw);
+  if (signal.is_signed && (raw >> (signal.length - 1)) != 0) {
+    value = static_cast<std::int64_t>(raw | ~mask_of(signal.length));  // two's complement sign extension
+  }
+  return static_cast<double>(value) * signal.factor + signal.offset;
+}
+
+EncodeReport encode_message(const MessageSpec& message, std::uint8_t counter, const double* values, CanFrame& out) {
+  out.id = message.id;
+  out.dlc = message.dlc;
+  for (auto& byte : out.data) byte = 0;
+  out.timestamp_ns = 0;
+  EncodeReport report;
+  write_raw_bits(out, 0, 4, counter & 0x0F);
+  for (std::size_t i = 0; i < message.data_signal_count(); ++i) {
+    const EncodeReport one = encode_signal(out, message.data_signal(i), values[i]);
+    report.saturated = static_cast<std::uint8_t>(report.saturated + one.saturated);
+    report.non_finite = static_cast<std::uint8_t>(report.non_finite + one.non_finite);
+  }
+  out.data[message.dlc - 1] = frame_checksum(out.id, out.data, message.dlc - 1u);
+  return report;
+}
+
+void decode_message(const MessageSpec& message, const CanFrame& frame, double* values) {
+  for (std::size_t i = 0; i < message.data_signal_count(); ++i) values[i] = decode_signal(frame, message.data_signal(i));
+}
+
+std::uint8_t frame_counter(const CanFrame& frame) { return frame.data[0] & 0x0F; }
+
+const char* to_string(RxVerdict verdict) {
+  switch (verdict) {
+    case RxVerdict::ok: return "ok";
+    case RxVerdict::unknown_id: return "unknown_id";
+    case RxVerdict::wrong_dlc: return "wrong_dlc";
+    case RxVerdict::corrupt: return "corrupt";
+    case RxVerdict::repeated: return "repeated";
+    case RxVerdict::stale: return "stale";
+  }
+  return "?";
+}
+
+void RxStats::record(RxVerdict verdict) {
+  switch (verdict) {
+    case RxVerdict::ok: ++ok; break;
+    case RxVerdict::unknown_id: ++unknown_id; break;
+    case RxVerdict::wrong_dlc: ++wrong_dlc; break;
+    case RxVerdict::corrupt: ++corrupt; break;
+    case RxVerdict::repeated: ++repeated; break;
+    case RxVerdict::stale: ++stale; break;
+  }
+}
+
+CanFrameCodec::CanFrameCodec() : CanFrameCodec(Config{}) {}
+CanFrameCodec::CanFrameCodec(Config config) : config_(config) {}
+
+void CanFrameCodec::restart_sequences() { sequences_ = {}; }
+
+RxVerdict CanFrameCodec::accept(const CanFrame& frame, const MessageSpec*& message) {
+  message = nullptr;
+  RxVerdict verdict = RxVerdict::ok;
+  const int index = message_index(frame.id);
+  if (index < 0) {
+    verdict = RxVerdict::unknown_id;
+  } else {
+    const MessageSpec& spec = protocol_messages()[static_cast<std::size_t>(index)];
+    if (frame.dlc != spec.dlc) {
+      verdict = RxVerdict::wrong_dlc;
+    } else if (frame.data[spec.dlc - 1] != frame_checksum(frame.id, frame.data, spec.dlc - 1u)) {
+      verdict = RxVerdict::corrupt;
+    } else {
+      Sequence& seq = sequences_[static_cast<std::size_t>(index)];
+      const std::uint8_t counter = frame_counter(frame);
+      const bool paused = seq.started && frame.timestamp_ns != 0 && seq.last_ns != 0 &&
+                          frame.timestamp_ns - seq.last_ns > config_.fresh_after_ns;
+      if (seq.started && !paused) {
+        const unsigned delta = (counter - seq.last) & 0x0Fu;
+        if (delta == 0) {
+          verdict = RxVerdict::repeated;
+        } else if (delta > config_.max_counter_gap) {
+          verdict = RxVerdict::stale;
+        }
+      }
+      if (verdict == RxVerdict::stale) {
+        // A sender that restarted (or a long loss) would otherwise be locked out for good.
+        if (++seq.stale_run >= config_.resync_after) {
+          seq.last = counter;
+          seq.stale_run = 0;
+        }
+      } else if (verdict == RxVerdict::ok) {
+        seq.started = true;
+        seq.last = counter;
+        seq.stale_run = 0;
+        seq.last_ns = frame.timestamp_ns;
+        message = &spec;
+      }
+    }
+  }
+  stats_.record(verdict);
+  return verdict;
+}
+
+}  // namespace exc::hal

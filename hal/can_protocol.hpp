@@ -1,0 +1,79 @@
+#pragma once
+// The excavator CAN protocol as data: every message and signal of hal/excavator.dbc, in the same
+// order and with the same layout. The codec is driven by these tables and a test parses the DBC and
+// holds the tables to it, so the DBC stays the single specification.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace exc::hal {
+
+enum class Node : std::uint8_t { firmware, plant };
+
+// One DBC signal, Intel byte order: `start` is the bit number of the least significant bit, bit k of
+// the frame being bit k % 8 of byte k / 8. physical = raw * factor + offset, allowed in [min, max].
+struct SignalSpec {
+  const char* name;
+  std::uint8_t start;
+  std::uint8_t length;
+  bool is_signed;
+  double factor;
+  double offset;
+  double min;
+  double max;
+  const char* unit;
+};
+
+// Which command set a frame belongs to (the DBC attribute ExcCommandSet); the two are exclusive.
+enum class CommandSet : std::uint8_t { none, effort, valve };
+
+// One DBC message. signals[0] is always Counter (bits 0..3) and signals[signal_count - 1] is always
+// Crc (the last byte); the data signals lie in between.
+struct MessageSpec {
+  const char* name;
+  std::uint32_t id;
+  std::uint8_t dlc;
+  Node sender;
+  int cycle_ms;  // 0: event-driven
+  CommandSet command_set;
+  const SignalSpec* signals;
+  std::uint8_t signal_count;
+
+  std::uint8_t data_signal_count() const { return static_cast<std::uint8_t>(signal_count - 2); }
+  const SignalSpec& data_signal(std::size_t i) const { return signals[i + 1]; }
+};
+
+namespace can_id {
+inline constexpr std::uint32_t fw_emergency = 0x010;
+inline constexpr std::uint32_t plant_emergency = 0x011;
+inline constexpr std::uint32_t sync = 0x080;
+inline constexpr std::uint32_t cmd_effort_a = 0x100;
+inline constexpr std::uint32_t cmd_effort_b = 0x101;
+inline constexpr std::uint32_t cmd_valve = 0x102;
+inline constexpr std::uint32_t sens_swing = 0x180;
+inline constexpr std::uint32_t sens_boom = 0x181;
+inline constexpr std::uint32_t sens_arm = 0x182;
+inline constexpr std::uint32_t sens_bucket = 0x183;
+inline constexpr std::uint32_t sens_pressure_boom = 0x184;
+inline constexpr std::uint32_t sens_pressure_arm = 0x185;
+inline constexpr std::uint32_t sens_pressure_bucket = 0x186;
+inline constexpr std::uint32_t fw_heartbeat = 0x701;
+inline constexpr std::uint32_t plant_heartbeat = 0x702;
+}  // namespace can_id
+
+inline constexpr std::size_t kMessageCount = 15;
+inline constexpr std::int64_t kCyclePeriodNs = 1'000'000;  // one SYNC per millisecond
+inline constexpr int kHeartbeatPeriodCycles = 100;
+inline constexpr int kEmergencyRepeatCycles = 10;
+inline constexpr int kPressureRoundRobin = 3;  // one cylinder's pressures per cycle
+
+// All messages, in the order of the DBC.
+const std::array<MessageSpec, kMessageCount>& protocol_messages();
+
+// Index of `id` in protocol_messages(), or -1 for an unknown identifier.
+int message_index(std::uint32_t id);
+
+// The message with identifier `id`, or nullptr.
+const MessageSpec* find_message(std::uint32_t id);
+
+}  // namespace exc::hal

@@ -1,0 +1,202 @@
+// The bus backends: in-memory broadcast semantics, fault injection rates, SocketCAN failing cleanly.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "hal/fault_injecting_bus.hpp"
+#include "hal/memory_bus.hpp"
+#include "hal/socketcan_bus.hpp"
+
+using namespace exc::hal;
+
+namespace {
+CanFrame frame_with(std::uint32_t id, std::uint8_t first_byte) {
+  CanFrame f;
+  f.id = id;
+  f.dlc = 8;
+  f.data[0] = first_byte;
+  for (int i = 1; i < 8; ++i) f.data[i] = static_cast<std::uint8_t>(0x10 * i);
+  return f;
+}
+std::int64_t fake_clock(void* context) { return ++*static_cast<std::int64_t*>(context); }
+}  // namespace
+
+TEST_CASE("hal/memory bus delivers each frame to every other node in order, never to the sender") {
+  MemoryBusHub hub;
+  MemoryBusNode* a = hub.attach(16);
+  MemoryBusNode* b = hub.attach(16);
+  MemoryBusNode* c = hub.attach(16);
+  REQUIRE((a && b && c));
+  CHECK(a->send(frame_with(0x100, 1)));
+  CHECK(a->send(frame_with(0x101, 2)));
+  CHECK(b->send(frame_with(0x102, 3)));
+
+  CanFrame f;
+  CHECK(a->pending() == 1);  // only b's frame
+  REQUIRE(a->receive(f));
+  CHECK(f.id == 0x102);
+  CHECK_FALSE(a->receive(f));
+
+  for (MemoryBusNode* node : {b}) {
+    REQUIRE(node->receive(f));
+    CHECK(f.id == 0x100);
+    CHECK(f.data[0] == 1);
+    REQUIRE(node->receive(f));
+    CHECK(f.id == 0x101);
+    CHECK_FALSE(node->receive(f));
+  }
+  const std::uint32_t order[] = {0x100, 0x101, 0x102};
+  for (std::uint32_t id : order) {
+    REQUIRE(c->receive(f));
+    CHECK(f.id == id);
+    CHECK(f.timestamp_ns > 0);
+  }
+  CHECK_FALSE(c->wait_readable(0));
+  CHECK(hub.frames_sent() == 3);
+}
+
+TEST_CASE("hal/memory bus counts overflow of a full receive ring and keeps the oldest frames") {
+  std::int64_t now = 0;
+  MemoryBusHub hub(&fake_clock, &now);
+  MemoryBusNode* tx = hub.attach(4);
+  MemoryBusNode* rx = hub.attach(4);
+  for (int i = 0; i < 6; ++i) tx->send(frame_with(0x100, static_cast<std::uint8_t>(i)));
+  CHECK(rx->overflows() == 2);
+  CanFrame f;
+  for (int i = 0; i < 4; ++i) {
+    REQUIRE(rx->receive(f));
+    CHECK(f.data[0] == i);
+    CHECK(f.timestamp_ns == i + 1);  // stamped by the hub's clock at send
+  }
+  // Invalid frames are refused at send.
+  CanFrame bad = frame_with(0x800, 0);
+  CHECK_FALSE(tx->send(bad));
+  bad = frame_with(0x100, 0);
+  bad.dlc = 9;
+  CHECK_FALSE(tx->send(bad));
+}
+
+TEST_CASE("hal/memory bus refuses more than kMaxNodes nodes") {
+  MemoryBusHub hub;
+  for (std::size_t i = 0; i < MemoryBusHub::kMaxNodes; ++i) CHECK(hub.attach(2) != nullptr);
+  CHECK(hub.attach(2) == nullptr);
+}
+
+TEST_CASE("hal/fault injection drops, corrupts and delays the configured fractions for a seed") {
+  MemoryBusHub hub;
+  MemoryBusNode* tx_node = hub.attach(8);
+  MemoryBusNode* rx = hub.attach(128);
+  FaultInjection config;
+  config.drop_fraction = 0.05;
+  config.corrupt_fraction = 0.03;
+  config.delay_fraction = 0.02;
+  config.delay_frames = 3;
+  config.seed = 42;
+  FaultInjectingBus faulty(*tx_node, config);
+
+  constexpr int kFrames = 200000;
+  std::uint64_t received = 0, corrupted = 0, reordered = 0;
+  std::uint32_t last_sequence = 0;
+  for (int i = 0; i < kFrames; ++i) {
+    CanFrame f;
+    f.id = 0x200;
+    f.dlc = 8;
+    const auto seq = static_cast<std::uint32_t>(i + 1);
+    for (int k = 0; k < 4; ++k) f.data[k] = static_cast<std::uint8_t>(seq >> (8 * k));
+    for (int k = 4; k < 8; ++k) f.data[k] = static_cast<std::uint8_t>(~f.data[k - 4]);  // check bytes
+    faulty.send(f);
+    CanFrame got;
+    while (rx->receive(got)) {
+      ++received;
+      bool intact = true;
+      for (int k = 4; k < 8; ++k) intact &= got.data[k] == static_cast<std::uint8_t>(~got.data[k - 4]);
+      if (!intact) {
+        ++corrupted;
+        continue;
+      }
+      std::uint32_t s = 0;
+      for (int k = 0; k < 4; ++k) s |= static_cast<std::uint32_t>(got.data[k]) << (8 * k);
+      if (s < last_sequence) ++reordered;
+      last_sequence = std::max(last_sequence, s);
+    }
+  }
+  faulty.release_delayed();
+  CanFrame got;
+  while (rx->receive(got)) ++received;
+
+  const auto& stats = faulty.stats();
+  MESSAGE("dropped ", stats.dropped, ", corrupted ", stats.corrupted, ", delayed ", stats.delayed, " of ", kFrames);
+  // Binomial standard deviation for 200000 frames is below 0.05% absolute: 0.3% is a wide margin.
+  CHECK(std::fabs(stats.dropped / double(kFrames) - 0.05) < 0.003);
+  CHECK(std::fabs(stats.corrupted / double(kFrames) - 0.03) < 0.003);
+  CHECK(std::fabs(stats.delayed / double(kFrames) - 0.02) < 0.003);
+  // What the receiver saw agrees with the decorator's own counts.
+  CHECK(received == kFrames - stats.dropped);
+  CHECK(corrupted == stats.corrupted);
+  // A delayed frame shows as out of order unless all frames sent after it were lost too (rare).
+  CHECK(reordered <= stats.delayed);
+  CHECK(reordered >= stats.delayed * 99 / 100);
+
+  // Same seed, same damage.
+  MemoryBusHub hub2;
+  MemoryBusNode* tx2 = hub2.attach(8);
+  hub2.attach(8);
+  FaultInjectingBus again(*tx2, config);
+  for (int i = 0; i < kFrames; ++i) again.send(frame_with(0x200, 0));
+  CHECK(again.stats().dropped == stats.dropped);
+  CHECK(again.stats().corrupted == stats.corrupted);
+}
+
+TEST_CASE("hal/socketcan fails cleanly naming the interface and the errno text") {
+  std::string why;
+  const bool supported = SocketCanBus::kernel_supports_can(&why);
+  std::string error;
+  const std::uint32_t ids[] = {0x080, 0x100};
+  auto bus = SocketCanBus::open("nosuchcan0", ids, 2, error);
+  CHECK(bus == nullptr);
+  CHECK(error.find("nosuchcan0") != std::string::npos);
+  MESSAGE(error);
+  if (!supported) {
+    CHECK(error.find("socket(PF_CAN") != std::string::npos);
+    MESSAGE("skipped the vcan part: no SocketCAN in this kernel (", why, ")");
+  } else {
+    CHECK(error.find("if_nametoindex") != std::string::npos);
+  }
+  auto too_long = SocketCanBus::open("a-name-longer-than-ifnamsiz", ids, 2, error);
+  CHECK(too_long == nullptr);
+  CHECK(error.find("a-name-longer-than-ifnamsiz") != std::string::npos);
+}
+
+TEST_CASE("hal/socketcan on vcan0 broadcasts between two sockets with filters and timestamps") {
+  std::string why;
+  if (!SocketCanBus::kernel_supports_can(&why)) {
+    MESSAGE("skipped: no SocketCAN in this kernel (", why, ")");
+    return;
+  }
+  std::string error;
+  const std::uint32_t a_ids[] = {0x181};
+  const std::uint32_t b_ids[] = {0x080};
+  auto a = SocketCanBus::open("vcan0", a_ids, 1, error);
+  if (!a) {
+    MESSAGE("skipped: vcan0 not available (", error, ")");
+    return;
+  }
+  auto b = SocketCanBus::open("vcan0", b_ids, 1, error);
+  REQUIRE(b != nullptr);
+  CanFrame f = frame_with(0x080, 7);
+  f.dlc = 3;
+  REQUIRE(a->send(f));
+  CanFrame filtered = frame_with(0x555, 1);
+  REQUIRE(a->send(filtered));
+  REQUIRE(b->wait_readable(100'000'000));
+  CanFrame got;
+  REQUIRE(b->receive(got));
+  CHECK(got.id == 0x080);
+  CHECK(got.dlc == 3);
+  CHECK(got.data[0] == 7);
+  CHECK(got.timestamp_ns > 0);
+  CHECK_FALSE(b->wait_readable(20'000'000));  // 0x555 is filtered out by the kernel
+  CHECK_FALSE(a->receive(got));               // a does not hear itself
+}
