@@ -3,11 +3,14 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <string>
 
 #include "allocation_counter.hpp"
 #include "hal/can_ports.hpp"
+#include "hal/clock.hpp"
 #include "hal/fault_injecting_bus.hpp"
 #include "hal/memory_bus.hpp"
+#include "hal/socketcan_bus.hpp"
 
 using namespace exc::hal;
 
@@ -282,4 +285,50 @@ TEST_CASE("hal/ports allocate nothing over 100000 cycles on the memory bus") {
   CHECK(allocations == 0);
   CHECK(r.cycles == 100000);
   CHECK(r.complete > 90000);
+}
+
+TEST_CASE("hal/ports run whole cycles over SocketCAN vcan0") {
+  std::string why;
+  if (!SocketCanBus::kernel_supports_can(&why)) {
+    MESSAGE("SKIPPED: no SocketCAN in this kernel (", why, ")");
+    return;
+  }
+  std::uint32_t fw_ids[kMessageCount];
+  std::uint32_t plant_ids[kMessageCount];
+  const std::size_t fw_count = receive_ids(Node::firmware, fw_ids, kMessageCount);
+  const std::size_t plant_count = receive_ids(Node::plant, plant_ids, kMessageCount);
+  std::string error;
+  auto fw_bus = SocketCanBus::open("vcan0", fw_ids, fw_count, error);
+  if (!fw_bus) {
+    MESSAGE("SKIPPED: vcan0 not available (", error, ")");
+    return;
+  }
+  auto plant_bus = SocketCanBus::open("vcan0", plant_ids, plant_count, error);
+  REQUIRE(plant_bus != nullptr);
+  FirmwareCanPort firmware(*fw_bus);
+  PlantCanPort plant(*plant_bus);
+  int complete = 0, mismatches = 0;
+  SensorState seen;
+  CommandState applied;
+  for (std::uint64_t k = 0; k < 1000; ++k) {
+    REQUIRE(firmware.send_sync(k));
+    std::uint64_t cycle = 0;
+    REQUIRE(plant.wait_sync(cycle, 100'000'000));
+    CHECK(cycle == k);
+    if (plant.read(applied) && !same_command(applied, command_for(applied.cycle, CommandMode::effort))) ++mismatches;
+    REQUIRE(plant.write(sensors_for(cycle, true)));
+    const std::int64_t deadline = exc::hal::monotonic_now_ns() + 100'000'000;
+    bool got = false;
+    while (!(got = firmware.read(seen)) && exc::hal::monotonic_now_ns() < deadline) fw_bus->wait_readable(1'000'000);
+    if (got) {
+      ++complete;
+      if (!same_motion(seen, sensors_for(k, true))) ++mismatches;
+    }
+    REQUIRE(firmware.write(command_for(k, CommandMode::effort)));
+  }
+  CHECK(complete == 1000);
+  CHECK(mismatches == 0);
+  CHECK(firmware.rx_stats().rejected() == 0);
+  CHECK(plant.rx_stats().rejected() == 0);
+  CHECK(firmware.last_valid_rx_ns() > 0);
 }
