@@ -1,6 +1,5 @@
 #include "hal/socketcan_bus.hpp"
 
-#include <fcntl.h>
 #include <linux/can.h>
 #include <linux/can/raw.h>
 #include <net/if.h>
