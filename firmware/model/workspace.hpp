@@ -1,6 +1,8 @@
 #pragma once
 // Every buffer the algorithms write (Pinocchio's Data): built once from a Model, reused each step.
 // All members are fixed-size; after construction nothing allocates.
+#include <Eigen/LU>
+
 #include "model.hpp"
 #include "model_status.hpp"
 
@@ -33,6 +35,15 @@ struct Workspace {
   Vec2 rhodd_bias = Vec2::Zero();  // Jd_t qd_a, so rhodd = J_t qdd_a + rhodd_bias
   Mat2x4 J_t = Mat2x4::Zero();     // d rho / d q_a
   Vec3 tip_world = Vec3::Zero();
+
+  // Planar front kinematics in the swing plane (front_kinematics.hpp): absolute link angles,
+  // angular rates, origins and their derivatives, per tree joint (entry 0, the swing, stays zero).
+  std::array<double, kNumJoints> phi{}, omega{}, alpha{};
+  std::array<Vec2, kNumJoints> origin, origin_d, origin_dd;
+  Vec8 Hd_qd = Vec8::Zero();                    // Hd qd: cut-pin relative acceleration at qdd = 0
+  Eigen::Matrix<double, 2, 12> J_tip_tree = Eigen::Matrix<double, 2, 12>::Zero();  // d rho / d q
+  Vec2 tip_acc_tree = Vec2::Zero();             // rho acceleration at qdd = 0 (tree)
+  Eigen::PartialPivLU<Mat8> lu_Hp;              // factor of H_p, reused by Psi, gamma and F_c
 };
 
 }  // namespace exc

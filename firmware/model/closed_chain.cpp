@@ -1,0 +1,86 @@
+// The closed chain in independent coordinates (paper eqs. 3-7, 14-17; model.md s.4).
+#include "closed_chain.hpp"
+
+#include "front_kinematics.hpp"
+#include "lie_group.hpp"
+#include "loop_closure.hpp"
+#include "newton_euler.hpp"
+
+namespace exc {
+
+namespace {
+// The soil and gravity are the only external loads; for M_a and h_a the soil is left out.
+const Vec2 kNoSoil = Vec2::Zero();
+}  // namespace
+
+ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a) {
+  if (!q_a.allFinite() || !qd_a.allFinite()) {
+    ws.report = ModelReport{ModelStatus::non_finite_input, -1, 0};
+    return ws.report;
+  }
+  // Position level: q_p from q_a in closed form (Table 2).
+  ws.report = solve_loop_closure(model, ws, q_a);
+  if (!ws.report.ok()) return ws.report;
+  front_positions(model, ws.q, ws);
+  front_loop_jacobian(model, ws, ws.H);  // H = dh/dq (eq. 4)
+
+  // Velocity level: qd = Psi qd_a, Psi = [I; -H_p^-1 H_a] (eq. 16a), in tree order.
+  Mat8 H_p;
+  Mat8x4 H_a;
+  for (int k = 0; k < kNumPassive; ++k) H_p.col(k) = ws.H.col(kPassiveJoints[k]);
+  for (int k = 0; k < kNumActive; ++k) H_a.col(k) = ws.H.col(kActiveJoints[k]);
+  ws.lu_Hp.compute(H_p);
+  const Mat8x4 dqp_dqa = -(ws.lu_Hp.solve(H_a));
+  ws.Psi.setZero();
+  for (int k = 0; k < kNumActive; ++k) ws.Psi(kActiveJoints[k], k) = 1.0;
+  for (int k = 0; k < kNumPassive; ++k) ws.Psi.row(kPassiveJoints[k]) = dqp_dqa.row(k);
+  ws.qd = ws.Psi * qd_a;
+
+  // Acceleration bias: with qdd = 0 the cut pins accelerate apart by Hd qd; gamma = (0; -H_p^-1 Hd qd).
+  front_rates(model, ws.qd, Vec12::Zero(), ws);
+  front_loop_acceleration(model, ws, ws.Hd_qd);
+  const Vec8 gamma_p = -(ws.lu_Hp.solve(ws.Hd_qd));
+  ws.gamma.setZero();
+  for (int k = 0; k < kNumPassive; ++k) ws.gamma[kPassiveJoints[k]] = gamma_p[k];
+  if (!ws.Psi.allFinite() || !ws.gamma.allFinite()) {
+    ws.report = ModelReport{ModelStatus::singular, -1, 0};
+    return ws.report;
+  }
+
+  // Tip kinematics (eq. 2): rho in the swing plane, z measured in the world.
+  Vec2 tip;
+  front_tip(model, ws, tip, ws.J_tip_tree, ws.tip_acc_tree);
+  ws.rho = tip + Vec2(0.0, model.machine.swing_height);
+  ws.J_t = ws.J_tip_tree * ws.Psi;
+  ws.rhod = ws.J_t * qd_a;
+  ws.rhodd_bias = ws.tip_acc_tree + ws.J_tip_tree * ws.gamma;
+
+  // Tree poses and twists for Newton-Euler (also fills ws.tip_world).
+  tree_kinematics(model, ws, ws.q, ws.qd);
+  return ws.report;
+}
+
+void inverse_dynamics(const Model& model, Workspace& ws, const Vec4& qdd_a, const Vec2& f_soil, Vec4& tau_a) {
+  ws.qdd = ws.Psi * qdd_a + ws.gamma;  // eq. 16a, differentiated
+  tree_inverse_dynamics(model, ws, ws.qdd, f_soil, ws.tau_r);
+  tau_a = ws.Psi.transpose() * ws.tau_r;  // eq. 16b
+  // eq. 7a: tau_r = tau_act + H^T F_c with tau_act zero on the passive joints, so H_p^T F_c = tau_p.
+  Vec8 tau_p;
+  for (int k = 0; k < kNumPassive; ++k) tau_p[k] = ws.tau_r[kPassiveJoints[k]];
+  ws.F_c = ws.lu_Hp.transpose().solve(tau_p);
+}
+
+void mass_matrix(const Model& model, Workspace& ws, Mat4& M_a) {
+  Mat12x4 MPsi;
+  tree_inertia_times<4>(model, ws, ws.Psi, MPsi);
+  M_a = ws.Psi.transpose() * MPsi;  // eq. 17
+  M_a = (0.5 * (M_a + M_a.transpose())).eval();
+}
+
+void bias_forces(const Model& model, Workspace& ws, Vec4& h_a) {
+  Vec12 tau;
+  tree_inverse_dynamics(model, ws, ws.gamma, kNoSoil, tau);  // C_r qd + g_r + M_r gamma
+  h_a = ws.Psi.transpose() * tau;
+}
+
+}  // namespace exc

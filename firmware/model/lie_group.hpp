@@ -1,0 +1,137 @@
+#pragma once
+// SE(3) and se(3) with fixed-size Eigen (model.md s.3): hat maps, exp, Ad, ad and their duals.
+// Twists are (w, v) and wrenches (m, f), angular part first, as in the paper. Nothing allocates.
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "types.hpp"
+
+namespace exc {
+
+// [w]: the skew-symmetric matrix with [w] x = w x x.
+inline Mat3 skew(const Vec3& w) {
+  Mat3 s;
+  s << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  return s;
+}
+
+inline Mat3 rotation(const SE3& T) { return T.topLeftCorner<3, 3>(); }
+inline Vec3 translation(const SE3& T) { return T.topRightCorner<3, 1>(); }
+
+inline SE3 make_se3(const Mat3& R, const Vec3& p) {
+  SE3 T = SE3::Identity();
+  T.topLeftCorner<3, 3>() = R;
+  T.topRightCorner<3, 1>() = p;
+  return T;
+}
+
+inline SE3 translation_se3(const Vec3& p) { return make_se3(Mat3::Identity(), p); }
+
+// T^-1 = (R^T, -R^T p), without a general 4x4 inverse.
+inline SE3 inverse(const SE3& T) {
+  const Mat3 Rt = rotation(T).transpose();
+  return make_se3(Rt, -Rt * translation(T));
+}
+
+// [S]: the 4x4 matrix of a twist in se(3).
+inline SE3 hat(const Twist& S) {
+  SE3 m = SE3::Zero();
+  m.topLeftCorner<3, 3>() = skew(S.head<3>());
+  m.topRightCorner<3, 1>() = S.tail<3>();
+  return m;
+}
+
+// exp([S] q) in closed form (Rodrigues for the rotation, the matching V matrix for the translation).
+inline SE3 exp_se3(const Twist& S, double q) {
+  const Vec3 w = S.head<3>() * q;
+  const Vec3 v = S.tail<3>() * q;
+  const double th = w.norm();
+  if (th < 1e-12) {
+    // Pure translation (prismatic) or a vanishing angle: first order is exact to rounding.
+    return make_se3(Mat3::Identity() + skew(w), v);
+  }
+  const Mat3 K = skew(w / th);
+  const double s = std::sin(th), c = std::cos(th);
+  const Mat3 R = Mat3::Identity() + s * K + (1 - c) * K * K;
+  const Mat3 V = Mat3::Identity() + ((1 - c) / th) * K + ((th - s) / th) * K * K;
+  return make_se3(R, V * v);
+}
+
+// Ad_T (6x6): maps a twist in frame B to frame A for T = X_AB.
+inline Mat6 Ad(const SE3& T) {
+  const Mat3 R = rotation(T);
+  Mat6 A = Mat6::Zero();
+  A.topLeftCorner<3, 3>() = R;
+  A.bottomRightCorner<3, 3>() = R;
+  A.bottomLeftCorner<3, 3>() = skew(translation(T)) * R;
+  return A;
+}
+
+// ad_V (6x6): the Lie bracket [V, .] of se(3).
+inline Mat6 ad(const Twist& V) {
+  Mat6 a = Mat6::Zero();
+  a.topLeftCorner<3, 3>() = skew(V.head<3>());
+  a.bottomRightCorner<3, 3>() = skew(V.head<3>());
+  a.bottomLeftCorner<3, 3>() = skew(V.tail<3>());
+  return a;
+}
+
+// Ad_T V without forming the 6x6 matrix.
+inline Twist Ad_apply(const SE3& T, const Twist& V) {
+  const Mat3 R = rotation(T);
+  const Vec3 w = R * V.head<3>();
+  Twist out;
+  out.head<3>() = w;
+  out.tail<3>() = translation(T).cross(w) + R * V.tail<3>();
+  return out;
+}
+
+// Ad_{T^-1} V: a twist of frame A expressed in frame B, for T = X_AB (the forward pass of eq. 1).
+inline Twist Ad_inv_apply(const SE3& T, const Twist& V) {
+  const Mat3 R = rotation(T);
+  Twist out;
+  out.head<3>() = R.transpose() * V.head<3>();
+  out.tail<3>() = R.transpose() * (V.tail<3>() - translation(T).cross(V.head<3>()));
+  return out;
+}
+
+// Ad*_{T^-1} F = Ad_{T^-1}^T F: a wrench in frame B expressed in frame A, for T = X_AB
+// (the backward pass of eq. 1 with T = f_{i,k}).
+inline Wrench Ad_inv_dual_apply(const SE3& T, const Wrench& F) {
+  const Mat3 R = rotation(T);
+  const Vec3 f = R * F.tail<3>();
+  Wrench out;
+  out.head<3>() = R * F.head<3>() + translation(T).cross(f);
+  out.tail<3>() = f;
+  return out;
+}
+
+// ad_V W.
+inline Twist ad_apply(const Twist& V, const Twist& W) {
+  Twist out;
+  out.head<3>() = V.head<3>().cross(W.head<3>());
+  out.tail<3>() = V.tail<3>().cross(W.head<3>()) + V.head<3>().cross(W.tail<3>());
+  return out;
+}
+
+// ad*_V F = ad_V^T F.
+inline Wrench ad_dual_apply(const Twist& V, const Wrench& F) {
+  Wrench out;
+  out.head<3>() = -V.head<3>().cross(F.head<3>()) - V.tail<3>().cross(F.tail<3>());
+  out.tail<3>() = -V.head<3>().cross(F.tail<3>());
+  return out;
+}
+
+// Spatial inertia about the frame origin, twist (w, v): J = [[Ic - m[c]^2, m[c]], [-m[c], m I]].
+inline Mat6 spatial_inertia(double mass, const Vec3& com, const Mat3& inertia_about_com) {
+  const Mat3 C = skew(com);
+  Mat6 J;
+  J.topLeftCorner<3, 3>() = inertia_about_com - mass * C * C;
+  J.topRightCorner<3, 3>() = mass * C;
+  J.bottomLeftCorner<3, 3>() = -mass * C;
+  J.bottomRightCorner<3, 3>() = mass * Mat3::Identity();
+  return J;
+}
+
+}  // namespace exc

@@ -1,0 +1,91 @@
+// Newton-Euler for the tree (paper eq. 1 with model.md's corrections: the second forward line is the
+// acceleration, and the backward sum transforms each child's wrench with f_{i,k} of that child).
+#include "newton_euler.hpp"
+
+#include "lie_group.hpp"
+
+namespace exc {
+
+void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Vec12& qd) {
+  ws.q = q;
+  ws.qd = qd;
+  for (int i = 0; i < kNumJoints; ++i) {
+    const int p = model.parent[i];
+    ws.f_parent[i] = model.home[i] * exp_se3(model.screw[i], q[i]);  // eq. 1: f = M exp([S] q)
+    const Twist S_qd = model.screw[i] * qd[i];
+    if (p < 0) {
+      ws.X_Wi[i] = ws.f_parent[i];
+      ws.V[i] = S_qd;  // the base does not move
+    } else {
+      ws.X_Wi[i] = ws.X_Wi[p] * ws.f_parent[i];
+      ws.V[i] = Ad_inv_apply(ws.f_parent[i], ws.V[p]) + S_qd;  // eq. 1, velocity
+    }
+  }
+  ws.tip_world = ws.X_Wi[kBucket].topLeftCorner<3, 3>() * model.tip_in_bucket +
+                 ws.X_Wi[kBucket].topRightCorner<3, 1>();
+}
+
+void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, const Vec2& f_soil,
+                           Vec12& tau) {
+  // Forward: accelerations, with gravity as the base acceleration Vd_0 (model.md s.3).
+  for (int i = 0; i < kNumJoints; ++i) {
+    const int p = model.parent[i];
+    const Twist S_qd = model.screw[i] * ws.qd[i];
+    const Twist Vd_parent = p < 0 ? model.base_acceleration : Twist(ws.Vd[p]);
+    // eq. 1 (corrected): Vd_i = Ad_{f^-1} Vd_p - ad_{S qd} Ad_{f^-1} V_p + S qdd; ad_{V_i} S qd is
+    // the same term since ad_{S qd} S qd = 0.
+    ws.Vd[i] = Ad_inv_apply(ws.f_parent[i], Vd_parent) + ad_apply(ws.V[i], S_qd) + model.screw[i] * qdd[i];
+    const Wrench momentum = model.inertia[i] * ws.V[i];
+    ws.F[i] = model.inertia[i] * ws.Vd[i] - ad_dual_apply(ws.V[i], momentum);
+  }
+  // The soil pushes on the bucket with -f_soil at the tip T: the joints must supply +f_soil there
+  // (paper eq. 2). f_soil is in the swing plane of the swing frame.
+  if (f_soil.x() != 0.0 || f_soil.y() != 0.0) {
+    const Mat3 R_sw_bucket = ws.X_Wi[kSwing].topLeftCorner<3, 3>().transpose() *
+                             ws.X_Wi[kBucket].topLeftCorner<3, 3>();
+    const Vec3 f_b = R_sw_bucket.transpose() * Vec3(f_soil.x(), 0.0, f_soil.y());
+    ws.F[kBucket].head<3>() += model.tip_in_bucket.cross(f_b);
+    ws.F[kBucket].tail<3>() += f_b;
+  }
+  // Backward: children have higher indices than their parents (Table 1 order).
+  for (int i = kNumJoints - 1; i >= 0; --i) {
+    tau[i] = model.screw[i].dot(ws.F[i]);  // eq. 1: tau_i = S_i^T F_i
+    const int p = model.parent[i];
+    if (p >= 0) ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
+  }
+  ws.tau_r = tau;
+}
+
+template <int N>
+void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Matrix<double, 12, N>& A,
+                        Eigen::Matrix<double, 12, N>& out) {
+  using Block = Eigen::Matrix<double, 6, N>;
+  std::array<Block, kNumJoints> acc, force;
+  for (int i = 0; i < kNumJoints; ++i) {
+    const int p = model.parent[i];
+    acc[i] = model.screw[i] * A.row(i);
+    if (p >= 0) {
+      for (int c = 0; c < N; ++c) acc[i].col(c) += Ad_inv_apply(ws.f_parent[i], acc[p].col(c));
+    }
+    force[i] = model.inertia[i] * acc[i];
+  }
+  for (int i = kNumJoints - 1; i >= 0; --i) {
+    out.row(i) = model.screw[i].transpose() * force[i];
+    const int p = model.parent[i];
+    if (p >= 0) {
+      for (int c = 0; c < N; ++c) force[p].col(c) += Ad_inv_dual_apply(ws.f_parent[i], force[i].col(c));
+    }
+  }
+}
+
+template void tree_inertia_times<4>(const Model&, const Workspace&, const Eigen::Matrix<double, 12, 4>&,
+                                    Eigen::Matrix<double, 12, 4>&);
+template void tree_inertia_times<12>(const Model&, const Workspace&, const Eigen::Matrix<double, 12, 12>&,
+                                     Eigen::Matrix<double, 12, 12>&);
+
+void tree_mass_matrix(const Model& model, const Workspace& ws, Mat12& M_r) {
+  tree_inertia_times<12>(model, ws, Mat12::Identity(), M_r);
+  M_r = (0.5 * (M_r + M_r.transpose())).eval();  // exact in theory; remove rounding asymmetry
+}
+
+}  // namespace exc
