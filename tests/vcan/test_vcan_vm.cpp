@@ -1,0 +1,211 @@
+// vcan-vm end to end: options, output and exit status passed back, frames on a real vcan0 (raw
+// sockets and a candump -L capture), the HAL's SocketCAN test run for real, timeout, missing
+// package. On this project's machines each run boots a QEMU VM; on a host with vcan it runs there.
+// Nothing here depends on how fast the VM is: waits end on events, timeouts only catch hangs.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "hal/candump_log.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kVcanVm = EXC_BINARY_DIR "/tools/vcan-vm";
+
+struct RunResult {
+  int status = -1;  // exit status, or -1 if the shell did not exit normally
+  std::string out, err;
+};
+
+std::string read_file(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// A fresh directory under the build tree that the VM gets read-write (--share).
+fs::path make_work_dir(const std::string& name) {
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "vcan" / "work" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+// Runs `command` under /bin/sh with stdout and stderr captured apart.
+RunResult run(const std::string& command, const fs::path& dir) {
+  const fs::path out = dir / "run.stdout", err = dir / "run.stderr";
+  const std::string line = "(" + command + ") >" + quote(out.string()) + " 2>" + quote(err.string()) + " </dev/null";
+  const int raw = std::system(line.c_str());
+  RunResult r;
+  r.status = (raw != -1 && WIFEXITED(raw)) ? WEXITSTATUS(raw) : -1;
+  r.out = read_file(out);
+  r.err = read_file(err);
+  return r;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  return lines;
+}
+
+}  // namespace
+
+TEST_CASE("vcan/vcan-vm rejects bad options, naming the option and its range") {
+  const fs::path dir = make_work_dir("options");
+  RunResult help = run(kVcanVm + " --help", dir);
+  CHECK(help.status == 0);
+  CHECK(help.out.find("Usage: vcan-vm") != std::string::npos);
+  CHECK(help.out.find("--share DIR") != std::string::npos);
+
+  struct Bad {
+    const char* args;
+    const char* says;
+  };
+  for (const Bad& bad : {Bad{"--timeout 0 -- true", "--timeout '0': must be whole seconds in 1..86400"},
+                         Bad{"--timeout 1.5 -- true", "--timeout '1.5'"},
+                         Bad{"--memory 64 -- true", "--memory '64': must be MiB in 128..16384"},
+                         Bad{"--cpus 0 -- true", "--cpus '0': must be in 1..16"},
+                         Bad{"--accel xen -- true", "--accel 'xen': must be tcg or kvm"},
+                         Bad{"--share /nonexistent/dir -- true", "--share '/nonexistent/dir': not an existing directory"},
+                         Bad{"--frobnicate -- true", "unknown option '--frobnicate'"},
+                         Bad{"--timeout", "option --timeout needs a value"},
+                         Bad{"", "no command given"}}) {
+    CAPTURE(bad.args);
+    RunResult r = run(kVcanVm + " " + bad.args, dir);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(bad.says) != std::string::npos);
+    CHECK(r.out.empty());
+  }
+}
+
+TEST_CASE("vcan/vcan-vm passes stdout, stderr, exit status, directory and environment through") {
+  const fs::path dir = make_work_dir("passthrough");
+  // Two lines on stdout (no carriage returns may appear), one on stderr, a file written into the
+  // shared directory from the caller's working directory, a variable of the caller's environment.
+  const std::string inner =
+      "printf 'out 1\\nout 2\\n'; printf 'err\\n' >&2; pwd > where.txt; "
+      "printf %s \"$EXC_VCAN_TEST_VALUE\" > env.txt; ip -o link show dev vcan0 > link.txt; exit 3";
+  RunResult r = run("cd " + quote(dir.string()) + " && EXC_VCAN_TEST_VALUE=\"a b'c\" " + kVcanVm +
+                        " --share " + quote(dir.string()) + " -- sh -c " + quote(inner),
+                    dir);
+  CHECK(r.status == 3);
+  CHECK(r.out == "out 1\nout 2\n");
+  CHECK(r.err == "err\n");
+  CHECK(read_file(dir / "where.txt") == dir.string() + "\n");
+  CHECK(read_file(dir / "env.txt") == "a b'c");
+  const std::string link = read_file(dir / "link.txt");
+  CHECK(link.find("vcan0") != std::string::npos);
+  CHECK(link.find("UP") != std::string::npos);
+  CHECK(link.find("link/can") != std::string::npos);
+}
+
+TEST_CASE("vcan/frames round-trip through vcan0 and a candump -L capture of them decodes") {
+  const fs::path dir = make_work_dir("frames");
+  // Edge IDs and lengths: DLC 0..8, 11-bit extremes, one 29-bit ID.
+  const std::vector<std::string> sent = {"123#DEADBEEF", "000#",           "7FF#0102030405060708",
+                                         "080#00",       "1ABCDEF0#11",    "456#A1B2C3",
+                                         "001#FFFFFFFFFFFFFFFF", "7FE#0A0B0C0D0E", "234#1122"};
+  std::string frames;
+  for (const std::string& f : sent) frames += " " + f;
+  const fs::path capture = dir / "capture.log";
+  // candump is started first; the probe sends only once the kernel lists candump's receiver on
+  // vcan0 (so no frame can be missed whatever the VM's speed), and candump stops after the count.
+  const std::string receivers = "cat /proc/net/can/rcvlist_* | grep -c -E '^ +vcan0 +[0-9A-Fa-f]'";
+  const std::string inner = "n0=$(" + receivers + "); candump -L -n " + std::to_string(sent.size()) +
+                            " vcan0 > " + quote(capture.string()) + " & c=$!; "
+                            "while [ \"$(" + receivers + ")\" -le \"$n0\" ]; do sleep 0.05; done; " +
+                            quote(VCAN_FRAME_PROBE) + " vcan0" + frames + "; p=$?; wait $c; c=$?; "
+                            "[ $p -eq 0 ] && [ $c -eq 0 ]";
+  RunResult r = run(kVcanVm + " --share " + quote(dir.string()) + " -- sh -c " + quote(inner), dir);
+  INFO("stderr: ", r.err);
+  REQUIRE(r.status == 0);
+
+  // What the second raw socket received, in order.
+  const std::vector<std::string> received = lines_of(r.out);
+  CHECK(received == sent);
+
+  // What candump recorded: same frames, same order, on vcan0, with time stamps that do not go back.
+  const std::vector<std::string> captured = lines_of(read_file(capture));
+  REQUIRE(captured.size() == sent.size());
+  std::int64_t last_ns = 0;
+  for (std::size_t i = 0; i < sent.size(); ++i) {
+    CAPTURE(captured[i]);
+    exc::hal::CandumpLine line;
+    std::string error;
+    REQUIRE_MESSAGE(exc::hal::parse_candump_line(captured[i], line, error), error);
+    CHECK(line.interface_name == "vcan0");
+    CHECK(line.frame.timestamp_ns >= last_ns);
+    last_ns = line.frame.timestamp_ns;
+    // The frame text after "vcan0 " is candump's own rendering: compare it with what was sent,
+    // and the parsed fields with the bytes of the sent text.
+    CHECK(captured[i].substr(captured[i].find(' ', captured[i].find(' ') + 1) + 1) == sent[i]);
+    const std::string& s = sent[i];
+    const std::size_t hash = s.find('#');
+    CHECK(line.extended == (hash == 8));
+    CHECK(line.frame.id == std::stoul(s.substr(0, hash), nullptr, 16));
+    CHECK(line.frame.dlc == (s.size() - hash - 1) / 2);
+    for (std::size_t b = 0; b < line.frame.dlc; ++b)
+      CHECK(line.frame.data[b] == std::stoul(s.substr(hash + 1 + 2 * b, 2), nullptr, 16));
+  }
+}
+
+#ifdef EXC_HAL_TESTS
+TEST_CASE("vcan/the HAL's SocketCAN test runs for real on vcan0 instead of skipping") {
+  const fs::path dir = make_work_dir("hal");
+  RunResult r = run(kVcanVm + " -- " + quote(EXC_HAL_TESTS) + " " +
+                        quote("--test-case=hal/ports run whole cycles over SocketCAN vcan0"),
+                    dir);
+  INFO("stdout: ", r.out, "\nstderr: ", r.err);
+  CHECK(r.status == 0);
+  CHECK(r.out.find("SKIPPED") == std::string::npos);
+  CHECK(std::regex_search(r.out, std::regex("test cases: +1 \\| +1 passed \\| +0 failed")));
+}
+#endif
+
+TEST_CASE("vcan/vcan-vm stops a command at the timeout and reports it") {
+  const fs::path dir = make_work_dir("timeout");
+  const auto start = std::chrono::steady_clock::now();
+  RunResult r = run(kVcanVm + " --timeout 5 -- sleep 1000", dir);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  CHECK(r.status == 124);
+  CHECK(r.err.find("timed out after 5 s") != std::string::npos);
+  CHECK(seconds < 120.0);  // generous: the kill comes at 5 s, a grace of 5 s more, then clean-up
+}
+
+TEST_CASE("vcan/vcan-vm names the Debian package when QEMU is missing") {
+  const fs::path dir = make_work_dir("missing");
+  // A PATH with everything of /usr/bin and /usr/sbin but QEMU.
+  const fs::path bin = dir / "bin";
+  fs::create_directories(bin);
+  for (const char* from : {"/usr/bin", "/usr/sbin"}) {
+    for (const auto& entry : fs::directory_iterator(from)) {
+      const std::string name = entry.path().filename().string();
+      if (name.rfind("qemu-system", 0) == 0 || fs::exists(bin / name)) continue;
+      fs::create_symlink(entry.path(), bin / name);
+    }
+  }
+  RunResult r = run("PATH=" + quote(bin.string()) + " " + kVcanVm + " --vm -- true", dir);
+  CHECK(r.status == 125);
+  CHECK(r.err.find("qemu-system-x86_64") != std::string::npos);
+  CHECK(r.err.find("Debian package qemu-system-x86") != std::string::npos);
+}
