@@ -1,0 +1,233 @@
+#include "app/firmware_node.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "control/make_controller.hpp"
+#include "exlcm/can_stats_t.hpp"
+#include "exlcm/command_t.hpp"
+#include "exlcm/controller_state_t.hpp"
+#include "exlcm/fault_t.hpp"
+#include "exlcm/timing_t.hpp"
+#include "hal/clock.hpp"
+#include "telemetry/telemetry_publisher.hpp"
+
+namespace exc::app {
+namespace {
+
+constexpr int kHeartbeatPeriod = 100;  // cycles (hal/can_protocol.hpp kHeartbeatPeriodCycles)
+constexpr int kCounterPeriod = 100;    // cycles between timing / CAN counter messages
+
+Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]); }
+
+bool finite(const Vec4& v) { return v.allFinite(); }
+
+void fill_timing(const control::PerfCounter& c, std::int8_t stage, std::int64_t utime,
+                 exlcm::timing_t& m) {
+  m.utime = utime;
+  m.stage = stage;
+  m.count = static_cast<std::int64_t>(c.count());
+  m.min_us = c.min_us();
+  m.median_us = c.median_us();
+  m.p99_us = c.p99_us();
+  m.max_us = c.max_us();
+  m.overruns = static_cast<std::int64_t>(c.overruns());
+  // Re-bin the counter's log histogram onto 64 linear bins covering twice the p99.
+  const double span = std::max(1.0, 2 * c.p99_us());
+  m.bin_width_us = span / 64;
+  std::fill(std::begin(m.bins), std::end(m.bins), 0);
+  const auto& h = c.histogram();
+  for (int b = 0; b < control::PerfCounter::kBuckets; ++b) {
+    if (h[b] == 0) continue;
+    const double centre = control::PerfCounter::upper_edge_us(b) / std::sqrt(control::PerfCounter::kRatio);
+    const int bin = std::min(63, static_cast<int>(centre / m.bin_width_us));
+    m.bins[bin] += h[b];
+  }
+}
+
+}  // namespace
+
+FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
+                           hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry)
+    : model_(model),
+      task_(task),
+      config_(config),
+      port_(port),
+      telemetry_(telemetry),
+      controller_(control::make_controller(config.kind, model, config.controller)),
+      estimator_(config.controller.filter),
+      machine_(config.controller.watchdog_timeout),
+      blender_(config.controller.blend_time),
+      control_timing_("control", 100.0),
+      cycle_timing_("cycle", 1000.0),
+      period_(config.controller.period) {}
+
+FirmwareNode::~FirmwareNode() = default;
+
+void FirmwareNode::begin_cycle() {
+  ++cycle_;
+  port_.send_sync(cycle_);
+  if (cycle_ % kHeartbeatPeriod == 0) port_.send_heartbeat(static_cast<std::uint8_t>(machine_.mode()));
+}
+
+void FirmwareNode::end_cycle() {
+  const std::int64_t start_ns = hal::monotonic_now_ns();
+  const double t = time();
+  if (port_.read(sensors_) && sensors_.motion_valid) {
+    have_valid_ = true;
+    last_valid_time_ = t;
+  }
+
+  control::StateMachineInputs in;
+  in.t = t;
+  in.have_valid_frame = have_valid_;
+  in.last_valid_frame_time = last_valid_time_;
+  in.track_requested = t >= config_.track_delay;
+  in.trajectory_finished = machine_.mode() == control::Mode::track &&
+                           t - track_start_ + task_.start_time() >= task_.end_time();
+  in.fault = fault_;
+  const control::Transition transition = machine_.step(in);
+  if (transition.changed) {
+    if (transition.to == control::Mode::hold) {
+      held_q_ = to_vec(sensors_.position);
+      fault_ = false;
+    }
+    if (transition.to == control::Mode::track) track_start_ = t;
+    if (transition.from == control::Mode::track && in.trajectory_finished) finished_ = true;
+    if (transition.to == control::Mode::safe_stop) {
+      ++safe_stops_;
+      port_.send_fault(false, static_cast<std::uint16_t>(fault_ ? FirmwareFault::model : FirmwareFault::sensor_timeout));
+    }
+  }
+
+  compute_command(transition);
+  port_.write(command_);
+  cycle_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
+  if (telemetry_ != nullptr) publish_cycle();
+  if (telemetry_ != nullptr && transition.changed) {
+    exlcm::fault_t f{};
+    f.utime = static_cast<std::int64_t>(t * 1e6);
+    f.code = static_cast<std::int32_t>(transition.to == control::Mode::safe_stop ? 1 : 0);
+    f.severity = transition.to == control::Mode::safe_stop ? 2 : 0;
+    f.active = transition.to == control::Mode::safe_stop;
+    std::snprintf(reinterpret_cast<char*>(f.text), sizeof(f.text), "%s -> %s: %s", control::to_string(transition.from),
+                  control::to_string(transition.to), transition.reason);
+    telemetry_->publish(telemetry::Channel::fault, f);
+  }
+  if (telemetry_ != nullptr && cycle_ % kCounterPeriod == 0) publish_counters();
+}
+
+void FirmwareNode::compute_command(const control::Transition& transition) {
+  const control::Mode mode = machine_.mode();
+  command_.cycle = cycle_;
+  command_.firmware_mode = static_cast<std::uint8_t>(mode);
+  if (mode != control::Mode::hold && mode != control::Mode::track) {
+    // No valid sensors (or a fault): the safe state is valves centred, i.e. zero cylinder flow and
+    // the swing brake; the plant holds the machine where it is.
+    command_.mode = hal::CommandMode::valve;
+    command_.value = {0, 0, 0, 0};
+    last_sent_.setZero();
+    return;
+  }
+  const std::int64_t start_ns = hal::monotonic_now_ns();
+  const double t = time();
+  const Vec4 q = to_vec(sensors_.position);
+  const Vec4 qd = to_vec(sensors_.velocity);
+  if (transition.changed && (transition.from == control::Mode::safe_stop ||
+                             transition.from == control::Mode::wait_sensors)) {
+    estimator_.reset(q, qd);
+    controller_->reset();
+  } else {
+    estimator_.update(q, qd);
+  }
+
+  if (mode == control::Mode::track) {
+    task_.trajectory.evaluate(t - track_start_ + task_.start_time(), q_d_, qd_d_, qdd_d_);
+  } else {
+    q_d_ = held_q_;
+    qd_d_.setZero();
+    qdd_d_.setZero();
+  }
+
+  control::ControlInput input;
+  input.t = t;
+  input.q = estimator_.position();
+  input.qd = estimator_.velocity();
+  input.qdd = estimator_.acceleration();
+  input.q_d = q_d_;
+  input.qd_d = qd_d_;
+  input.qdd_d = qdd_d_;
+  input.soil.terrain_height = config_.terrain_height;
+  input.soil.theta_known = config_.theta_known;
+  input.soil.theta = config_.theta_true;
+  out_ = controller_->update(input);
+  if (out_.status != ModelStatus::ok || !finite(out_.tau)) fault_ = true;
+
+  // Bumpless: entering hold/track from another effort-commanding mode starts from the last command.
+  if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))
+    blender_.on_switch(t, last_sent_, out_.tau);
+  const Vec4 tau = blender_.apply(t, out_.tau);
+  command_.mode = hal::CommandMode::effort;
+  for (int j = 0; j < 4; ++j) command_.value[j] = tau[j];
+  last_sent_ = tau;
+  control_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
+}
+
+void FirmwareNode::publish_cycle() {
+  const auto utime = static_cast<std::int64_t>(time() * 1e6);
+  exlcm::command_t c{};
+  c.utime = utime;
+  c.mode = static_cast<std::int8_t>(machine_.mode());
+  c.controller = static_cast<std::int8_t>(config_.kind);
+  for (int j = 0; j < 4; ++j) {
+    const bool effort = command_.mode == hal::CommandMode::effort;
+    c.effort[j] = effort ? command_.value[j] : 0.0;
+    c.valve[j] = effort ? 0.0 : command_.value[j];
+    c.saturated[j] = (out_.saturated >> j) & 1;
+  }
+  telemetry_->publish(telemetry::Channel::command, c);
+
+  exlcm::controller_state_t s{};
+  s.utime = utime;
+  s.controller = static_cast<std::int8_t>(config_.kind);
+  s.mode = static_cast<std::int8_t>(machine_.mode());
+  for (int j = 0; j < 4; ++j) {
+    s.q_desired[j] = q_d_[j];
+    s.qd_desired[j] = qd_d_[j];
+    s.error[j] = out_.e[j];
+    s.error_rate[j] = out_.ed[j];
+  }
+  for (int i = 0; i < 6; ++i) {
+    s.theta_hat[i] = out_.theta_hat[i];
+    s.theta_true[i] = config_.theta_known ? config_.theta_true[i] : std::nan("");
+  }
+  s.lyapunov = out_.lyapunov;
+  telemetry_->publish(telemetry::Channel::controller, s);
+}
+
+void FirmwareNode::publish_counters() {
+  if (telemetry_ == nullptr) return;
+  const auto utime = static_cast<std::int64_t>(time() * 1e6);
+  exlcm::timing_t m{};
+  fill_timing(cycle_timing_, 0, utime, m);
+  telemetry_->publish(telemetry::Channel::timing, m);
+  fill_timing(control_timing_, 2, utime, m);
+  telemetry_->publish(telemetry::Channel::timing, m);
+
+  const hal::RxStats& rx = port_.rx_stats();
+  exlcm::can_stats_t cs{};
+  cs.utime = utime;
+  cs.node = 0;
+  cs.tx = static_cast<std::int64_t>(port_.tx_stats().frames_sent);
+  cs.rx_ok = static_cast<std::int64_t>(rx.ok);
+  cs.stale = static_cast<std::int64_t>(rx.stale);
+  cs.repeated = static_cast<std::int64_t>(rx.repeated);
+  cs.corrupt = static_cast<std::int64_t>(rx.corrupt);
+  cs.wrong_dlc = static_cast<std::int64_t>(rx.wrong_dlc);
+  cs.unknown = static_cast<std::int64_t>(rx.unknown_id);
+  cs.dropped = static_cast<std::int64_t>(port_.tx_stats().send_failed);
+  telemetry_->publish(telemetry::Channel::can_stats, cs);
+}
+
+}  // namespace exc::app

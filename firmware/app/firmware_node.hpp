@@ -1,0 +1,108 @@
+#pragma once
+// The firmware's 1 kHz cycle, wired (PX4 module style: the control law is a library, this only
+// wires bus, state machine, estimator, trajectory, controller and telemetry):
+//   begin_cycle(): send SYNC(k) (+ heartbeat)              -> the plant steps once and answers
+//   end_cycle():   read + validate sensors -> watchdog/state machine -> estimate -> trajectory
+//                  -> control law -> saturate/blend -> write commands -> telemetry
+// Time is the cycle count times the period, so a run is deterministic and the plant's time is the
+// firmware's. Nothing here allocates, locks or blocks after construction.
+#include <cstdint>
+#include <memory>
+
+#include "control/control_types.hpp"
+#include "control/controller_config.hpp"
+#include "control/perf_counter.hpp"
+#include "control/state_estimator.hpp"
+#include "control/state_machine.hpp"
+#include "control/task.hpp"
+#include "hal/can_ports.hpp"
+#include "model/model.hpp"
+
+namespace exc::telemetry {
+class TelemetryPublisher;
+}
+
+namespace exc::app {
+
+struct FirmwareNodeConfig {
+  control::ControllerKind kind = control::ControllerKind::adaptive;
+  control::ControllerConfig controller;
+  double terrain_height = 0;      // m, world z of the flat terrain (from the scene)
+  double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
+  // Simulation only: the plant's true soil parameters, for telemetry and the Lyapunov value.
+  bool theta_known = false;
+  Vec6 theta_true = Vec6::Zero();
+};
+
+// Firmware fault codes (fault_t.code and the CAN fault frame).
+enum class FirmwareFault : std::uint16_t {
+  none = 0,
+  sensor_timeout = 1,  // watchdog: no valid sensor set within the timeout
+  model = 2,           // the closed-chain model refused the state (no assembly, toggle)
+};
+
+class FirmwareNode {
+ public:
+  FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
+               hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry);
+  ~FirmwareNode();
+  FirmwareNode(const FirmwareNode&) = delete;
+  FirmwareNode& operator=(const FirmwareNode&) = delete;
+
+  // Starts cycle k (k = previous + 1): SYNC, and the heartbeat every 100 cycles.
+  void begin_cycle();
+  // Completes the cycle once the plant had its chance to answer.
+  void end_cycle();
+
+  std::uint64_t cycle() const { return cycle_; }
+  double time() const { return static_cast<double>(cycle_) * period_; }
+  control::Mode mode() const { return machine_.mode(); }
+  bool tracking() const { return machine_.mode() == control::Mode::track; }
+  // The trajectory ran to its end (the node then holds the last point).
+  bool trajectory_finished() const { return finished_; }
+  // Desired and measured q_a of the last cycle (valid while tracking or holding).
+  const Vec4& q_desired() const { return q_d_; }
+  const hal::SensorState& sensors() const { return sensors_; }
+  const control::ControlOutput& last_output() const { return out_; }
+  const hal::CommandState& last_command() const { return command_; }
+  // Time of the control computation (estimate + trajectory + control law), and of the whole
+  // end_cycle (read + compute + write + telemetry encode).
+  const control::PerfCounter& control_timing() const { return control_timing_; }
+  const control::PerfCounter& cycle_timing() const { return cycle_timing_; }
+  std::uint64_t safe_stops() const { return safe_stops_; }
+  // Publishes the timing and CAN counters now (also done every 100 cycles).
+  void publish_counters();
+
+ private:
+  void compute_command(const control::Transition& transition);
+  void publish_cycle();
+
+  const Model& model_;
+  const control::Task& task_;
+  FirmwareNodeConfig config_;
+  hal::FirmwareCanPort& port_;
+  telemetry::TelemetryPublisher* telemetry_;
+  std::unique_ptr<control::Controller> controller_;
+  control::StateEstimator estimator_;
+  control::ControlStateMachine machine_;
+  control::CommandBlender blender_;
+  control::PerfCounter control_timing_;
+  control::PerfCounter cycle_timing_;
+
+  double period_;
+  std::uint64_t cycle_ = 0;
+  bool have_valid_ = false;
+  double last_valid_time_ = -1e300;
+  double track_start_ = 0;
+  Vec4 held_q_ = Vec4::Zero();
+  Vec4 q_d_ = Vec4::Zero(), qd_d_ = Vec4::Zero(), qdd_d_ = Vec4::Zero();
+  Vec4 last_sent_ = Vec4::Zero();
+  bool fault_ = false;
+  bool finished_ = false;
+  std::uint64_t safe_stops_ = 0;
+  hal::SensorState sensors_;
+  hal::CommandState command_;
+  control::ControlOutput out_;
+};
+
+}  // namespace exc::app
