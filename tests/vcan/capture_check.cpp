@@ -1,0 +1,94 @@
+#include "capture_check.hpp"
+
+#include <cstdio>
+
+#include "hal/can_codec.hpp"
+#include "hal/can_protocol.hpp"
+#include "hal/candump_log.hpp"
+
+namespace exc::vcan {
+
+namespace {
+
+std::string hex(std::uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%03X", v);
+  return buf;
+}
+
+}  // namespace
+
+CaptureReport check_capture(std::istream& in, const std::string& interface_name) {
+  using namespace exc::hal;
+  CaptureReport report;
+  bool have_sync = false;
+  std::uint8_t sync_counter = 0;
+  std::map<std::uint32_t, int> own_counter;  // last counter per non-cyclic ID
+  std::string text;
+  std::size_t line_no = 0;
+  while (std::getline(in, text)) {
+    ++line_no;
+    if (text.find_first_not_of(" \t\r") == std::string::npos) continue;
+    ++report.frames;
+    const std::string where = "line " + std::to_string(line_no) + ": ";
+    CandumpLine line;
+    std::string error;
+    if (!parse_candump_line(text, line, error)) {
+      report.errors.push_back(where + "not a candump -L line (" + error + ")");
+      continue;
+    }
+    if (!interface_name.empty() && line.interface_name != interface_name) {
+      report.errors.push_back(where + "interface " + line.interface_name + ", expected " + interface_name);
+      continue;
+    }
+    if (line.extended || line.remote || line.fd) {
+      report.errors.push_back(where + "not a classical 11-bit data frame");
+      continue;
+    }
+    const CanFrame& frame = line.frame;
+    const MessageSpec* spec = find_message(frame.id);
+    if (spec == nullptr) {
+      report.errors.push_back(where + "identifier " + hex(frame.id) + " is not in the DBC");
+      continue;
+    }
+    if (frame.dlc != spec->dlc) {
+      report.errors.push_back(where + spec->name + " has DLC " + std::to_string(frame.dlc) + ", the DBC says " +
+                              std::to_string(spec->dlc));
+      continue;
+    }
+    const std::uint8_t crc = frame_checksum(frame.id, frame.data, static_cast<std::size_t>(frame.dlc - 1));
+    if (crc != frame.data[frame.dlc - 1]) {
+      report.errors.push_back(where + spec->name + " checksum " + hex(frame.data[frame.dlc - 1]) + ", expected " + hex(crc));
+      continue;
+    }
+    const std::uint8_t counter = frame_counter(frame);
+    if (frame.id == can_id::sync) {
+      if (have_sync && counter != ((sync_counter + 1) & 0x0F)) {
+        report.errors.push_back(where + "SYNC counter " + std::to_string(counter) + " after " +
+                                std::to_string(sync_counter) + " (a cycle was skipped or repeated)");
+      }
+      have_sync = true;
+      sync_counter = counter;
+      ++report.syncs;
+    } else if (spec->cycle_ms == 1) {
+      if (!have_sync) {
+        report.errors.push_back(where + spec->name + " before the first SYNC");
+      } else if (counter != sync_counter) {
+        report.errors.push_back(where + spec->name + " counter " + std::to_string(counter) +
+                                " does not match the last SYNC's " + std::to_string(sync_counter));
+      }
+    } else {
+      auto it = own_counter.find(frame.id);
+      if (it != own_counter.end() && counter != ((it->second + 1) & 0x0F)) {
+        report.errors.push_back(where + spec->name + " counter " + std::to_string(counter) + " after " +
+                                std::to_string(it->second) + " (a frame was lost or repeated)");
+      }
+      own_counter[frame.id] = counter;
+    }
+    ++report.per_message[spec->name];
+  }
+  if (report.frames == 0) report.errors.push_back("the capture has no frames");
+  return report;
+}
+
+}  // namespace exc::vcan
