@@ -16,6 +16,24 @@ std::string hex(std::uint32_t v) {
   return buf;
 }
 
+std::string decoded_signals(const exc::hal::MessageSpec& spec, const exc::hal::CanFrame& frame) {
+  double values[16] = {};
+  exc::hal::decode_message(spec, frame, values);
+  std::string text;
+  for (std::size_t i = 0; i < spec.data_signal_count() && i < 16; ++i) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%s%s=%g", text.empty() ? "" : " ", spec.data_signal(i).name, values[i]);
+    text += buf;
+  }
+  return text;
+}
+
+struct Accepted {
+  std::size_t line;
+  exc::hal::CanFrame frame;
+  const exc::hal::MessageSpec* spec;
+};
+
 }  // namespace
 
 CaptureReport check_capture(std::istream& in, const std::string& interface_name) {
@@ -24,6 +42,7 @@ CaptureReport check_capture(std::istream& in, const std::string& interface_name)
   bool have_sync = false;
   std::uint8_t sync_counter = 0;
   std::map<std::uint32_t, int> own_counter;  // last counter per non-cyclic ID
+  std::vector<Accepted> accepted;
   std::string text;
   std::size_t line_no = 0;
   while (std::getline(in, text)) {
@@ -86,8 +105,40 @@ CaptureReport check_capture(std::istream& in, const std::string& interface_name)
       own_counter[frame.id] = counter;
     }
     ++report.per_message[spec->name];
+    accepted.push_back({line_no, frame, spec});
   }
   if (report.frames == 0) report.errors.push_back("the capture has no frames");
+
+  // Reactions to silence: the last ordinary frame of each side, then the other side's emergency.
+  std::size_t last_plant = accepted.size(), last_firmware = accepted.size();
+  for (std::size_t i = 0; i < accepted.size(); ++i) {
+    const std::uint32_t id = accepted[i].frame.id;
+    if (id == can_id::fw_emergency || id == can_id::plant_emergency) continue;
+    (accepted[i].spec->sender == Node::plant ? last_plant : last_firmware) = i;
+  }
+  if (last_plant < accepted.size()) {
+    report.last_plant_line = accepted[last_plant].line;
+    long syncs = 0;
+    for (std::size_t i = last_plant + 1; i < accepted.size(); ++i) {
+      if (accepted[i].frame.id == can_id::sync) ++syncs;
+      if (accepted[i].frame.id == can_id::fw_emergency) {
+        report.fw_emergency_line = accepted[i].line;
+        report.fw_emergency_cycles = syncs;
+        report.fw_emergency_signals = decoded_signals(*accepted[i].spec, accepted[i].frame);
+        break;
+      }
+    }
+  }
+  if (last_firmware < accepted.size()) {
+    report.last_firmware_line = accepted[last_firmware].line;
+    for (std::size_t i = last_firmware + 1; i < accepted.size(); ++i) {
+      if (accepted[i].frame.id == can_id::plant_emergency) {
+        report.plant_emergency_line = accepted[i].line;
+        report.plant_emergency_signals = decoded_signals(*accepted[i].spec, accepted[i].frame);
+        break;
+      }
+    }
+  }
   return report;
 }
 

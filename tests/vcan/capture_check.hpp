@@ -6,6 +6,8 @@
 //   - Cyclic (1 ms) frames carry the cycle mod 16: SYNC's counter steps by exactly one from SYNC to
 //     SYNC, and every other cyclic frame carries the counter of the last SYNC before it.
 //   - The others (pressures, heartbeats, emergencies) count their own sends: +1 per frame of an ID.
+// It also measures how each side reacted when the other fell silent (the kill tests), in cycles
+// (SYNC frames), so the figure does not depend on how fast the machine running the test is.
 #include <cstddef>
 #include <cstdint>
 #include <istream>
@@ -20,6 +22,16 @@ struct CaptureReport {
   std::size_t syncs = 0;
   std::map<std::string, std::size_t> per_message;  // accepted frames by DBC message name
   std::vector<std::string> errors;                 // "line N: what", in capture order
+  // Lines (1-based; 0: none) of the last frame each side sent before any emergency frame of its own.
+  std::size_t last_plant_line = 0, last_firmware_line = 0;
+  // The first FW_EMERGENCY after the plant's last frame: its line, the SYNCs between the two (the
+  // firmware's reaction time in cycles), and its decoded signals "EmergencyStop=1 FaultCode=1".
+  std::size_t fw_emergency_line = 0;
+  long fw_emergency_cycles = -1;
+  std::string fw_emergency_signals;
+  // The first PLANT_EMERGENCY after the firmware's last frame (0: none) and its decoded signals.
+  std::size_t plant_emergency_line = 0;
+  std::string plant_emergency_signals;
   bool ok() const { return errors.empty() && frames > 0; }
 };
 

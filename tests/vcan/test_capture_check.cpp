@@ -154,3 +154,45 @@ TEST_CASE("vcan/capture check finds each kind of damage at its line") {
     CHECK(r.errors.at(0) == "the capture has no frames");
   }
 }
+
+TEST_CASE("vcan/capture check counts the cycles from the plant's silence to the firmware's safe stop") {
+  // The plant answers cycles 0..99 and then falls silent; the firmware keeps sending SYNC and sends
+  // its emergency frame right after SYNC(120): the SYNCs of cycles 100..120, 21 of them, lie between
+  // the plant's last frame and the emergency.
+  MemoryBusHub hub;
+  MemoryBusNode* fw_node = hub.attach();
+  MemoryBusNode* pl_node = hub.attach();
+  MemoryBusNode* tap = hub.attach(1 << 16);
+  FirmwareCanPort firmware(*fw_node);
+  PlantCanPort plant(*pl_node);
+  for (std::uint64_t k = 0; k < 140; ++k) {
+    firmware.send_sync(k);
+    std::uint64_t cycle = 0;
+    while (plant.poll_sync(cycle)) {
+      if (cycle >= 100) continue;
+      SensorState s;
+      s.cycle = cycle;
+      plant.write(s);
+    }
+    if (k == 120 || k == 130) firmware.send_fault(true, 1);
+  }
+  std::vector<std::string> lines;
+  CanFrame f;
+  std::int64_t t = 1'000'000'000;
+  while (tap->receive(f)) lines.push_back(candump_line(f, t += 1000));
+  const exc::vcan::CaptureReport r = check(lines);
+  CHECK(r.ok());
+  CHECK(r.last_plant_line == index_of(lines, "183#", 99) + 1);
+  CHECK(r.fw_emergency_line == index_of(lines, "010#", 0) + 1);
+  CHECK(r.fw_emergency_cycles == 21);
+  CHECK(r.fw_emergency_signals == "EmergencyStop=1 FaultCode=1");
+  CHECK(r.plant_emergency_line == 0);
+
+  // The reverse: the firmware falls silent after SYNC(139) and the plant sends its emergency.
+  plant.send_fault(true, 7);
+  while (tap->receive(f)) lines.push_back(candump_line(f, t += 1000));
+  const exc::vcan::CaptureReport r2 = check(lines);
+  CHECK(r2.plant_emergency_line == lines.size());
+  CHECK(r2.last_firmware_line == index_of(lines, "080#", 139) + 1);
+  CHECK(r2.plant_emergency_signals == "EmergencyStop=1 FaultCode=7");
+}

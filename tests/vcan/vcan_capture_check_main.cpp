@@ -2,6 +2,7 @@
 // by frame (see capture_check.hpp). The two-process vcan tests run it on the capture of a run.
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -11,6 +12,8 @@
 
 int main(int argc, char** argv) {
   std::string path, interface_name = "vcan0";
+  long safe_stop_within = -1;  // --expect-safe-stop-within N (cycles); -1: not asked
+  bool expect_plant_hold = false;
   for (int i = 1; i < argc; ++i) {
     if (std::strcmp(argv[i], "--help") == 0 || std::strcmp(argv[i], "-h") == 0) {
       std::puts(
@@ -19,12 +22,26 @@ int main(int argc, char** argv) {
           "identifier, the DBC's DLC, valid CRC-8 checksum, counters in sequence with nothing lost\n"
           "(cyclic frames carry the last SYNC's counter; SYNC, pressures, heartbeats and emergencies\n"
           "step by one), all on interface NAME (default vcan0; \"\" for any).\n"
-          "Prints frames per message and every error with its line number. Exit status: 0 when the\n"
-          "capture is clean, 1 when a frame is wrong, 2 when CAPTURE cannot be read.");
+          "  --expect-safe-stop-within N  also require an FW_EMERGENCY frame at most N cycles (SYNC\n"
+          "                               frames) after the plant's last frame (plant killed)\n"
+          "  --expect-plant-hold          also require a PLANT_EMERGENCY frame after the firmware's\n"
+          "                               last frame (firmware killed)\n"
+          "Prints frames per message, the reactions to silence and every error with its line number.\n"
+          "Exit status: 0 when the capture is clean (and the expectations hold), 1 otherwise, 2 when\n"
+          "the arguments are wrong or CAPTURE cannot be read.");
       return 0;
     }
     if (std::strcmp(argv[i], "--interface") == 0 && i + 1 < argc) {
       interface_name = argv[++i];
+    } else if (std::strcmp(argv[i], "--expect-safe-stop-within") == 0 && i + 1 < argc) {
+      char* end = nullptr;
+      safe_stop_within = std::strtol(argv[++i], &end, 10);
+      if (*argv[i] == '\0' || *end != '\0' || safe_stop_within < 0 || safe_stop_within > 1000000) {
+        std::fprintf(stderr, "vcan-capture-check: --expect-safe-stop-within '%s': must be cycles in 0..1000000\n", argv[i]);
+        return 2;
+      }
+    } else if (std::strcmp(argv[i], "--expect-plant-hold") == 0) {
+      expect_plant_hold = true;
     } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
       std::fprintf(stderr, "vcan-capture-check: unknown option '%s' (see --help)\n", argv[i]);
       return 2;
@@ -48,8 +65,31 @@ int main(int argc, char** argv) {
   std::cout << path << ": " << report.frames << " frames, " << report.syncs << " cycles (SYNC), "
             << report.errors.size() << " errors\n";
   for (const auto& [name, count] : report.per_message) std::cout << "  " << name << ": " << count << "\n";
+  bool ok = report.ok();
+  if (report.fw_emergency_line > 0) {
+    std::cout << path << ": the plant's last frame is line " << report.last_plant_line << "; FW_EMERGENCY ("
+              << report.fw_emergency_signals << ") followed " << report.fw_emergency_cycles << " cycles later, line "
+              << report.fw_emergency_line << "\n";
+  }
+  if (report.plant_emergency_line > 0) {
+    std::cout << path << ": the firmware's last frame is line " << report.last_firmware_line
+              << "; PLANT_EMERGENCY (" << report.plant_emergency_signals << ") followed, line "
+              << report.plant_emergency_line << "\n";
+  }
+  if (safe_stop_within >= 0 && (report.fw_emergency_cycles < 0 || report.fw_emergency_cycles > safe_stop_within)) {
+    std::cout << path << ": expected FW_EMERGENCY within " << safe_stop_within << " cycles of the plant's last frame (line "
+              << report.last_plant_line << "), "
+              << (report.fw_emergency_cycles < 0 ? std::string("found none") : "it came after " + std::to_string(report.fw_emergency_cycles))
+              << "\n";
+    ok = false;
+  }
+  if (expect_plant_hold && report.plant_emergency_line == 0) {
+    std::cout << path << ": expected PLANT_EMERGENCY after the firmware's last frame (line " << report.last_firmware_line
+              << "), found none\n";
+    ok = false;
+  }
   const std::size_t shown = report.errors.size() < 50 ? report.errors.size() : 50;
   for (std::size_t i = 0; i < shown; ++i) std::cout << path << ": " << report.errors[i] << "\n";
   if (shown < report.errors.size()) std::cout << "(" << report.errors.size() - shown << " more errors)\n";
-  return report.ok() ? 0 : 1;
+  return ok ? 0 : 1;
 }
