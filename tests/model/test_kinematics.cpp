@@ -1,0 +1,195 @@
+// Loop closure and kinematics: the reference poses, closed form against Newton, the planar loop
+// residual against the 3-D tree transforms, Psi, gamma and J_t against finite differences, and the
+// typed errors for states with no assembly or near the four-bar toggle.
+#include <doctest/doctest.h>
+
+#include "model/front_kinematics.hpp"
+#include "model/lie_group.hpp"
+#include "model/newton_euler.hpp"
+#include "model_fixture.hpp"
+
+using namespace exc;
+using exc::test::reference_model;
+
+namespace {
+constexpr double kDeg = 180.0 / M_PI;
+
+Vec3 pin_world(const Model& m, const Workspace& ws, const std::string& name) {
+  const Machine& k = m.machine;
+  auto at = [&](int link, const Vec2& p) {
+    return Vec3((ws.X_Wi[link] * Eigen::Vector4d(p.x(), 0.0, p.y(), 1.0)).head<3>());
+  };
+  if (name == "C") return translation(ws.X_Wi[kBoom]);
+  if (name == "E") return translation(ws.X_Wi[kBoomRod]);  // rod-end frame origin
+  if (name == "H") return translation(ws.X_Wi[kArm]);
+  if (name == "G") return translation(ws.X_Wi[kArmRod]);
+  if (name == "M") return translation(ws.X_Wi[kBucket]);
+  if (name == "J") return translation(ws.X_Wi[kBucketRod]);
+  if (name == "L") return at(kBucket, k.L);
+  if (name == "T") return ws.tip_world;
+  FAIL("unknown pin " << name);
+  return Vec3::Zero();
+}
+}  // namespace
+
+TEST_CASE("model/both reference poses are reproduced (0.5 mm, 0.01 deg)") {
+  const Model& m = reference_model();
+  Workspace ws(m);
+  REQUIRE(m.machine.reference_poses.size() == 2);
+  for (const ReferencePose& pose : m.machine.reference_poses) {
+    CAPTURE(pose.q_a.transpose());
+    REQUIRE(update_closed_chain(m, ws, pose.q_a, Vec4::Zero()).ok());
+    CHECK(std::abs(ws.q[kBoom] * kDeg - pose.boom_angle_deg) < 0.01);
+    CHECK(std::abs(ws.q[kArm] * kDeg - pose.arm_angle_deg) < 0.01);
+    CHECK(std::abs(ws.q[kBucket] * kDeg - pose.bucket_angle_deg) < 0.01);
+    REQUIRE(pose.pins_world.size() == 8);
+    for (const auto& [name, p] : pose.pins_world) {
+      CAPTURE(name);
+      CHECK((pin_world(m, ws, name) - p).norm() < 0.5e-3);
+    }
+    // The cut pins really meet in 3-D: the other side of each loop reaches the same world point.
+    const Vec3 E_on_boom = (ws.X_Wi[kBoom] * Eigen::Vector4d(m.machine.E.x(), 0, m.machine.E.y(), 1)).head<3>();
+    CHECK((E_on_boom - pin_world(m, ws, "E")).norm() < 1e-12);
+    const Vec3 L_on_link = (ws.X_Wi[kLink11] * Eigen::Vector4d(m.machine.JL, 0, 0, 1)).head<3>();
+    CHECK((L_on_link - pin_world(m, ws, "L")).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("model/closed-form and Newton loop closure agree") {
+  const Model& m = reference_model();
+  Workspace ws(m), wn(m);
+  test::RandomStates rs(11);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Vec4 q_a = rs.q_a(m);
+    REQUIRE(solve_loop_closure(m, ws, q_a).ok());
+    Vec8 h;
+    loop_residual(m, ws.q, h);
+    CHECK(h.cwiseAbs().maxCoeff() < 1e-12);
+    // Newton from a perturbed guess (0.05 rad on every passive joint) lands on the same branch.
+    wn.q = ws.q;
+    for (int k : kPassiveJoints) wn.q[k] += rs.uniform(-0.05, 0.05);
+    const ModelReport r = solve_loop_closure_newton(m, wn, q_a);
+    REQUIRE(r.ok());
+    CHECK((wn.q - ws.q).cwiseAbs().maxCoeff() < 1e-10);
+  }
+}
+
+TEST_CASE("model/the planar loop residual equals the 3-D tree transforms") {
+  const Model& m = reference_model();
+  Workspace ws(m);
+  test::RandomStates rs(12);
+  for (int trial = 0; trial < 50; ++trial) {
+    Vec12 q;  // an arbitrary, unclosed tree configuration
+    for (int i = 0; i < kNumJoints; ++i) q[i] = m.prismatic[i] ? rs.uniform(1.5, 3.0) : rs.uniform(-2, 2);
+    Vec8 h;
+    loop_residual(m, q, h);
+    tree_kinematics(m, ws, q, Vec12::Zero());
+    const Mat3 R_sw = rotation(ws.X_Wi[kSwing]);
+    for (int l = 0; l < kNumLoops; ++l) {
+      const LoopCut& c = m.loops[l];
+      const Vec3 p = (ws.X_Wi[c.link_p] * c.point_p.homogeneous()).head<3>();
+      const Vec3 s = (ws.X_Wi[c.link_s] * c.point_s.homogeneous()).head<3>();
+      const Vec3 d = R_sw.transpose() * (p - s);  // in the swing frame
+      CHECK(std::abs(d.y()) < 1e-12);             // the front is planar
+      CHECK(std::abs(d.x() - h[2 * l]) < 1e-12);
+      CHECK(std::abs(d.z() - h[2 * l + 1]) < 1e-12);
+    }
+  }
+}
+
+TEST_CASE("model/Psi, gamma and the tip Jacobian match finite differences of the loop closure") {
+  const Model& m = reference_model();
+  Workspace ws(m), wp(m), wm(m);
+  test::RandomStates rs(13);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Vec4 q_a = rs.q_a(m), qd_a = rs.qd_a();
+    REQUIRE(update_closed_chain(m, ws, q_a, qd_a).ok());
+    const double eps = 1e-6;
+    for (int j = 0; j < kNumActive; ++j) {
+      const Vec4 dq = Vec4::Unit(j) * eps;
+      REQUIRE(update_closed_chain(m, wp, q_a + dq, Vec4::Zero()).ok());
+      REQUIRE(update_closed_chain(m, wm, q_a - dq, Vec4::Zero()).ok());
+      const Vec12 col = (wp.q - wm.q) / (2 * eps);
+      CHECK((col - ws.Psi.col(j)).cwiseAbs().maxCoeff() < 1e-6);
+      const Vec2 dtip = (wp.rho - wm.rho) / (2 * eps);
+      CHECK((dtip - ws.J_t.col(j)).cwiseAbs().maxCoeff() < 1e-6);
+    }
+    // Along q_a(t) = q_a + qd_a t: q(t) has second derivative gamma (qdd_a = 0) and the tip rho
+    // has second derivative rhodd_bias.
+    const double h = 1e-4;
+    REQUIRE(update_closed_chain(m, wp, q_a + qd_a * h, Vec4::Zero()).ok());
+    REQUIRE(update_closed_chain(m, wm, q_a - qd_a * h, Vec4::Zero()).ok());
+    const Vec12 qdd_fd = (wp.q - 2 * ws.q + wm.q) / (h * h);
+    CHECK((qdd_fd - ws.gamma).cwiseAbs().maxCoeff() < 1e-5 * (1 + ws.gamma.cwiseAbs().maxCoeff()));
+    const Vec2 rhodd_fd = (wp.rho - 2 * ws.rho + wm.rho) / (h * h);
+    CHECK((rhodd_fd - ws.rhodd_bias).cwiseAbs().maxCoeff() < 1e-5 * (1 + ws.rhodd_bias.norm()));
+    // rho (z in the world) against the 3-D tip in swing coordinates.
+    const Vec3 tip_sw = rotation(ws.X_Wi[kSwing]).transpose() * (ws.tip_world - translation(ws.X_Wi[kSwing]));
+    CHECK(std::abs(tip_sw.x() - ws.rho.x()) < 1e-12);
+    CHECK(std::abs(tip_sw.z() + m.machine.swing_height - ws.rho.y()) < 1e-12);
+    CHECK(ws.J_t.col(0).norm() == 0.0);
+  }
+}
+
+TEST_CASE("model/no-assembly and four-bar toggle states give typed errors, never NaN") {
+  const Model& m = reference_model();
+  Workspace ws(m);
+  const Vec4 good(0.0, 2.4, 2.6, 2.0);
+  REQUIRE(update_closed_chain(m, ws, good, Vec4::Zero()).ok());
+  const Vec12 q_before = ws.q;
+
+  SUBCASE("boom cylinder longer than its triangle allows") {
+    const ModelReport r = update_closed_chain(m, ws, Vec4(0.0, 3.5, 2.6, 2.0), Vec4::Zero());
+    CHECK(r.status == ModelStatus::no_assembly);
+    CHECK(r.loop == 0);
+  }
+  SUBCASE("arm cylinder shorter than its triangle allows") {
+    const ModelReport r = update_closed_chain(m, ws, Vec4(0.0, 2.4, 1.0, 2.0), Vec4::Zero());
+    CHECK(r.status == ModelStatus::no_assembly);
+    CHECK(r.loop == 1);
+  }
+  SUBCASE("bucket cylinder past the four-bar toggle") {
+    const ModelReport r = update_closed_chain(m, ws, Vec4(0.0, 2.4, 2.6, 1.55), Vec4::Zero());
+    CHECK(r.status == ModelStatus::no_assembly);
+    CHECK(r.loop == 3);
+  }
+  SUBCASE("bucket cylinder at the four-bar toggle (L_bucket ~1.58 m)") {
+    const ModelReport r = update_closed_chain(m, ws, Vec4(0.0, 2.4, 2.6, 1.5825), Vec4::Zero());
+    CHECK(r.status == ModelStatus::near_toggle);
+    CHECK(r.loop == 3);
+    CHECK(r.conditioning > 0.0);
+    CHECK(r.conditioning < 0.1);
+    // Newton from the last good state reports it too (H_p ill-conditioned or no convergence).
+    Workspace wn(m);
+    REQUIRE(solve_loop_closure(m, wn, Vec4(0.0, 2.4, 2.6, 1.59)).ok());
+    const ModelReport rn = solve_loop_closure_newton(m, wn, Vec4(0.0, 2.4, 2.6, 1.5805));
+    CHECK(rn.status != ModelStatus::ok);
+  }
+  SUBCASE("a NaN input") {
+    const ModelReport r = update_closed_chain(m, ws, Vec4(0.0, NAN, 2.6, 2.0), Vec4::Zero());
+    CHECK(r.status == ModelStatus::non_finite_input);
+  }
+  // The workspace keeps the last good state: no NaN leaks to a caller that ignores the status.
+  CHECK(ws.q.allFinite());
+  CHECK(ws.q == q_before);
+  Vec4 qdd;
+  const ModelReport r = forward_dynamics(m, ws, Vec4(0.0, 2.4, 2.6, 1.5), Vec4::Zero(), Vec4::Zero(), TipLoad{}, qdd);
+  CHECK(r.status == ModelStatus::no_assembly);
+}
+
+TEST_CASE("model/the whole stroke box assembles with usable conditioning") {
+  const Model& m = reference_model();
+  Workspace ws(m);
+  const Vec4 lo = m.machine.q_min(), hi = m.machine.q_max();
+  double worst = 1.0;
+  for (int i = 0; i <= 8; ++i)
+    for (int j = 0; j <= 8; ++j)
+      for (int k = 0; k <= 8; ++k) {
+        const Vec4 q_a(0.0, lo[1] + (hi[1] - lo[1]) * i / 8.0, lo[2] + (hi[2] - lo[2]) * j / 8.0,
+                       lo[3] + (hi[3] - lo[3]) * k / 8.0);
+        const ModelReport r = update_closed_chain(m, ws, q_a, Vec4::Zero());
+        REQUIRE(r.ok());
+        worst = std::min(worst, r.conditioning);
+      }
+  CHECK(worst > 0.05);
+}
