@@ -1,0 +1,262 @@
+// Integrators: semi-implicit Euler, RK4, implicit midpoint; independent and augmented formulations.
+#include "sim_plant/integrators.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+
+#include "model/forward_dynamics.hpp"
+#include "model/front_kinematics.hpp"
+#include "model/newton_euler.hpp"
+
+namespace exc::plant {
+
+const char* to_string(IntegrationMethod m) {
+  switch (m) {
+    case IntegrationMethod::semi_implicit_euler: return "semi_implicit_euler";
+    case IntegrationMethod::rk4: return "rk4";
+    case IntegrationMethod::implicit_midpoint: return "implicit_midpoint";
+  }
+  return "?";
+}
+
+const char* to_string(Formulation f) {
+  switch (f) {
+    case Formulation::independent: return "independent";
+    case Formulation::augmented_baumgarte: return "augmented_baumgarte";
+    case Formulation::augmented_projection: return "augmented_projection";
+  }
+  return "?";
+}
+
+Integrator::Integrator(const Model& model, const IntegratorSettings& settings)
+    : model_(&model), settings_(settings) {}
+
+ModelReport Integrator::closed_chain(Workspace& ws, const Vec4& q_a, const Vec4& qd_a) {
+  if (cache_valid_ && q_a == cached_q_ && qd_a == cached_qd_) return cached_report_;
+  cached_report_ = update_closed_chain(*model_, ws, q_a, qd_a);
+  cached_q_ = q_a;
+  cached_qd_ = qd_a;
+  cache_valid_ = settings_.formulation == Formulation::independent && cached_report_.ok();
+  return cached_report_;
+}
+
+ModelReport Integrator::project(Workspace& ws, MechanicalState& s) {
+  const ModelReport r = closed_chain(ws, s.q_a, s.qd_a);
+  if (r.ok()) {
+    s.q = ws.q;
+    s.qd = ws.qd;
+  }
+  return r;
+}
+
+ModelReport Integrator::kinematics(Workspace& ws, const MechanicalState& s, Vec2& rho, Vec2& rhod) {
+  if (settings_.formulation == Formulation::independent) {
+    const ModelReport r = closed_chain(ws, s.q_a, s.qd_a);
+    rho = ws.rho;
+    rhod = ws.rhod;
+    return r;
+  }
+  if (!s.q.allFinite() || !s.qd.allFinite()) return ModelReport{ModelStatus::non_finite_input, -1, 0};
+  Vec2 tip;
+  front_positions(*model_, s.q, ws);
+  front_rates(*model_, s.qd, Vec12::Zero(), ws);
+  front_tip(*model_, ws, tip, ws.J_tip_tree, ws.tip_acc_tree);
+  rho = tip + Vec2(0.0, model_->machine.swing_height);
+  rhod = ws.J_tip_tree * s.qd;
+  tree_kinematics(*model_, ws, s.q, s.qd);
+  return ModelReport{};
+}
+
+Evaluation Integrator::evaluate(Workspace& ws, const SoilModel& soil, const Vec4& tau_a, const MechanicalState& s) {
+  if (settings_.formulation == Formulation::independent) return evaluate_independent(ws, soil, tau_a, s.q_a, s.qd_a);
+  return evaluate_augmented(ws, soil, tau_a, s.q, s.qd);
+}
+
+Evaluation Integrator::evaluate_independent(Workspace& ws, const SoilModel& soil, const Vec4& tau_a, const Vec4& q_a,
+                                            const Vec4& qd_a) {
+  Evaluation e;
+  e.report = closed_chain(ws, q_a, qd_a);
+  if (!e.report.ok()) return e;
+  e.rho = ws.rho;
+  e.rhod = ws.rhod;
+  e.load = soil.load(ws.rho, ws.rhod);
+  // Independent coordinates with the soil's added mass (model.md s.4, eq. 9):
+  // (M_a + J_t^T M_t J_t) qdd_a = tau_a - h_a - J_t^T (f + M_t rhodd_bias).
+  Mat4 M_a;
+  Vec4 h_a;
+  mass_matrix(*model_, ws, M_a);
+  bias_forces(*model_, ws, h_a);
+  const Mat2 M_t = e.load.added_mass.asDiagonal();
+  last_effective_mass_ = M_a + ws.J_t.transpose() * M_t * ws.J_t;
+  last_J_t_ = ws.J_t;
+  const Vec4 b = tau_a - h_a - ws.J_t.transpose() * (e.load.force + M_t * ws.rhodd_bias);
+  const Eigen::LLT<Mat4> llt(last_effective_mass_);
+  if (llt.info() != Eigen::Success) {
+    e.report.status = ModelStatus::singular;
+    return e;
+  }
+  e.qdd_a = llt.solve(b);
+  if (!e.qdd_a.allFinite()) {
+    e.report.status = ModelStatus::singular;
+    return e;
+  }
+  e.qdd = ws.Psi * e.qdd_a + ws.gamma;
+  e.rhodd = ws.J_t * e.qdd_a + ws.rhodd_bias;
+  return e;
+}
+
+Evaluation Integrator::evaluate_augmented(Workspace& ws, const SoilModel& soil, const Vec4& tau_a, const Vec12& q,
+                                          const Vec12& qd) {
+  Evaluation e;
+  if (!q.allFinite() || !qd.allFinite()) {
+    e.report.status = ModelStatus::non_finite_input;
+    return e;
+  }
+  // The tip on the (possibly drifted) tree coordinates, for the soil.
+  Vec2 tip;
+  front_positions(*model_, q, ws);
+  front_rates(*model_, qd, Vec12::Zero(), ws);
+  front_tip(*model_, ws, tip, ws.J_tip_tree, ws.tip_acc_tree);
+  e.rho = tip + Vec2(0.0, model_->machine.swing_height);
+  e.rhod = ws.J_tip_tree * qd;
+  e.load = soil.load(e.rho, e.rhod);
+  const bool baumgarte = settings_.formulation == Formulation::augmented_baumgarte;
+  Vec8 lambda;
+  e.report = forward_dynamics_augmented(*model_, ws, q, qd, tau_a, e.load, baumgarte ? settings_.baumgarte_alpha : 0.0,
+                                        baumgarte ? settings_.baumgarte_beta : 0.0, e.qdd, lambda);
+  if (!e.report.ok()) return e;
+  for (int k = 0; k < kNumActive; ++k) e.qdd_a[k] = e.qdd[kActiveJoints[k]];
+  e.rhodd = ws.J_tip_tree * e.qdd + ws.tip_acc_tree;
+  return e;
+}
+
+StepOutcome Integrator::step(Workspace& ws, const SoilModel& soil, const Vec4& tau_a, double dt, MechanicalState& s,
+                             Evaluation& start) {
+  if (settings_.formulation == Formulation::independent) return step_independent(ws, soil, tau_a, dt, s, start);
+  return step_augmented(ws, soil, tau_a, dt, s, start);
+}
+
+StepOutcome Integrator::step_independent(Workspace& ws, const SoilModel& soil, const Vec4& tau, double h,
+                                         MechanicalState& s, Evaluation& start) {
+  StepOutcome out;
+  const Vec4 q0 = s.q_a, v0 = s.qd_a;
+  start = evaluate_independent(ws, soil, tau, q0, v0);
+  if (!start.report.ok()) return out.report = start.report, out;
+  switch (settings_.method) {
+    case IntegrationMethod::semi_implicit_euler: {
+      s.qd_a = v0 + h * start.qdd_a;
+      s.q_a = q0 + h * s.qd_a;
+      break;
+    }
+    case IntegrationMethod::rk4: {
+      const Vec4 k1v = start.qdd_a, k1q = v0;
+      Evaluation e = evaluate_independent(ws, soil, tau, q0 + 0.5 * h * k1q, v0 + 0.5 * h * k1v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const Vec4 k2v = e.qdd_a, k2q = v0 + 0.5 * h * k1v;
+      e = evaluate_independent(ws, soil, tau, q0 + 0.5 * h * k2q, v0 + 0.5 * h * k2v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const Vec4 k3v = e.qdd_a, k3q = v0 + 0.5 * h * k2v;
+      e = evaluate_independent(ws, soil, tau, q0 + h * k3q, v0 + h * k3v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const Vec4 k4v = e.qdd_a, k4q = v0 + h * k3v;
+      s.q_a = q0 + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q);
+      s.qd_a = v0 + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
+      break;
+    }
+    case IntegrationMethod::implicit_midpoint: {
+      // Unknown: the midpoint velocity w, with w = v0 + h/2 a(q0 + h/2 w, w). Newton with the Jacobian
+      // I + h/2 A^-1 J_t^T (B_t + h/2 K_t) J_t: exact for the soil (the stiff part), the rigid-body
+      // terms left to the iteration.
+      Vec4 w = v0 + 0.5 * h * start.qdd_a;
+      out.converged = false;
+      for (int it = 0; it < settings_.implicit_max_iterations; ++it) {
+        const Evaluation e = evaluate_independent(ws, soil, tau, q0 + 0.5 * h * w, w);
+        if (!e.report.ok()) return out.report = e.report, out;
+        const Vec4 r = w - v0 - 0.5 * h * e.qdd_a;
+        out.iterations = it + 1;
+        Mat4 jac = last_effective_mass_;
+        if (e.load.added_mass.any() || e.load.force.any()) {
+          const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
+          jac += 0.5 * h * last_J_t_.transpose() * c.asDiagonal() * last_J_t_;
+        }
+        const Eigen::LLT<Mat4> llt(jac);
+        const Vec4 dw = -llt.solve(last_effective_mass_ * r);
+        if (!dw.allFinite()) return out.report = ModelReport{ModelStatus::singular, -1, 0}, out;
+        w += dw;
+        if (r.lpNorm<Eigen::Infinity>() < settings_.implicit_tolerance * (1.0 + w.lpNorm<Eigen::Infinity>())) {
+          out.converged = true;
+          break;
+        }
+      }
+      s.q_a = q0 + h * w;
+      s.qd_a = 2.0 * w - v0;
+      break;
+    }
+  }
+  if (!s.q_a.allFinite() || !s.qd_a.allFinite()) out.report = ModelReport{ModelStatus::non_finite_input, -1, 0};
+  return out;
+}
+
+StepOutcome Integrator::step_augmented(Workspace& ws, const SoilModel& soil, const Vec4& tau, double h,
+                                       MechanicalState& s, Evaluation& start) {
+  StepOutcome out;
+  const Vec12 q0 = s.q, v0 = s.qd;
+  start = evaluate_augmented(ws, soil, tau, q0, v0);
+  if (!start.report.ok()) return out.report = start.report, out;
+  switch (settings_.method) {
+    case IntegrationMethod::semi_implicit_euler: {
+      s.qd = v0 + h * start.qdd;
+      s.q = q0 + h * s.qd;
+      break;
+    }
+    case IntegrationMethod::rk4: {
+      const Vec12 k1v = start.qdd, k1q = v0;
+      Evaluation e = evaluate_augmented(ws, soil, tau, q0 + 0.5 * h * k1q, v0 + 0.5 * h * k1v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const Vec12 k2v = e.qdd, k2q = v0 + 0.5 * h * k1v;
+      e = evaluate_augmented(ws, soil, tau, q0 + 0.5 * h * k2q, v0 + 0.5 * h * k2v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const Vec12 k3v = e.qdd, k3q = v0 + 0.5 * h * k2v;
+      e = evaluate_augmented(ws, soil, tau, q0 + h * k3q, v0 + h * k3v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const Vec12 k4v = e.qdd, k4q = v0 + h * k3v;
+      s.q = q0 + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q);
+      s.qd = v0 + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
+      break;
+    }
+    case IntegrationMethod::implicit_midpoint: {
+      // Fixed-point iteration on the midpoint velocity: converges only while h/2 times the
+      // Lipschitz constant of the acceleration stays below 1 (stiff soil limits it; measured).
+      Vec12 w = v0 + 0.5 * h * start.qdd;
+      out.converged = false;
+      for (int it = 0; it < settings_.implicit_max_iterations; ++it) {
+        const Evaluation e = evaluate_augmented(ws, soil, tau, q0 + 0.5 * h * w, w);
+        if (!e.report.ok()) return out.report = e.report, out;
+        const Vec12 w_next = v0 + 0.5 * h * e.qdd;
+        const double r = (w_next - w).lpNorm<Eigen::Infinity>();
+        w = w_next;
+        out.iterations = it + 1;
+        if (r < settings_.implicit_tolerance * (1.0 + w.lpNorm<Eigen::Infinity>())) {
+          out.converged = true;
+          break;
+        }
+      }
+      s.q = q0 + h * w;
+      s.qd = 2.0 * w - v0;
+      break;
+    }
+  }
+  if (!s.q.allFinite() || !s.qd.allFinite()) return out.report = ModelReport{ModelStatus::non_finite_input, -1, 0}, out;
+  for (int k = 0; k < kNumActive; ++k) {
+    s.q_a[k] = s.q[kActiveJoints[k]];
+    s.qd_a[k] = s.qd[kActiveJoints[k]];
+  }
+  if (settings_.formulation == Formulation::augmented_projection) {
+    const ModelReport r = project(ws, s);
+    if (!r.ok()) out.report = r;
+  }
+  return out;
+}
+
+}  // namespace exc::plant

@@ -1,0 +1,88 @@
+#pragma once
+// The simulated excavator as a library: load a scene, step one control cycle at a time with actuator
+// commands, read the sensors and the full state. step() reads top to bottom: soil -> actuators ->
+// dynamics -> integrate -> checks (MuJoCo's mj_step order), with the integrator's substeps inside one
+// cycle. After construction nothing allocates; failures stop the plant with a message (PlantStatus).
+#include <cstdint>
+#include <string>
+
+#include "model/workspace.hpp"
+#include "sim_plant/actuators.hpp"
+#include "sim_plant/integrators.hpp"
+#include "sim_plant/plant_checks.hpp"
+#include "sim_plant/scene.hpp"
+#include "sim_plant/sensors.hpp"
+#include "sim_plant/soil.hpp"
+
+namespace exc::plant {
+
+struct PlantState {
+  double time = 0;                 // s
+  std::int64_t cycle = 0;          // cycles stepped
+  Vec4 q_a = Vec4::Zero(), qd_a = Vec4::Zero(), qdd_a = Vec4::Zero();
+  Vec12 q = Vec12::Zero(), qd = Vec12::Zero();  // the tree's 12 coordinates (Table 1 order)
+  Vec3 tip_world = Vec3::Zero();   // m
+  Vec2 rho = Vec2::Zero(), rhod = Vec2::Zero();  // tip in the swing plane (x, world z)
+  Vec2 soil_force = Vec2::Zero();  // N, total force of the bucket on the soil (eq. 9)
+  Vec2 soil_anchor = Vec2::Zero(); // rho_env
+  bool in_soil = false;
+  double depth = 0;                // m, terrain height - tip z
+  int reanchor_count = 0;          // shear failures so far (eq. 11)
+  Vec4 effort = Vec4::Zero();      // N m, N: efforts actually applied
+  Vec4 spool = Vec4::Zero();       // hydraulic: spool positions (-1..1)
+  Vec4 pressure_a = Vec4::Zero(), pressure_b = Vec4::Zero();  // Pa (hydraulic; swing motor ports first)
+  double kinetic_energy = 0, potential_energy = 0;  // J
+  double energy_error = 0;         // J: energy minus (initial energy + work of actuators and soil)
+  double actuator_work = 0, soil_work = 0;          // J, done on the machine
+  double constraint_residual = 0;  // m, |h(q)|
+  int end_stop_events = 0;         // substeps at which an end stop or a speed limit acted
+  int implicit_iterations = 0;     // of the last substep (implicit_midpoint)
+};
+
+class Plant {
+ public:
+  explicit Plant(const Scene& scene);
+  static Plant load(const std::string& scene_path);
+  Plant(const Plant&) = delete;
+  Plant& operator=(const Plant&) = delete;
+
+  // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
+  void reset();
+  // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.
+  PlantStatus step(const ActuatorCommand& command);
+
+  const PlantState& state() const { return state_; }
+  const SensorReading& sensors() const { return sensors_.latest(); }
+  const PlantStatus& status() const { return status_; }
+  const Scene& scene() const { return scene_; }
+  const Model& model() const { return model_; }
+  // Efforts that hold the initial state still (gravity only): the hydraulic chambers start there.
+  const Vec4& hold_effort() const { return hold_effort_; }
+  double energy() const { return state_.kinetic_energy + state_.potential_energy; }
+  double constraint_residual() const { return state_.constraint_residual; }
+
+ private:
+  bool accept_command(const ActuatorCommand& command);
+  bool apply_limits();
+  void account_work(const Vec4& tau, const MechanicalState& before, const Evaluation& start, const Vec2& rho1,
+                    const Vec2& rhod1);
+  void fill_state(const Evaluation& last);
+
+  Scene scene_;
+  Model model_;
+  Workspace ws_;
+  SoilModel soil_;
+  ActuatorModel actuators_;
+  SensorModel sensors_;
+  Integrator integrator_;
+  MechanicalState mech_;
+  PlantState state_;
+  PlantStatus status_;
+  Vec4 hold_effort_ = Vec4::Zero();
+  Vec4 q_min_, q_max_, speed_max_;
+  int substeps_ = 1;
+  double energy0_ = 0, work_abs_ = 0;
+  Vec2 rho_ = Vec2::Zero(), rhod_ = Vec2::Zero();
+};
+
+}  // namespace exc::plant

@@ -1,0 +1,44 @@
+// Sensors: quantisation, seeded noise, latency (fixed ring).
+#include "sim_plant/sensors.hpp"
+
+#include <cmath>
+
+namespace exc::plant {
+
+SensorModel::SensorModel(const SensorParameters& params) : params_(params) { reset(); }
+
+void SensorModel::reset() {
+  rng_.seed(params_.seed);
+  normal_.reset();
+  ring_.fill(SensorReading{});
+  write_index_ = read_index_ = filled_ = 0;
+}
+
+double SensorModel::quantise(double v, double quantum) {
+  return quantum > 0 ? quantum * std::round(v / quantum) : v;
+}
+
+void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a,
+                         const Vec4& p_b) {
+  SensorReading& r = ring_[write_index_];
+  for (int i = 0; i < 4; ++i) {
+    // Noise first, then the converter's quantisation, as a real encoder chain does.
+    const double pn = params_.position_noise[i] > 0 ? params_.position_noise[i] * normal_(rng_) : 0.0;
+    const double vn = params_.velocity_noise[i] > 0 ? params_.velocity_noise[i] * normal_(rng_) : 0.0;
+    r.position[i] = quantise(q_a[i] + pn, params_.position_quantum[i]);
+    r.velocity[i] = qd_a[i] + vn;
+  }
+  for (int i = 0; i < 3; ++i) {
+    r.pressure_a[i] = quantise(p_a[i + 1], params_.pressure_quantum);
+    r.pressure_b[i] = quantise(p_b[i + 1], params_.pressure_quantum);
+  }
+  r.cycle = cycle;
+  const int n = static_cast<int>(ring_.size());
+  const int latency = params_.latency_cycles;
+  // Until the ring holds 'latency' older samples, the oldest one is what the bus shows.
+  read_index_ = filled_ >= latency ? (write_index_ - latency + n) % n : (write_index_ - filled_ + n) % n;
+  if (filled_ < latency) ++filled_;
+  write_index_ = (write_index_ + 1) % n;
+}
+
+}  // namespace exc::plant

@@ -1,0 +1,48 @@
+#pragma once
+// What the machine's sensors report each cycle: swing angle and cylinder lengths, their rates and the
+// chamber pressures, with quantisation, seeded Gaussian noise and a latency of whole cycles (a fixed
+// ring: nothing allocates).
+#include <array>
+#include <cstdint>
+#include <random>
+
+#include "model/types.hpp"
+
+namespace exc::plant {
+
+struct SensorParameters {
+  Vec4 position_quantum = Vec4::Zero();  // rad, m (0: none)
+  Vec4 position_noise = Vec4::Zero();    // standard deviation, rad, m
+  Vec4 velocity_noise = Vec4::Zero();    // standard deviation, rad/s, m/s
+  double pressure_quantum = 0;           // Pa (0: none)
+  std::uint64_t seed = 1;
+  int latency_cycles = 0;                // 0 .. kMaxLatency
+  static constexpr int kMaxLatency = 63;
+};
+
+struct SensorReading {
+  Vec4 position = Vec4::Zero();  // swing rad, cylinder lengths m
+  Vec4 velocity = Vec4::Zero();  // rad/s, m/s
+  Vec3 pressure_a = Vec3::Zero(), pressure_b = Vec3::Zero();  // cylinders (boom, arm, bucket), Pa
+  std::int64_t cycle = 0;        // the plant cycle the values were measured in
+};
+
+class SensorModel {
+ public:
+  SensorModel() = default;
+  explicit SensorModel(const SensorParameters& params);
+  void reset();
+  // Measure the true values of cycle 'cycle'; the reading returned by latest() lags by the latency.
+  void sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a, const Vec4& p_b);
+  const SensorReading& latest() const { return ring_[read_index_]; }
+
+ private:
+  static double quantise(double v, double quantum);
+  SensorParameters params_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  std::array<SensorReading, SensorParameters::kMaxLatency + 1> ring_{};
+  int write_index_ = 0, read_index_ = 0, filled_ = 0;
+};
+
+}  // namespace exc::plant

@@ -1,0 +1,75 @@
+#pragma once
+// Soil reaction at the bucket tip (paper eqs. 9-11, model.md s.5): a mass-spring-damper per axis
+// (x, z in the swing plane) anchored at rho_env, active only while the tip is below the terrain,
+// with the shear re-anchoring rho_env = rho when |rho_env - rho| > S_dist(h).
+#include <array>
+
+#include "model/closed_chain.hpp"
+
+namespace exc::plant {
+
+// The ground surface: flat at 'height', or piecewise linear in x through up to kMaxPoints points
+// (held flat beyond the ends).
+struct Terrain {
+  static constexpr int kMaxPoints = 64;
+  double height = 0.0;  // m, world z of a flat terrain
+  int num_points = 0;   // 0: flat; otherwise the profile below is used
+  std::array<Vec2, kMaxPoints> profile{};  // (x, z), x strictly increasing
+
+  double height_at(double x) const;
+};
+
+// Diagonal soil parameters (x, z). All zero means no soil.
+struct SoilParameters {
+  Vec2 stiffness = Vec2::Zero();  // K_t, N/m
+  Vec2 damping = Vec2::Zero();    // B_t, N s/m
+  Vec2 mass = Vec2::Zero();       // M_t, kg
+};
+
+enum class SoilPreset { none, loose_sand, loam, stiff_clay };
+const char* to_string(SoilPreset preset);
+// machine.md's table: K_t, B_t, M_t for each preset.
+SoilParameters soil_preset(SoilPreset preset);
+
+// The shear distance of eq. 11: S_dist = 0.365 h + 0.00754 (m, h in m).
+inline double shear_distance(double depth) { return 0.365 * depth + 0.00754; }
+
+// The soil's state and the force law. The plant asks for the load at every dynamics evaluation
+// (load()), then commits the tip's end-of-step position (commit()), which is where the entry anchor
+// and the re-anchoring (discrete events) happen.
+class SoilModel {
+ public:
+  SoilModel() = default;
+  SoilModel(const Terrain& terrain, const SoilParameters& params) : terrain_(terrain), params_(params) {}
+
+  const Terrain& terrain() const { return terrain_; }
+  const SoilParameters& parameters() const { return params_; }
+
+  // Depth h = terrain height - tip z (h > 0: in soil).
+  double depth(const Vec2& rho) const { return terrain_.height_at(rho.x()) - rho.y(); }
+
+  // The part of eq. 9 known before the acceleration, f = B rhod + K (rho - rho_env), and the added
+  // mass M_t; zero out of the soil. A tip that enters during a step is anchored where it is.
+  TipLoad load(const Vec2& rho, const Vec2& rhod) const;
+
+  // Total force of the bucket on the soil (eq. 9) once the tip acceleration is known.
+  Vec2 total_force(const Vec2& rho, const Vec2& rhod, const Vec2& rhodd) const;
+
+  // End of a step: entry anchor, shear re-anchoring (eqs. 10-11), exit. Returns true on a
+  // re-anchoring (a shear failure).
+  bool commit(const Vec2& rho);
+
+  bool in_soil() const { return in_soil_; }
+  const Vec2& anchor() const { return anchor_; }
+  int reanchor_count() const { return reanchor_count_; }
+  void reset() { in_soil_ = false; anchor_.setZero(); reanchor_count_ = 0; }
+
+ private:
+  Terrain terrain_;
+  SoilParameters params_;
+  bool in_soil_ = false;
+  Vec2 anchor_ = Vec2::Zero();  // rho_env
+  int reanchor_count_ = 0;
+};
+
+}  // namespace exc::plant

@@ -1,0 +1,49 @@
+#pragma once
+// Scenes for the plant's tests, written as YAML text so that they go through the real loader.
+#include <string>
+
+#include "sim_plant/plant.hpp"
+
+namespace exc::plant::test {
+
+// The first reference pose of reference-machine.yaml: tip at about (8.66, 1.83) m.
+inline const char* kReferencePose = "[0.0, 2.4626, 2.3231, 2.1447]";
+
+struct SceneText {
+  std::string method = "semi_implicit_euler";
+  std::string formulation = "independent";
+  double step = 1e-3;
+  double cycle = 1e-3;
+  std::string q_a = kReferencePose;
+  std::string qd_a = "[0, 0, 0, 0]";
+  std::string terrain = "height: 0.0";
+  std::string soil = "preset: none";
+  std::string actuators = "fidelity: ideal";
+  std::string extra_integrator;  // more "key: value" lines for the integrator section
+  std::string checks = "energy_tolerance: 100";
+  std::string sensors = "seed: 1";
+
+  std::string yaml() const {
+    auto num = [](double v) {
+      char b[64];
+      std::snprintf(b, sizeof b, "%.17g", v);
+      return std::string(b);
+    };
+    return "name: test\n"
+           "terrain: {" + terrain + "}\n"
+           "soil: {" + soil + "}\n"
+           "initial_state: {q_a: " + q_a + ", qd_a: " + qd_a + "}\n"
+           "actuators: {" + actuators + "}\n"
+           "integrator: {method: " + method + ", formulation: " + formulation + ", step: " + num(step) +
+           ", cycle: " + num(cycle) + (extra_integrator.empty() ? "" : ", " + extra_integrator) + "}\n"
+           "duration: 10\n"
+           "sensors: {" + sensors + "}\n"
+           "checks: {" + checks + "}\n";
+  }
+  Scene scene() const { return load_scene_from_string(yaml(), "<test>"); }
+};
+
+inline const char* kMethods[] = {"semi_implicit_euler", "rk4", "implicit_midpoint"};
+inline const char* kFormulations[] = {"independent", "augmented_baumgarte", "augmented_projection"};
+
+}  // namespace exc::plant::test
