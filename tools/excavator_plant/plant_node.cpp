@@ -1,0 +1,129 @@
+#include "plant_node.hpp"
+
+#include "exlcm/can_stats_t.hpp"
+#include "exlcm/machine_state_t.hpp"
+#include "model/closed_chain.hpp"
+#include "telemetry/telemetry_publisher.hpp"
+
+namespace exc::app {
+
+PlantNode::PlantNode(plant::Plant& plant, hal::PlantCanPort& port, telemetry::TelemetryPublisher* telemetry,
+                     const PlantNodeConfig& config)
+    : plant_(plant), port_(port), telemetry_(telemetry), config_(config), ws_(plant.model()) {}
+
+bool PlantNode::poll() {
+  std::uint64_t cycle = 0;
+  if (!port_.poll_sync(cycle)) return false;
+  step(cycle);
+  return true;
+}
+
+bool PlantNode::wait(std::int64_t timeout_ns) {
+  std::uint64_t cycle = 0;
+  if (!port_.wait_sync(cycle, timeout_ns)) return false;
+  step(cycle);
+  return true;
+}
+
+Vec4 PlantNode::hold_effort() {
+  const plant::PlantState& s = plant_.state();
+  Vec4 tau = Vec4::Zero();
+  // Static load at the current pose, then a velocity brake scaled by the mass matrix so every axis
+  // stops at the same rate; outside assembly (never expected here) the last efforts are held.
+  if (!update_closed_chain(plant_.model(), ws_, s.q_a, Vec4::Zero()).ok()) return s.effort;
+  bias_forces(plant_.model(), ws_, tau);
+  Mat4 M_a;
+  mass_matrix(plant_.model(), ws_, M_a);
+  tau -= M_a * (config_.brake_rate * s.qd_a);
+  return tau;
+}
+
+void PlantNode::step(std::uint64_t cycle) {
+  if (port_.read(command_)) {
+    have_command_ = true;
+    last_command_cycle_ = cycle;
+  }
+  const bool timed_out = !have_command_ || cycle - last_command_cycle_ > static_cast<std::uint64_t>(config_.command_timeout_cycles);
+  // The firmware's safe state is "valves centred" (valve command of zeros); a force-commanded
+  // plant has no valves, so it brakes instead.
+  const bool hydraulic = plant_.scene().actuators.fidelity == plant::ActuatorFidelity::hydraulic;
+  const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && !hydraulic;
+  const bool hold = timed_out || command_.emergency_stop || firmware_holds;
+  if (hold && !holding_) ++holds_;
+  holding_ = hold;
+
+  plant::ActuatorCommand actuator;
+  if (hydraulic) {
+    actuator.mode = plant::ActuatorCommand::valve;
+    if (!hold && command_.mode == hal::CommandMode::valve)
+      for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
+  } else {
+    actuator.mode = plant::ActuatorCommand::effort;
+    if (hold) {
+      actuator.value = hold_effort();
+    } else {
+      for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
+    }
+  }
+  plant_.step(actuator);
+  ++steps_;
+
+  const plant::SensorReading& r = plant_.sensors();
+  sensors_.cycle = cycle;
+  for (int j = 0; j < 4; ++j) {
+    sensors_.position[j] = r.position[j];
+    sensors_.velocity[j] = r.velocity[j];
+  }
+  for (int c = 0; c < 3; ++c) {
+    sensors_.pressure_a[c] = r.pressure_a[c];
+    sensors_.pressure_b[c] = r.pressure_b[c];
+    sensors_.pressure_valid[c] = hydraulic;
+  }
+  sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
+  sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
+  if (!failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
+  if (cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
+  if (telemetry_ != nullptr) {
+    publish_state();
+    if (cycle % 100 == 0) publish_counters();
+  }
+}
+
+void PlantNode::publish_state() {
+  const plant::PlantState& s = plant_.state();
+  exlcm::machine_state_t m{};
+  m.utime = static_cast<std::int64_t>(s.time * 1e6 + 0.5);
+  for (int j = 0; j < 4; ++j) {
+    m.q_active[j] = s.q_a[j];
+    m.qd_active[j] = s.qd_a[j];
+  }
+  for (int i = 0; i < kNumPassive; ++i) m.q_passive[i] = s.q[kPassiveJoints[i]];
+  for (int i = 0; i < 3; ++i) m.tip_world[i] = s.tip_world[i];
+  for (int i = 0; i < 2; ++i) {
+    m.tip_rho[i] = s.rho[i];
+    m.soil_force[i] = s.soil_force[i];
+    m.soil_anchor[i] = s.soil_anchor[i];
+  }
+  m.in_soil = s.in_soil;
+  m.depth = s.depth;
+  telemetry_->publish(telemetry::Channel::state, m);
+}
+
+void PlantNode::publish_counters() {
+  if (telemetry_ == nullptr) return;
+  const hal::RxStats& rx = port_.rx_stats();
+  exlcm::can_stats_t cs{};
+  cs.utime = static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5);
+  cs.node = 1;
+  cs.tx = static_cast<std::int64_t>(port_.tx_stats().frames_sent);
+  cs.rx_ok = static_cast<std::int64_t>(rx.ok);
+  cs.stale = static_cast<std::int64_t>(rx.stale);
+  cs.repeated = static_cast<std::int64_t>(rx.repeated);
+  cs.corrupt = static_cast<std::int64_t>(rx.corrupt);
+  cs.wrong_dlc = static_cast<std::int64_t>(rx.wrong_dlc);
+  cs.unknown = static_cast<std::int64_t>(rx.unknown_id);
+  cs.dropped = static_cast<std::int64_t>(port_.tx_stats().send_failed);
+  telemetry_->publish(telemetry::Channel::can_stats, cs);
+}
+
+}  // namespace exc::app

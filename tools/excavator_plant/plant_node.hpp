@@ -1,0 +1,61 @@
+#pragma once
+// The simulated machine's end of the bus: on each SYNC(k) it takes the latest valid command set,
+// steps the plant exactly once and answers with the sensor frames of cycle k. It holds the machine
+// (valves centred; for force-commanded fidelities a model-based brake, see hold_effort()) when the
+// firmware asks for it, when commands stop for longer than the command timeout, or on an emergency
+// stop. Nothing allocates after construction.
+#include <cstdint>
+
+#include "hal/can_ports.hpp"
+#include "model/workspace.hpp"
+#include "sim_plant/plant.hpp"
+
+namespace exc::telemetry {
+class TelemetryPublisher;
+}
+
+namespace exc::app {
+
+struct PlantNodeConfig {
+  int command_timeout_cycles = 20;  // cycles without a new valid command set -> hold
+  double brake_rate = 40.0;         // 1/s, velocity decay rate of the model-based hold
+};
+
+class PlantNode {
+ public:
+  PlantNode(plant::Plant& plant, hal::PlantCanPort& port, telemetry::TelemetryPublisher* telemetry,
+            const PlantNodeConfig& config = {});
+
+  // Handles what is on the bus; if a SYNC was among it, steps once and answers. True if stepped.
+  bool poll();
+  // Same, waiting up to timeout_ns for a SYNC (SocketCAN); false on timeout.
+  bool wait(std::int64_t timeout_ns);
+
+  bool failed() const { return !plant_.status().ok(); }
+  bool holding() const { return holding_; }
+  std::uint64_t holds() const { return holds_; }     // transitions into hold
+  std::uint64_t steps() const { return steps_; }
+  const plant::Plant& plant() const { return plant_; }
+  void publish_counters();
+
+ private:
+  void step(std::uint64_t cycle);
+  // Efforts that brake the machine to rest where it is: g_a(q) - M_a * rate * qd_a.
+  Vec4 hold_effort();
+  void publish_state();
+
+  plant::Plant& plant_;
+  hal::PlantCanPort& port_;
+  telemetry::TelemetryPublisher* telemetry_;
+  PlantNodeConfig config_;
+  Workspace ws_;
+  hal::CommandState command_;
+  hal::SensorState sensors_;
+  std::uint64_t last_command_cycle_ = 0;
+  bool have_command_ = false;
+  bool holding_ = true;
+  std::uint64_t holds_ = 0;
+  std::uint64_t steps_ = 0;
+};
+
+}  // namespace exc::app

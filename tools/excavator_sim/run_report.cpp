@@ -1,0 +1,131 @@
+#include "run_report.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <string>
+
+namespace exc::sim {
+namespace {
+
+constexpr const char* kJoints[4] = {"swing", "boom", "arm", "bucket"};
+constexpr const char* kUnits[4] = {"rad", "m", "m", "m"};
+constexpr const char* kTheta[6] = {"M_x", "B_x", "K_x", "M_z", "B_z", "K_z"};
+
+nlohmann::json per_joint(const double (&v)[4]) {
+  nlohmann::json j;
+  for (int i = 0; i < 4; ++i) j[kJoints[i]] = v[i];
+  return j;
+}
+
+nlohmann::json timing_json(const Timing& t) {
+  return {{"median", t.median_us}, {"p99", t.p99_us}, {"max", t.max_us}, {"count", t.count}};
+}
+
+}  // namespace
+
+void print_summary(const Summary& summary, std::ostream& out) {
+  char line[256];
+  out << "\nscene " << summary.scene << "\n\n";
+  out << "tracking error (while tracking)     ";
+  for (const RunResult& r : summary.runs) {
+    std::snprintf(line, sizeof line, "| %-10s RMS      max     ", r.controller.c_str());
+    out << line;
+  }
+  out << "\n";
+  for (int j = 0; j < 4; ++j) {
+    std::snprintf(line, sizeof line, "  %-7s (%-3s)                     ", kJoints[j], kUnits[j]);
+    out << line;
+    for (const RunResult& r : summary.runs) {
+      std::snprintf(line, sizeof line, "| %10.3e %10.3e    ", r.rms_error[j], r.max_error[j]);
+      out << line;
+    }
+    out << "\n";
+  }
+  out << "\nsoil estimates at the end (true value)\n";
+  for (int i = 0; i < 6; ++i) {
+    std::snprintf(line, sizeof line, "  %-4s true %10.4g   ", kTheta[i], summary.runs.empty() ? 0.0 : summary.runs[0].theta_true[i]);
+    out << line;
+    for (const RunResult& r : summary.runs) {
+      std::snprintf(line, sizeof line, "| %-10s %10.4g ", r.controller.c_str(), r.theta_hat[i]);
+      out << line;
+    }
+    out << "\n";
+  }
+  out << "\n";
+  for (const RunResult& r : summary.runs) {
+    std::snprintf(line, sizeof line,
+                  "%-10s peak soil force %8.1f kN, %d shear re-anchorings; control step median %.1f us, p99 %.1f us, "
+                  "max %.1f us; heap allocations in loop %llu; %.1f s simulated in %.2f s (%.0fx real time)%s%s\n",
+                  r.controller.c_str(), r.peak_soil_force * 1e-3, r.reanchor_count, r.control_step.median_us,
+                  r.control_step.p99_us, r.control_step.max_us,
+                  static_cast<unsigned long long>(r.heap_allocations_in_loop), r.simulated_seconds, r.wall_seconds,
+                  r.wall_seconds > 0 ? r.simulated_seconds / r.wall_seconds : 0.0, r.ok ? "" : "\n  FAILED: ",
+                  r.ok ? "" : r.failure.c_str());
+    out << line;
+  }
+}
+
+nlohmann::json to_json(const Summary& summary) {
+  nlohmann::json j;
+  j["scene"] = summary.scene;
+  j["ok"] = summary.all_ok;
+  Timing worst;
+  std::uint64_t allocations = 0;
+  double simulated = 0;
+  for (const RunResult& r : summary.runs) {
+    nlohmann::json run;
+    run["ok"] = r.ok;
+    if (!r.ok) run["failure"] = r.failure;
+    run["rms_error"] = per_joint(r.rms_error);
+    run["max_error"] = per_joint(r.max_error);
+    nlohmann::json theta_hat, theta_true;
+    for (int i = 0; i < 6; ++i) {
+      theta_hat[kTheta[i]] = r.theta_hat[i];
+      theta_true[kTheta[i]] = r.theta_true[i];
+    }
+    run["theta_hat"] = theta_hat;
+    run["theta_true"] = theta_true;
+    run["peak_soil_force"] = r.peak_soil_force;
+    run["reanchor_count"] = r.reanchor_count;
+    run["control_step_us"] = timing_json(r.control_step);
+    run["firmware_cycle_us"] = timing_json(r.firmware_cycle);
+    run["heap_allocations_in_loop"] = r.heap_allocations_in_loop;
+    run["simulated_seconds"] = r.simulated_seconds;
+    run["wall_seconds"] = r.wall_seconds;
+    run["safe_stops"] = r.safe_stops;
+    run["can_frames_rejected"] = r.rx_rejected;
+    j[r.controller] = run;
+    // Headline figures over all runs: the worst timing, the total allocations.
+    worst.median_us = std::max(worst.median_us, r.control_step.median_us);
+    worst.p99_us = std::max(worst.p99_us, r.control_step.p99_us);
+    worst.max_us = std::max(worst.max_us, r.control_step.max_us);
+    worst.count += r.control_step.count;
+    allocations += r.heap_allocations_in_loop;
+    simulated = std::max(simulated, r.simulated_seconds);
+  }
+  j["control_step_us"] = timing_json(worst);
+  j["heap_allocations_in_loop"] = allocations;
+  j["simulated_seconds"] = simulated;
+  return j;
+}
+
+int write_report(const char* /*argv0*/, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json) {
+  const std::string log = (out_dir / "run.lcm").string();
+  const std::string report = (out_dir / "report").string();
+  const std::string summary = summary_json.string();
+  const pid_t pid = fork();
+  if (pid < 0) return 127;
+  if (pid == 0) {
+    execl(EXC_LOG_TOOL, EXC_LOG_TOOL, "report", log.c_str(), "--out", report.c_str(), "--summary", summary.c_str(),
+          "--title", "Digging scene: PID against adaptive computed torque", static_cast<char*>(nullptr));
+    std::perror("excavator-sim: cannot run " EXC_LOG_TOOL);
+    _exit(127);
+  }
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return 127;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+}  // namespace exc::sim

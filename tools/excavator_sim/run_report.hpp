@@ -1,0 +1,17 @@
+#pragma once
+// The main job's outputs: the summary table on stdout, the JSON for machines, and the report page
+// (CSV export + plots by excavator-log report).
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <ostream>
+
+#include "in_process_run.hpp"
+
+namespace exc::sim {
+
+void print_summary(const Summary& summary, std::ostream& out);
+nlohmann::json to_json(const Summary& summary);
+// Runs `excavator-log report` on out_dir/run.lcm; returns its exit status.
+int write_report(const char* argv0, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json);
+
+}  // namespace exc::sim
