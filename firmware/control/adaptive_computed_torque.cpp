@@ -1,0 +1,86 @@
+#include "control/adaptive_computed_torque.hpp"
+
+#include <Eigen/Cholesky>
+
+#include "control/lyapunov.hpp"
+
+namespace exc::control {
+
+AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const ControllerConfig& config,
+                                               const EffortLimits& limits)
+    : model_(model), ws_(model), config_(config), limits_(limits) {
+  const Mat8 A = error_dynamics_matrix(config.gains.kp, config.gains.kv);
+  const Mat8 Q = config.lyapunov_q.asDiagonal();
+  if (!solve_lyapunov(A, Q, P_))
+    throw ConfigError("<controller>", "controller.kp/kv", "A^T P + P A + Q = 0 has no SPD solution");
+  reset();
+}
+
+void AdaptiveComputedTorque::reset() {
+  theta_hat_ = config_.theta_initial;
+  anchor_.reset();
+}
+
+Vec6 AdaptiveComputedTorque::gamma() const {
+  Vec6 g;
+  for (int i = 0; i < 6; ++i) g[i] = config_.adaptation_rate[i] > 0 ? 1 / config_.adaptation_rate[i] : 0;
+  return g;
+}
+
+ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
+  ControlOutput out;
+  out.e = in.q - in.q_d;
+  out.ed = in.qd - in.qd_d;
+  out.theta_hat = theta_hat_;
+  const ModelReport report = update_closed_chain(model_, ws_, in.q, in.qd);
+  out.status = report.status;
+  if (!report.ok()) {
+    out.tau = out.tau_unsaturated = last_tau_;
+    return out;
+  }
+  Mat4 M_a;
+  Vec4 h_a;
+  mass_matrix(model_, ws_, M_a);
+  bias_forces(model_, ws_, h_a);
+
+  // Contact and anchor (the controller's own estimate unless the caller knows them).
+  out.rho = ws_.rho;
+  if (in.soil.anchor_given) {
+    out.in_soil = in.soil.in_soil;
+    out.rho_env = in.soil.rho_env;
+  } else {
+    anchor_.update(ws_.rho, in.soil.terrain_height);
+    out.in_soil = anchor_.in_soil();
+    out.rho_env = anchor_.anchor();
+  }
+  const Vec4& qdd_for_y = config_.regressor_acceleration == RegressorAcceleration::desired ? in.qdd_d : in.qdd;
+  const Vec2 rhodd = ws_.J_t * qdd_for_y + ws_.rhodd_bias;
+  const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, ws_.rhod, rhodd, out.rho_env, out.in_soil);
+
+  const Vec4 v = in.qdd_d - config_.gains.kv.cwiseProduct(out.ed) - config_.gains.kp.cwiseProduct(out.e);
+  out.tau_unsaturated = M_a * v + h_a + Y * theta_hat_;  // eq. 12
+  out.saturated = limits_.saturate(out.tau_unsaturated, out.tau);
+  last_tau_ = out.tau;
+
+  Vec8 x;
+  x << out.e, out.ed;
+  out.lyapunov_tracking = x.dot(P_ * x);
+  out.lyapunov = out.lyapunov_tracking;
+  if (in.soil.theta_known) {
+    const Vec6 g = gamma();
+    const Vec6 tilde = theta_hat_ - in.soil.theta;
+    out.lyapunov += tilde.dot(g.cwiseProduct(tilde));
+  }
+
+  // Update law (eq. 27), explicit Euler at the control period, then the projection.
+  if (out.in_soil && out.saturated == 0) {
+    const Eigen::LDLT<Mat4> ldlt(M_a);
+    const Mat4x6 Phi = ldlt.solve(Y);                       // M_a^-1 Y
+    const Vec4 BtPx = P_.bottomRows<4>() * x;               // B^T P x
+    const Vec6 theta_dot = -config_.adaptation_rate.cwiseProduct(Phi.transpose() * BtPx);
+    theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
+  }
+  return out;
+}
+
+}  // namespace exc::control

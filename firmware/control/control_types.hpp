@@ -1,0 +1,60 @@
+#pragma once
+// What every controller takes and returns, and the interface the firmware loop calls
+// (ros2_control's update(): the loop reads sensors, calls update(), writes the command).
+// All fixed-size; update() never allocates, throws or blocks.
+#include <cstdint>
+
+#include "model/model_status.hpp"
+#include "model/types.hpp"
+
+namespace exc::control {
+
+// What the controller knows about the soil beyond its own state (model.md s.5, s.6).
+struct SoilContext {
+  double terrain_height = 0;  // world z of the flat terrain (m), from the scene
+  // false (the firmware): the controller estimates contact and the anchor rho_env itself from its
+  // own tip position (soil_anchor_estimator.hpp). true (simulation truth, tests): take them below.
+  bool anchor_given = false;
+  bool in_soil = false;
+  Vec2 rho_env = Vec2::Zero();  // anchor (x, z world height) in the swing plane (m)
+  // True soil parameters [M_x B_x K_x M_z B_z K_z] when the caller knows them (the simulator, for
+  // telemetry and the Lyapunov test); V then includes the parameter-error term.
+  bool theta_known = false;
+  Vec6 theta = Vec6::Zero();
+};
+
+struct ControlInput {
+  double t = 0;                  // s
+  Vec4 q = Vec4::Zero();         // measured q_a
+  Vec4 qd = Vec4::Zero();        // measured (filtered) qd_a
+  Vec4 qdd = Vec4::Zero();       // filtered qdd_a (state_estimator.hpp); only the adaptive law uses it
+  Vec4 q_d = Vec4::Zero(), qd_d = Vec4::Zero(), qdd_d = Vec4::Zero();  // desired
+  SoilContext soil;
+};
+
+struct ControlOutput {
+  Vec4 tau = Vec4::Zero();            // saturated effort sent to the actuators
+  Vec4 tau_unsaturated = Vec4::Zero();
+  std::uint8_t saturated = 0;         // bit j set: joint j hit its effort limit this step
+  Vec4 e = Vec4::Zero(), ed = Vec4::Zero();  // q_a - q_d, qd_a - qd_d
+  Vec6 theta_hat = Vec6::Zero();      // soil estimate (zero for the PID baseline)
+  double lyapunov = 0;                // V (see each controller); includes Theta~ only if theta_known
+  double lyapunov_tracking = 0;       // the tracking-error part of V alone
+  bool in_soil = false;               // contact as the controller sees it
+  Vec2 rho = Vec2::Zero(), rho_env = Vec2::Zero();  // tip and anchor as the controller sees them
+  ModelStatus status = ModelStatus::ok;  // not ok: tau is the last good command held (never NaN)
+};
+
+enum class ControllerKind : std::uint8_t { pid = 0, adaptive = 1, slotine_li = 2 };
+const char* to_string(ControllerKind kind);
+
+class Controller {
+ public:
+  virtual ~Controller() = default;
+  // Forget integrators and adaptation state; theta_hat restarts at the configured initial value.
+  virtual void reset() = 0;
+  virtual ControlOutput update(const ControlInput& in) = 0;
+  virtual ControllerKind kind() const = 0;
+};
+
+}  // namespace exc::control

@@ -1,0 +1,70 @@
+#include "control/slotine_li.hpp"
+
+namespace exc::control {
+
+SlotineLi::SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits)
+    : model_(model), ws_(model), config_(config), limits_(limits) {
+  reset();
+}
+
+void SlotineLi::reset() {
+  theta_hat_ = config_.theta_initial;
+  anchor_.reset();
+}
+
+ControlOutput SlotineLi::update(const ControlInput& in) {
+  ControlOutput out;
+  out.e = in.q - in.q_d;
+  out.ed = in.qd - in.qd_d;
+  out.theta_hat = theta_hat_;
+  const Vec4& lambda = config_.sl_lambda;
+  const Vec4 qd_r = in.qd_d - lambda.cwiseProduct(out.e);
+  const Vec4 qdd_r = in.qdd_d - lambda.cwiseProduct(out.ed);
+  const Vec4 s = out.ed + lambda.cwiseProduct(out.e);
+
+  // Kinematics at (q, qd_r): M_a(q), C_a(q, qd_r) qd_r + g_a, J_t(q), Jd_t(q, qd_r) qd_r.
+  const ModelReport report = update_closed_chain(model_, ws_, in.q, qd_r);
+  out.status = report.status;
+  if (!report.ok()) {
+    out.tau = out.tau_unsaturated = last_tau_;
+    return out;
+  }
+  Mat4 M_a;
+  Vec4 h_r;
+  mass_matrix(model_, ws_, M_a);
+  bias_forces(model_, ws_, h_r);
+
+  out.rho = ws_.rho;  // position level: independent of the velocity passed in
+  if (in.soil.anchor_given) {
+    out.in_soil = in.soil.in_soil;
+    out.rho_env = in.soil.rho_env;
+  } else {
+    anchor_.update(ws_.rho, in.soil.terrain_height);
+    out.in_soil = anchor_.in_soil();
+    out.rho_env = anchor_.anchor();
+  }
+  const Vec2 rhod_r = ws_.J_t * qd_r;
+  const Vec2 rhodd_r = ws_.J_t * qdd_r + ws_.rhodd_bias;
+  const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, rhod_r, rhodd_r, out.rho_env, out.in_soil);
+
+  const Vec4 kd = config_.sl_kd.cwiseProduct(M_a.diagonal());
+  out.tau_unsaturated = M_a * qdd_r + h_r + Y * theta_hat_ - kd.cwiseProduct(s);
+  out.saturated = limits_.saturate(out.tau_unsaturated, out.tau);
+  last_tau_ = out.tau;
+
+  out.lyapunov_tracking = 0.5 * s.dot(M_a * s) + out.e.dot(lambda.cwiseProduct(kd).cwiseProduct(out.e));
+  out.lyapunov = out.lyapunov_tracking;
+  if (in.soil.theta_known) {
+    const Vec6 tilde = theta_hat_ - in.soil.theta;
+    for (int i = 0; i < 6; ++i)
+      if (config_.sl_adaptation_rate[i] > 0)
+        out.lyapunov += 0.5 * tilde[i] * tilde[i] / config_.sl_adaptation_rate[i];
+  }
+  if (out.in_soil && out.saturated == 0) {
+    const Vec6 theta_dot = -config_.sl_adaptation_rate.cwiseProduct(Y.transpose() * s);
+    theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
+  }
+  return out;
+}
+
+}  // namespace exc::control

@@ -1,0 +1,108 @@
+#pragma once
+// The firmware's operating modes and their transitions (issue 5):
+//   init -> wait_sensors          once the loop runs (start-up done)
+//   wait_sensors -> hold          the first valid sensor frame arrived
+//   hold -> track                 tracking requested (and sensors fresh)
+//   track -> hold                 stop requested, or the trajectory finished
+//   hold/track -> safe_stop       watchdog: no valid sensor frame for longer than the timeout, or a
+//                                 fault (model, non-finite command); command: zero flow / brake
+//   safe_stop -> hold             frames are back (fresh) and no fault: hold where the machine is
+// Each transition carries a reason. Pure logic on the inputs; no allocation, no clock of its own.
+#include <cstdint>
+
+#include "model/types.hpp"
+
+namespace exc::control {
+
+enum class Mode : std::uint8_t { init = 0, wait_sensors = 1, hold = 2, track = 3, safe_stop = 4 };
+const char* to_string(Mode m);
+
+struct StateMachineInputs {
+  double t = 0;                          // s, the loop's time
+  bool have_valid_frame = false;         // a valid sensor frame has ever been received
+  double last_valid_frame_time = -1e300; // s, time of the latest valid sensor frame
+  bool track_requested = false;
+  bool stop_requested = false;
+  bool trajectory_finished = false;
+  bool fault = false;                    // e.g. model status not ok, non-finite command
+};
+
+struct Transition {
+  bool changed = false;
+  Mode from = Mode::init, to = Mode::init;
+  const char* reason = "";  // static string
+};
+
+class ControlStateMachine {
+ public:
+  explicit ControlStateMachine(double watchdog_timeout = 0.02) : timeout_(watchdog_timeout) {}
+  Mode mode() const { return mode_; }
+  const char* last_reason() const { return reason_; }
+  double watchdog_timeout() const { return timeout_; }
+
+  Transition step(const StateMachineInputs& in) {
+    const bool fresh = in.have_valid_frame && (in.t - in.last_valid_frame_time) <= timeout_;
+    switch (mode_) {
+      case Mode::init: return go(Mode::wait_sensors, "started");
+      case Mode::wait_sensors:
+        if (fresh) return go(Mode::hold, "first valid sensor frame");
+        break;
+      case Mode::hold:
+      case Mode::track:
+        if (!fresh) return go(Mode::safe_stop, "watchdog: sensor frames timed out");
+        if (in.fault) return go(Mode::safe_stop, "fault");
+        if (mode_ == Mode::hold && in.track_requested && !in.stop_requested && !in.trajectory_finished)
+          return go(Mode::track, "tracking requested");
+        if (mode_ == Mode::track && in.stop_requested) return go(Mode::hold, "stop requested");
+        if (mode_ == Mode::track && in.trajectory_finished) return go(Mode::hold, "trajectory finished");
+        break;
+      case Mode::safe_stop:
+        if (fresh && !in.fault) return go(Mode::hold, "sensor frames back, no fault");
+        break;
+    }
+    return Transition{false, mode_, mode_, ""};
+  }
+
+ private:
+  Transition go(Mode to, const char* reason) {
+    Transition t{true, mode_, to, reason};
+    mode_ = to;
+    reason_ = reason;
+    return t;
+  }
+  double timeout_;
+  Mode mode_ = Mode::init;
+  const char* reason_ = "";
+};
+
+// Bumpless switching of modes or controllers: at the switch the new law's command is offset to
+// equal the last command sent, and the offset fades linearly to zero over blend_time. The command
+// is continuous at the switch and equals the new law's after blend_time.
+class CommandBlender {
+ public:
+  explicit CommandBlender(double blend_time = 0.2) : blend_time_(blend_time) {}
+  // last_sent: the command sent on the previous cycle; first_new: the new law's command now.
+  void on_switch(double t, const Vec4& last_sent, const Vec4& first_new) {
+    t_switch_ = t;
+    offset_ = last_sent - first_new;
+    active_ = true;
+  }
+  Vec4 apply(double t, const Vec4& command) {
+    if (!active_) return command;
+    const double s = blend_time_ > 0 ? (t - t_switch_) / blend_time_ : 1.0;
+    if (s >= 1) {
+      active_ = false;
+      return command;
+    }
+    return command + offset_ * (1 - (s < 0 ? 0 : s));
+  }
+  bool active() const { return active_; }
+
+ private:
+  double blend_time_;
+  double t_switch_ = 0;
+  bool active_ = false;
+  Vec4 offset_ = Vec4::Zero();
+};
+
+}  // namespace exc::control

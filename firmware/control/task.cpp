@@ -1,0 +1,124 @@
+#include "control/task.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <set>
+#include <sstream>
+
+namespace exc::control {
+namespace {
+
+std::string fmt(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+
+double number(const YAML::Node& n, const std::string& file, const std::string& field, double lo, double hi,
+              const char* unit) {
+  if (!n.IsDefined() || n.IsNull()) throw ConfigError(file, field, std::string("missing (a number in ") + fmt(lo) + " .. " + fmt(hi) + " " + unit + ")");
+  double v = 0;
+  try {
+    v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    throw ConfigError(file, field, std::string("not a number (allowed: ") + fmt(lo) + " .. " + fmt(hi) + " " + unit + ")");
+  }
+  if (!std::isfinite(v) || v < lo || v > hi)
+    throw ConfigError(file, field, fmt(v) + " " + unit + " outside the allowed range " + fmt(lo) + " .. " + fmt(hi));
+  return v;
+}
+
+void only_keys(const YAML::Node& n, const std::string& file, const std::string& field,
+               const std::set<std::string>& allowed) {
+  if (!n.IsMap()) throw ConfigError(file, field, "must be a mapping");
+  for (const auto& kv : n) {
+    const std::string key = kv.first.as<std::string>();
+    if (!allowed.count(key)) {
+      std::string list;
+      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+      throw ConfigError(file, field + "." + key, "unknown key (allowed: " + list + ")");
+    }
+  }
+}
+
+const YAML::Node& sequence(const YAML::Node& n, const std::string& file, const std::string& field) {
+  if (!n.IsDefined() || !n.IsSequence() || n.size() < 2)
+    throw ConfigError(file, field, "must be a list of at least 2 waypoints");
+  return n;
+}
+
+}  // namespace
+
+Task parse_task(const YAML::Node& node, const std::string& file, const Machine& machine,
+                const TrajectoryCheckOptions& options) {
+  const std::string s = "task";
+  if (!node.IsDefined() || node.IsNull()) throw ConfigError(file, s, "missing (type: joint_waypoints or dig)");
+  if (!node.IsMap()) throw ConfigError(file, s, "must be a mapping with a type");
+  const std::string type = node["type"] ? node["type"].as<std::string>() : "";
+  Task task;
+  constexpr double kTimeMax = 1e5;
+  if (type == "joint_waypoints") {
+    only_keys(node, file, s, {"type", "waypoints"});
+    task.type = TaskType::joint_waypoints;
+    const YAML::Node w = sequence(node["waypoints"], file, s + ".waypoints");
+    const Vec4 lo = machine.q_min(), hi = machine.q_max();
+    std::vector<Vec4> qs;
+    for (std::size_t i = 0; i < w.size(); ++i) {
+      const std::string f = s + ".waypoints[" + std::to_string(i) + "]";
+      only_keys(w[i], file, f, {"t", "q"});
+      const double t = number(w[i]["t"], file, f + ".t", 0, kTimeMax, "s");
+      if (!task.waypoint_times.empty() && !(t > task.waypoint_times.back()))
+        throw ConfigError(file, f + ".t", fmt(t) + " s must be later than the previous waypoint's " +
+                                              fmt(task.waypoint_times.back()) + " s");
+      const YAML::Node q = w[i]["q"];
+      if (!q.IsDefined() || !q.IsSequence() || q.size() != kNumActive)
+        throw ConfigError(file, f + ".q", "must be 4 numbers [swing rad, L_boom m, L_arm m, L_bucket m]");
+      Vec4 v;
+      for (int j = 0; j < kNumActive; ++j) {
+        const double l = std::isfinite(lo[j]) ? lo[j] : -1e3, h = std::isfinite(hi[j]) ? hi[j] : 1e3;
+        v[j] = number(q[j], file, f + ".q[" + std::to_string(j) + "]", l, h, j == 0 ? "rad" : "m");
+      }
+      task.waypoint_times.push_back(t);
+      qs.push_back(v);
+    }
+    task.trajectory = JointTrajectory(task.waypoint_times, qs);
+    check_joint_trajectory(machine, task.trajectory, task.waypoint_times, options, file, s + ".waypoints");
+  } else if (type == "dig") {
+    only_keys(node, file, s, {"type", "swing", "path"});
+    task.type = TaskType::dig;
+    task.swing = node["swing"] ? number(node["swing"], file, s + ".swing", -3.14159265358979323846,
+                                        3.14159265358979323846, "rad")
+                               : 0.0;
+    const YAML::Node p = sequence(node["path"], file, s + ".path");
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const std::string f = s + ".path[" + std::to_string(i) + "]";
+      only_keys(p[i], file, f, {"t", "x", "z", "pitch_deg"});
+      DigWaypoint wp;
+      wp.t = number(p[i]["t"], file, f + ".t", 0, kTimeMax, "s");
+      wp.pose.x = number(p[i]["x"], file, f + ".x", 0, 100, "m");
+      wp.pose.z = number(p[i]["z"], file, f + ".z", -100, 100, "m");
+      wp.pose.pitch = number(p[i]["pitch_deg"], file, f + ".pitch_deg", -360, 360, "deg") * 3.14159265358979323846 / 180;
+      task.path.push_back(wp);
+      task.waypoint_times.push_back(wp.t);
+    }
+    task.trajectory = dig_trajectory(machine, task.swing, task.path, options, file, s + ".path");
+  } else {
+    throw ConfigError(file, s + ".type", "'" + type + "' (allowed: joint_waypoints, dig)");
+  }
+  return task;
+}
+
+Task load_task(const std::string& scene_path, const Machine& machine, const TrajectoryCheckOptions& options) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(scene_path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(scene_path, "", "cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(scene_path, "", std::string("not valid YAML: ") + e.what());
+  }
+  return parse_task(root["task"], scene_path, machine, options);
+}
+
+}  // namespace exc::control

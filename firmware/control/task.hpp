@@ -1,0 +1,42 @@
+#pragma once
+// The scene's `task:` section, parsed, validated and turned into the desired joint trajectory:
+//   task:
+//     type: joint_waypoints        # paper 5.1: q_a waypoints, C2 spline through them
+//     waypoints:                   # t in s; q = [swing rad, L_boom m, L_arm m, L_bucket m]
+//       - {t: 0.0, q: [0.0, 2.30, 2.60, 1.95]}
+//   task:
+//     type: dig                    # paper 5.2: tip path in the swing plane
+//     swing: 0.0                   # rad, held
+//     path:                        # x: from the swing axis (m), z: world height (m)
+//       - {t: 0.0, x: 7.0, z: 1.0, pitch_deg: -60}   # pitch: angle of M->L above swing x
+// Errors (ConfigError) name the file, the field (task.waypoints[2].q[1]) and the allowed values;
+// limits (stroke, speed, reach) are checked here, before the run starts.
+#include <string>
+#include <vector>
+
+#include "control/dig_path.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace exc::control {
+
+enum class TaskType { joint_waypoints, dig };
+
+struct Task {
+  TaskType type = TaskType::joint_waypoints;
+  JointTrajectory trajectory;
+  std::vector<double> waypoint_times;  // of the waypoints or tip poses given in the file
+  double swing = 0;                    // dig: the held swing angle
+  std::vector<DigWaypoint> path;       // dig: the tip poses as given
+  double start_time() const { return trajectory.start_time(); }
+  double end_time() const { return trajectory.end_time(); }
+};
+
+Task parse_task(const YAML::Node& task, const std::string& file, const Machine& machine,
+                const TrajectoryCheckOptions& options = {});
+// Reads a scene file and parses its `task:` section (required).
+Task load_task(const std::string& scene_path, const Machine& machine, const TrajectoryCheckOptions& options = {});
+
+}  // namespace exc::control

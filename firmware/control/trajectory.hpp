@@ -1,0 +1,116 @@
+#pragma once
+// C2 trajectories through timed waypoints (the paper's section 5.1): a clamped cubic spline per
+// coordinate, with zero velocity at the first and last waypoint. Position, velocity and acceleration
+// are continuous everywhere inside; before the first time it holds the first point, after the last
+// time the last point (velocity and acceleration zero there).
+// Built once at start-up (allocates); evaluate() allocates nothing.
+#include <Eigen/Core>
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "model/types.hpp"
+
+namespace exc::control {
+
+template <int N>
+class CubicSpline {
+ public:
+  using Point = Eigen::Matrix<double, N, 1>;
+
+  CubicSpline() = default;
+  // times strictly increasing, at least two points. Throws std::invalid_argument otherwise (the
+  // parsers check first and name the field; this is the last line of defence).
+  CubicSpline(std::vector<double> times, std::vector<Point> points)
+      : t_(std::move(times)), y_(std::move(points)) {
+    if (t_.size() < 2 || t_.size() != y_.size())
+      throw std::invalid_argument("CubicSpline: need >= 2 waypoints with one time each");
+    for (std::size_t i = 1; i < t_.size(); ++i)
+      if (!(t_[i] > t_[i - 1])) throw std::invalid_argument("CubicSpline: times must increase");
+    solve_second_derivatives();
+  }
+
+  bool empty() const { return t_.empty(); }
+  double start_time() const { return t_.front(); }
+  double end_time() const { return t_.back(); }
+  std::size_t size() const { return t_.size(); }
+  const std::vector<double>& times() const { return t_; }
+  const std::vector<Point>& points() const { return y_; }
+
+  // Position, velocity, acceleration at time t (s). No allocation.
+  void evaluate(double t, Point& y, Point& yd, Point& ydd) const {
+    if (t <= t_.front() || t >= t_.back()) {
+      y = t <= t_.front() ? y_.front() : y_.back();
+      yd.setZero();
+      ydd.setZero();
+      return;
+    }
+    const std::size_t i = segment(t);
+    const double h = t_[i + 1] - t_[i];
+    const double a = t_[i + 1] - t;  // time to the segment end
+    const double b = t - t_[i];      // time from the segment start
+    const Point& m0 = m_[i];
+    const Point& m1 = m_[i + 1];
+    // The standard second-derivative form of a cubic spline segment.
+    y = (m0 * (a * a * a) + m1 * (b * b * b)) / (6 * h) + (y_[i] / h - m0 * (h / 6)) * a +
+        (y_[i + 1] / h - m1 * (h / 6)) * b;
+    yd = (-m0 * (a * a) + m1 * (b * b)) / (2 * h) - (y_[i] / h - m0 * (h / 6)) +
+         (y_[i + 1] / h - m1 * (h / 6));
+    ydd = (m0 * a + m1 * b) / h;
+  }
+
+ private:
+  std::size_t segment(double t) const {
+    // Cached guess first: the loop evaluates at increasing times.
+    if (last_ + 1 < t_.size() && t_[last_] <= t && t < t_[last_ + 1]) return last_;
+    const auto it = std::upper_bound(t_.begin(), t_.end(), t);
+    last_ = static_cast<std::size_t>(it - t_.begin()) - 1;
+    return last_;
+  }
+
+  // Second derivatives m_i at the knots: tridiagonal system of the C2 conditions with clamped
+  // (zero-slope) ends, solved by the Thomas algorithm (diagonally dominant, no pivoting needed).
+  void solve_second_derivatives() {
+    const std::size_t n = t_.size();
+    std::vector<double> lower(n, 0), diag(n, 0), upper(n, 0);
+    std::vector<Point> rhs(n, Point::Zero());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (i == 0) {
+        const double h = t_[1] - t_[0];
+        diag[i] = 2 * h;
+        upper[i] = h;
+        rhs[i] = 6 * (y_[1] - y_[0]) / h;  // minus 6 * start slope (zero)
+      } else if (i == n - 1) {
+        const double h = t_[i] - t_[i - 1];
+        lower[i] = h;
+        diag[i] = 2 * h;
+        rhs[i] = -6 * (y_[i] - y_[i - 1]) / h;  // plus 6 * end slope (zero)
+      } else {
+        const double h0 = t_[i] - t_[i - 1], h1 = t_[i + 1] - t_[i];
+        lower[i] = h0;
+        diag[i] = 2 * (h0 + h1);
+        upper[i] = h1;
+        rhs[i] = 6 * ((y_[i + 1] - y_[i]) / h1 - (y_[i] - y_[i - 1]) / h0);
+      }
+    }
+    for (std::size_t i = 1; i < n; ++i) {
+      const double w = lower[i] / diag[i - 1];
+      diag[i] -= w * upper[i - 1];
+      rhs[i] -= w * rhs[i - 1];
+    }
+    m_.assign(n, Point::Zero());
+    m_[n - 1] = rhs[n - 1] / diag[n - 1];
+    for (std::size_t i = n - 1; i-- > 0;) m_[i] = (rhs[i] - upper[i] * m_[i + 1]) / diag[i];
+  }
+
+  std::vector<double> t_;
+  std::vector<Point> y_;
+  std::vector<Point> m_;
+  mutable std::size_t last_ = 0;
+};
+
+// The desired active-joint trajectory q_d(t) = [swing rad, L_boom, L_arm, L_bucket] (m).
+using JointTrajectory = CubicSpline<kNumActive>;
+
+}  // namespace exc::control
