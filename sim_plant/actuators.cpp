@@ -74,10 +74,10 @@ void ActuatorModel::reset(const Vec4& /*q_a*/, const Vec4& hold) {
     const double f = lagged_[i];
     if (f >= 0) {
       p_b_[i] = low;
-      p_a_[i] = std::min((f + area_b_[i] * low) / area_a_[i], relief_);
+      p_a_[i] = std::clamp((f + area_b_[i] * low) / area_a_[i], params_.tank_pressure, relief_);
     } else {
       p_a_[i] = low;
-      p_b_[i] = std::min((area_a_[i] * low - f) / area_b_[i], relief_);
+      p_b_[i] = std::clamp((area_a_[i] * low - f) / area_b_[i], params_.tank_pressure, relief_);
     }
   }
   if (params_.fidelity == ActuatorFidelity::hydraulic) command_.mode = ActuatorCommand::valve;

@@ -12,9 +12,10 @@ namespace exc::plant {
 // (held flat beyond the ends).
 struct Terrain {
   static constexpr int kMaxPoints = 64;
+  Terrain() { profile.fill(Vec2::Zero()); }
   double height = 0.0;  // m, world z of a flat terrain
   int num_points = 0;   // 0: flat; otherwise the profile below is used
-  std::array<Vec2, kMaxPoints> profile{};  // (x, z), x strictly increasing
+  std::array<Vec2, kMaxPoints> profile;  // (x, z), x strictly increasing
 
   double height_at(double x) const;
 };
