@@ -1,0 +1,243 @@
+#!/usr/bin/env bash
+# The two-process vcan tests: excavator-plant and excavator-firmware as separate processes on vcan0
+# (inside vcan-vm, one VM boot for all scenarios), with a candump -L capture of the bus.
+#   run            the dig scene for --duration simulated seconds: both exit 0, the capture checks
+#                  clean against the DBC, and the firmware's tracking figures equal those of the
+#                  in-process run (excavator-sim) of the same scene, duration and controller.
+#   kill-plant     the plant is killed mid-run: the firmware sends FW_EMERGENCY within its
+#                  watchdog time (counted in cycles on the bus) and reports the safe stop.
+#   kill-firmware  the firmware is killed mid-run: the plant holds and says so (PLANT_EMERGENCY).
+# Nothing waits on wall-clock speed: every wait ends on an event (a receiver registered on vcan0,
+# frames in the capture, a process exit); the time limits only catch hangs.
+#
+# The command lines assumed for the two programs (adapt PLANT_ARGS / FIRMWARE_ARGS below if theirs
+# differ; @SCENE@, @DURATION@, @OUT@ are replaced):
+#   excavator-plant    --scene @SCENE@ --can vcan0 --duration @DURATION@
+#        steps once per SYNC; exits 0 after the last cycle of the duration; when the firmware falls
+#        silent it holds, sends PLANT_EMERGENCY and prints a line containing "hold".
+#   excavator-firmware --scene @SCENE@ --can vcan0 --controller adaptive --duration @DURATION@ --json @OUT@
+#        exits 0 after the duration with a summary JSON holding a "tracking" object (the same as in
+#        excavator-sim's --json summary); when the plant falls silent it goes to safe stop, sends
+#        FW_EMERGENCY and prints a line containing "safe".
+set -u
+
+PLANT_ARGS=${PLANT_ARGS:-"--scene @SCENE@ --can vcan0 --duration @DURATION@"}
+FIRMWARE_ARGS=${FIRMWARE_ARGS:-"--scene @SCENE@ --can vcan0 --controller adaptive --duration @DURATION@ --json @OUT@"}
+SIM_ARGS=${SIM_ARGS:-"run @SCENE@ --controller adaptive --duration @DURATION@ --no-report --quiet --out @OUTDIR@ --json @OUT@"}
+
+usage() {
+  cat <<'EOF'
+Usage: two_process.sh --vcan-vm PATH --plant PATH --firmware PATH --sim PATH --capture-check PATH
+                      --scene FILE --work DIR [--duration S] [--watchdog-cycles N]
+                      [--scenario all|run|kill-plant|kill-firmware] [--timeout S]
+Runs the two-process scenarios (see the head of this file) inside vcan-vm, in one VM.
+  --work DIR          output directory (made writable in the VM): captures, program output, JSON
+  --duration S        simulated seconds of the run scenario (default 3)
+  --watchdog-cycles N the firmware's watchdog in cycles (default 20: 20 ms at 1 kHz); the safe
+                      stop must come within N + 2 cycles of the plant's last frame
+  --timeout S         wall-clock limit for the whole VM run (default 280)
+Exit status: 0 when every scenario passed; 1 when one failed (the reasons are printed); 2 for bad
+arguments; otherwise vcan-vm's (124 timeout, 125 VM failure).
+EOF
+}
+
+vcan_vm="" plant="" firmware="" sim="" capture_check="" scene="" work=""
+duration=3 watchdog_cycles=20 scenario=all timeout_s=280 inside=0
+while [ $# -gt 0 ]; do
+  case $1 in
+    -h|--help) usage; exit 0 ;;
+    --vcan-vm) vcan_vm=$2; shift 2 ;;
+    --plant) plant=$2; shift 2 ;;
+    --firmware) firmware=$2; shift 2 ;;
+    --sim) sim=$2; shift 2 ;;
+    --capture-check) capture_check=$2; shift 2 ;;
+    --scene) scene=$2; shift 2 ;;
+    --work) work=$2; shift 2 ;;
+    --duration) duration=$2; shift 2 ;;
+    --watchdog-cycles) watchdog_cycles=$2; shift 2 ;;
+    --scenario) scenario=$2; shift 2 ;;
+    --timeout) timeout_s=$2; shift 2 ;;
+    --inside) inside=1; shift ;;
+    *) echo "two_process.sh: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
+  esac
+done
+for pair in "--plant:$plant" "--firmware:$firmware" "--sim:$sim" "--capture-check:$capture_check"; do
+  opt=${pair%%:*} path=${pair#*:}
+  [ -n "$path" ] && [ -x "$path" ] || { echo "two_process.sh: $opt '$path': not an executable program" >&2; exit 2; }
+done
+[ -r "$scene" ] || { echo "two_process.sh: --scene '$scene': not a readable file" >&2; exit 2; }
+[ -n "$work" ] || { echo "two_process.sh: --work DIR is required" >&2; exit 2; }
+[[ $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "two_process.sh: --duration '$duration': must be positive seconds" >&2; exit 2; }
+[[ $watchdog_cycles =~ ^[0-9]+$ ]] || { echo "two_process.sh: --watchdog-cycles '$watchdog_cycles': must be a whole number" >&2; exit 2; }
+case $scenario in all|run|kill-plant|kill-firmware) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant or kill-firmware" >&2; exit 2 ;; esac
+
+if [ "$inside" = 0 ]; then
+  [ -n "$vcan_vm" ] && [ -x "$vcan_vm" ] || { echo "two_process.sh: --vcan-vm '$vcan_vm': not an executable program" >&2; exit 2; }
+  mkdir -p "$work" || exit 2
+  work=$(cd "$work" && pwd -P)
+  self=$(cd "$(dirname "$0")" && pwd -P)/$(basename "$0")
+  exec "$vcan_vm" --timeout "$timeout_s" --share "$work" -- "$self" --inside \
+    --plant "$plant" --firmware "$firmware" --sim "$sim" --capture-check "$capture_check" \
+    --scene "$scene" --work "$work" --duration "$duration" --watchdog-cycles "$watchdog_cycles" --scenario "$scenario"
+fi
+
+# ---- inside the VM (or on a host with vcan) -----------------------------------------------------
+failures=0
+fail() { echo "FAIL [$current]: $*"; failures=$((failures + 1)); }
+note() { echo "[$current] $*"; }
+expand() {  # template, out file, out dir
+  local t=$1
+  t=${t//@SCENE@/$scene}; t=${t//@DURATION@/$2}; t=${t//@OUT@/$3}; t=${t//@OUTDIR@/${4:-}}
+  echo "$t"
+}
+# Receivers the kernel lists on vcan0 (candump, the programs' sockets).
+receivers() { cat /proc/net/can/rcvlist_* 2>/dev/null | grep -c -E '^ +vcan0 +[0-9A-Fa-f]'; }
+# wait_until WHAT COMMAND...: polls COMMAND until it succeeds; gives up after 2400 polls (a hang).
+wait_until() {
+  local what=$1 i=0; shift
+  until "$@"; do
+    i=$((i + 1))
+    [ $i -ge 2400 ] && { fail "gave up waiting for $what"; return 1; }
+    sleep 0.05
+  done
+}
+more_receivers_than() { [ "$(receivers)" -gt "$1" ]; }
+syncs_at_least() { [ "$(grep -c ' 080#' "$1" 2>/dev/null)" -ge "$2" ]; }
+id_in_capture() { grep -q " $2#" "$1" 2>/dev/null; }
+alive() { kill -0 "$1" 2>/dev/null; }
+dead() { ! kill -0 "$1" 2>/dev/null; }
+stop() { kill -TERM "$1" 2>/dev/null; wait "$1" 2>/dev/null; }
+stop_capture() { stop "$candump_pid"; cp "$capture" "$1/capture.log"; }
+
+# Starts candump, then the plant, each only once the previous one's receiver is registered, so the
+# capture and the plant miss nothing of what the firmware sends. candump writes to local scratch
+# space with a large socket buffer: writing each line through 9p is slow enough to drop frames.
+scratch=$(mktemp -d "${TMPDIR:-/tmp}/two_process.XXXXXX") || exit 1
+trap 'rm -rf "$scratch"' EXIT
+start_capture_and_plant() {  # dir, plant duration
+  local dir=$1 n
+  capture=$scratch/$(basename "$dir").log
+  n=$(receivers)
+  stdbuf -oL candump -r 8388608 -L vcan0 > "$capture" 2> "$dir/candump.err" &
+  candump_pid=$!
+  wait_until "candump's receiver on vcan0" more_receivers_than "$n" || return 1
+  n=$(receivers)
+  # shellcheck disable=SC2046  # the argument template is split into words on purpose
+  "$plant" $(expand "$PLANT_ARGS" "$2" "$dir/plant.json") > "$dir/plant.out" 2>&1 &
+  plant_pid=$!
+  wait_until "the plant's receiver on vcan0" more_receivers_than "$n" || return 1
+}
+
+scenario_run() {
+  current=run
+  local dir=$work/run
+  rm -rf "$dir"; mkdir -p "$dir"
+  # The in-process reference runs here too: same machine, same libm code paths as the two processes.
+  # shellcheck disable=SC2046
+  "$sim" $(expand "$SIM_ARGS" "$duration" "$dir/in_process.json" "$dir/in_process") > "$dir/sim.out" 2>&1 ||
+    { fail "the in-process run failed (exit $?): $(tail -3 "$dir/sim.out")"; return; }
+  start_capture_and_plant "$dir" "$duration" || return
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$FIRMWARE_ARGS" "$duration" "$dir/two_process.json") > "$dir/firmware.out" 2>&1
+  local fw_rc=$?
+  wait "$plant_pid"; local plant_rc=$?
+  stop_capture "$dir"
+  [ $fw_rc -eq 0 ] || fail "the firmware exited with $fw_rc: $(tail -3 "$dir/firmware.out")"
+  [ $plant_rc -eq 0 ] || fail "the plant exited with $plant_rc: $(tail -3 "$dir/plant.out")"
+  if "$capture_check" "$dir/capture.log" > "$dir/capture_check.out"; then
+    note "$(head -1 "$dir/capture_check.out")"
+  else
+    fail "the capture does not check against the DBC:"; sed -n '1,30p' "$dir/capture_check.out"
+  fi
+  # The tracking figures of both runs must be identical (the runs are deterministic: same cycles,
+  # same arithmetic); the first "tracking" object found in each summary is compared.
+  if python3 - "$dir/in_process.json" "$dir/two_process.json" > "$dir/compare.out" 2>&1 <<'PY'
+import json, sys
+def find(node):
+    if isinstance(node, dict):
+        if "tracking" in node:
+            return node["tracking"]
+        children = list(node.values())
+    elif isinstance(node, list):
+        children = node
+    else:
+        return None
+    for child in children:
+        found = find(child)
+        if found is not None:
+            return found
+    return None
+figures = []
+for path in sys.argv[1:]:
+    with open(path) as f:
+        t = find(json.load(f))
+    if t is None:
+        sys.exit(f"{path}: no 'tracking' figures")
+    figures.append(t)
+if figures[0] != figures[1]:
+    sys.exit(f"tracking figures differ:\n  in-process:  {json.dumps(figures[0], sort_keys=True)}\n  two-process: {json.dumps(figures[1], sort_keys=True)}")
+print("tracking figures equal:", json.dumps(figures[0], sort_keys=True))
+PY
+  then note "$(cat "$dir/compare.out")"; else fail "$(cat "$dir/compare.out")"; fi
+}
+
+scenario_kill_plant() {
+  current=kill-plant
+  local dir=$work/kill_plant long=600
+  rm -rf "$dir"; mkdir -p "$dir"
+  start_capture_and_plant "$dir" "$long" || return
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$FIRMWARE_ARGS" "$long" "$dir/two_process.json") > "$dir/firmware.out" 2>&1 &
+  local fw_pid=$!
+  # Mid-run: 300 cycles on the bus (the firmware is tracking by then).
+  wait_until "300 cycles on the bus" syncs_at_least "$capture" 300 || { stop "$fw_pid"; stop "$plant_pid"; stop_capture "$dir"; return; }
+  kill -KILL "$plant_pid"; wait "$plant_pid" 2>/dev/null
+  note "plant killed after $(grep -c ' 080#' "$capture") cycles"
+  wait_until "FW_EMERGENCY on the bus" id_in_capture "$capture" 010
+  # A few more cycles so the capture shows what follows (the emergency repeats), then stop it.
+  local seen; seen=$(grep -c ' 080#' "$capture")
+  wait_until "cycles after the safe stop" syncs_at_least "$capture" $((seen + 12))
+  alive "$fw_pid" && stop "$fw_pid"
+  stop_capture "$dir"
+  if "$capture_check" --expect-safe-stop-within $((watchdog_cycles + 2)) "$dir/capture.log" > "$dir/capture_check.out"; then
+    note "$(grep 'FW_EMERGENCY (' "$dir/capture_check.out")"
+  else
+    fail "safe stop not shown on the bus in time:"; sed -n '1,30p' "$dir/capture_check.out"
+  fi
+  grep -q -i 'safe' "$dir/firmware.out" || fail "the firmware did not report its safe stop: $(tail -3 "$dir/firmware.out")"
+}
+
+scenario_kill_firmware() {
+  current=kill-firmware
+  local dir=$work/kill_firmware long=600
+  rm -rf "$dir"; mkdir -p "$dir"
+  start_capture_and_plant "$dir" "$long" || return
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$FIRMWARE_ARGS" "$long" "$dir/two_process.json") > "$dir/firmware.out" 2>&1 &
+  local fw_pid=$!
+  wait_until "300 cycles on the bus" syncs_at_least "$capture" 300 || { stop "$fw_pid"; stop "$plant_pid"; stop_capture "$dir"; return; }
+  kill -KILL "$fw_pid"; wait "$fw_pid" 2>/dev/null
+  note "firmware killed after $(grep -c ' 080#' "$capture") cycles"
+  wait_until "PLANT_EMERGENCY on the bus" id_in_capture "$capture" 011
+  alive "$plant_pid" || fail "the plant exited instead of holding: $(tail -3 "$dir/plant.out")"
+  stop "$plant_pid"
+  stop_capture "$dir"
+  if "$capture_check" --expect-plant-hold "$dir/capture.log" > "$dir/capture_check.out"; then
+    note "$(grep 'PLANT_EMERGENCY (' "$dir/capture_check.out")"
+  else
+    fail "the plant's hold is not shown on the bus:"; sed -n '1,30p' "$dir/capture_check.out"
+  fi
+  grep -q -i 'hold' "$dir/plant.out" || fail "the plant did not report that it holds: $(tail -3 "$dir/plant.out")"
+}
+
+current=setup
+command -v candump > /dev/null || { fail "candump not found: install the Debian package can-utils"; exit 1; }
+case $scenario in
+  all) scenario_run; note "done at ${SECONDS} s"; scenario_kill_plant; note "done at ${SECONDS} s"; scenario_kill_firmware; note "done at ${SECONDS} s" ;;
+  run) scenario_run ;;
+  kill-plant) scenario_kill_plant ;;
+  kill-firmware) scenario_kill_firmware ;;
+esac
+if [ $failures -eq 0 ]; then echo "two_process.sh: all scenarios passed ($scenario)"; exit 0; fi
+echo "two_process.sh: $failures failure(s)"
+exit 1
