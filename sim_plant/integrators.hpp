@@ -1,9 +1,8 @@
 #pragma once
 // Time integration of the closed chain: three methods x three formulations (model.md s.4).
 //   methods       semi_implicit_euler (symplectic Euler: v then q), rk4 (classical), implicit_midpoint
-//                 (symplectic, A-stable; solved by a Newton iteration whose Jacobian carries the
-//                 soil's stiffness and damping exactly, in independent coordinates; by fixed-point
-//                 iteration in the augmented form)
+//                 (symplectic, A-stable; solved by a chord iteration whose Jacobian carries the
+//                 soil's stiffness and damping exactly on the constraint manifold, the identity off it)
 //   formulations  independent (q_a, qd_a: the loop is closed exactly at every evaluation),
 //                 augmented_baumgarte (all 12 coordinates, eq. 8 with Baumgarte terms),
 //                 augmented_projection (all 12, eq. 8 as written, then projected back onto h = 0

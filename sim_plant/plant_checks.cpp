@@ -75,7 +75,7 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
     return false;
   }
   if (!in.implicit_converged) {
-    unstable(status, PlantFailure::not_converged, in, "the implicit midpoint iteration did not converge (iterations)",
+    unstable(status, PlantFailure::not_converged, in, "the implicit midpoint iteration did not converge (iterations used",
              integ.implicit_max_iterations, integ.implicit_max_iterations);
     return false;
   }

@@ -38,7 +38,7 @@ struct PlantStatus {
   PlantFailure failure = PlantFailure::none;
   double time = 0;        // s, simulated time of the failure
   std::int64_t cycle = 0;
-  std::array<char, 384> message{};  // what failed, when, what to change ("" when ok)
+  std::array<char, 512> message{};  // what failed, when, what to change ("" when ok)
   bool ok() const { return failure == PlantFailure::none; }
   const char* text() const { return message.data(); }
 };
