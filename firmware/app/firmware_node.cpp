@@ -67,14 +67,20 @@ FirmwareNode::~FirmwareNode() = default;
 
 void FirmwareNode::begin_cycle() {
   ++cycle_;
+  complete_ = false;
   port_.send_sync(cycle_);
   if (cycle_ % kHeartbeatPeriod == 0) port_.send_heartbeat(static_cast<std::uint8_t>(machine_.mode()));
+}
+
+bool FirmwareNode::receive() {
+  if (port_.read(sensors_) && sensors_.motion_valid && sensors_.cycle == cycle_) complete_ = true;
+  return complete_;
 }
 
 void FirmwareNode::end_cycle() {
   const std::int64_t start_ns = hal::monotonic_now_ns();
   const double t = time();
-  if (port_.read(sensors_) && sensors_.motion_valid) {
+  if (receive()) {
     have_valid_ = true;
     last_valid_time_ = t;
   }
@@ -88,6 +94,7 @@ void FirmwareNode::end_cycle() {
                            t - track_start_ + task_.start_time() >= task_.end_time();
   in.fault = fault_;
   const control::Transition transition = machine_.step(in);
+  transition_ = transition;
   if (transition.changed) {
     if (transition.to == control::Mode::hold) {
       held_q_ = to_vec(sensors_.position);
@@ -103,6 +110,7 @@ void FirmwareNode::end_cycle() {
 
   compute_command(transition);
   port_.write(command_);
+  if (machine_.mode() == control::Mode::track) measured_.add(to_vec(sensors_.position), q_d_);
   cycle_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
   if (telemetry_ != nullptr) publish_cycle();
   if (telemetry_ != nullptr && transition.changed) {

@@ -16,6 +16,7 @@
 #include "control/state_machine.hpp"
 #include "control/task.hpp"
 #include "hal/can_ports.hpp"
+#include "app/tracking_metrics.hpp"
 #include "model/model.hpp"
 
 namespace exc::telemetry {
@@ -51,8 +52,15 @@ class FirmwareNode {
 
   // Starts cycle k (k = previous + 1): SYNC, and the heartbeat every 100 cycles.
   void begin_cycle();
+  // Drains the bus into the sensor state; true once the complete sensor set of this cycle is in.
+  // Callers on a real bus call it while waiting for the plant's answer; end_cycle() calls it too.
+  bool receive();
   // Completes the cycle once the plant had its chance to answer.
   void end_cycle();
+  // The last mode transition (changed == false when the last cycle kept its mode).
+  const control::Transition& last_transition() const { return transition_; }
+  // Tracking figures as the firmware measures them (sensed q_a against q_d, while tracking).
+  const TrackingMetrics& measured_tracking() const { return measured_; }
 
   std::uint64_t cycle() const { return cycle_; }
   double time() const { return static_cast<double>(cycle_) * period_; }
@@ -92,6 +100,9 @@ class FirmwareNode {
   double period_;
   std::uint64_t cycle_ = 0;
   bool have_valid_ = false;
+  bool complete_ = false;
+  control::Transition transition_;
+  TrackingMetrics measured_;
   double last_valid_time_ = -1e300;
   double track_start_ = 0;
   Vec4 held_q_ = Vec4::Zero();

@@ -38,12 +38,22 @@ Vec4 PlantNode::hold_effort() {
   return tau;
 }
 
+void PlantNode::hold_for_silence() {
+  if (!silence_hold_) ++holds_;
+  silence_hold_ = true;
+  holding_ = true;
+  port_.send_fault(true, 1);
+}
+
 void PlantNode::step(std::uint64_t cycle) {
   if (port_.read(command_)) {
     have_command_ = true;
     last_command_cycle_ = cycle;
+    silence_hold_ = false;
   }
-  const bool timed_out = !have_command_ || cycle - last_command_cycle_ > static_cast<std::uint64_t>(config_.command_timeout_cycles);
+  // A cycle counter that went backwards (a restarted firmware) counts as timed out until it commands.
+  const bool timed_out = !have_command_ || silence_hold_ || cycle < last_command_cycle_ ||
+                         cycle - last_command_cycle_ > static_cast<std::uint64_t>(config_.command_timeout_cycles);
   // The firmware's safe state is "valves centred" (valve command of zeros); a force-commanded
   // plant has no valves, so it brakes instead.
   const bool hydraulic = plant_.scene().actuators.fidelity == plant::ActuatorFidelity::hydraulic;

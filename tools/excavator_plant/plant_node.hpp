@@ -32,6 +32,9 @@ class PlantNode {
   bool wait(std::int64_t timeout_ns);
 
   bool failed() const { return !plant_.status().ok(); }
+  // The firmware fell silent (no SYNC): latch the hold until a fresh command set arrives, and say
+  // so on the bus with PLANT_EMERGENCY.
+  void hold_for_silence();
   bool holding() const { return holding_; }
   std::uint64_t holds() const { return holds_; }     // transitions into hold
   std::uint64_t steps() const { return steps_; }
@@ -54,6 +57,7 @@ class PlantNode {
   std::uint64_t last_command_cycle_ = 0;
   bool have_command_ = false;
   bool holding_ = true;
+  bool silence_hold_ = false;
   std::uint64_t holds_ = 0;
   std::uint64_t steps_ = 0;
 };

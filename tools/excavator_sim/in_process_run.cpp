@@ -116,6 +116,8 @@ RunResult run_one(const SceneBundle& bundle, control::ControllerKind kind, const
   for (int j = 0; j < 4; ++j) {
     result.rms_error[j] = metrics.rms(j);
     result.max_error[j] = metrics.max_abs(j);
+    result.measured_rms_error[j] = firmware.measured_tracking().rms(j);
+    result.measured_max_error[j] = firmware.measured_tracking().max_abs(j);
   }
   const Vec6 truth = theta_of(bundle.scene.soil);
   for (int i = 0; i < 6; ++i) {

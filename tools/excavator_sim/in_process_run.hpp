@@ -44,6 +44,10 @@ struct RunResult {
   double wall_seconds = 0;
   double rms_error[4] = {0, 0, 0, 0};  // while tracking; rad (swing), m (cylinders)
   double max_error[4] = {0, 0, 0, 0};
+  // The same as the firmware measures it (sensed q_a, after CAN scaling): what excavator-firmware
+  // reports in a two-process run, and equal to it bit for bit (SYNC lockstep).
+  double measured_rms_error[4] = {0, 0, 0, 0};
+  double measured_max_error[4] = {0, 0, 0, 0};
   double theta_hat[6] = {0, 0, 0, 0, 0, 0};
   double theta_true[6] = {0, 0, 0, 0, 0, 0};
   double peak_soil_force = 0;         // N, |F_soil| maximum

@@ -80,6 +80,7 @@ nlohmann::json to_json(const Summary& summary) {
     if (!r.ok) run["failure"] = r.failure;
     run["rms_error"] = per_joint(r.rms_error);
     run["max_error"] = per_joint(r.max_error);
+    run["tracking"] = {{"rms_error", per_joint(r.measured_rms_error)}, {"max_error", per_joint(r.measured_max_error)}};
     nlohmann::json theta_hat, theta_true;
     for (int i = 0; i < 6; ++i) {
       theta_hat[kTheta[i]] = r.theta_hat[i];

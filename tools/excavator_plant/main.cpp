@@ -1,0 +1,109 @@
+// excavator-plant: the simulated excavator as its own process on a SocketCAN interface. It steps
+// exactly once per SYNC and answers with its sensor frames; when SYNC stops (the firmware died or
+// was stopped) it holds the machine, says so on the bus (PLANT_EMERGENCY) and on stdout, and waits.
+#include <CLI/CLI.hpp>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "hal/socketcan_bus.hpp"
+#include "plant_node.hpp"
+#include "sim_plant/plant.hpp"
+#include "telemetry/telemetry_publisher.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"excavator-plant: the simulated excavator on a SocketCAN interface (see README)."};
+  std::string iface, scene_path, lcm_url;
+  double duration = 0, silence_ms = 500, startup_s = 120;
+  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
+  app.add_option("--scene", scene_path, "scene file")->required();
+  app.add_option("--duration", duration, "exit after this many simulated seconds (default: the scene's)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--lcm", lcm_url, "publish the machine state (EXC_STATE) to this LCM URL");
+  app.add_option("--silence-ms", silence_ms, "hold after this long without SYNC (wall clock)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--startup-timeout", startup_s, "give up if no SYNC arrives within this many seconds")
+      ->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    exc::plant::Plant plant(exc::plant::load_scene(scene_path));
+    std::uint32_t ids[32];
+    const std::size_t n = exc::hal::receive_ids(exc::hal::Node::plant, ids, 32);
+    std::string error;
+    auto bus = exc::hal::SocketCanBus::open(iface, ids, n, error);
+    if (!bus) {
+      std::cerr << "excavator-plant: " << error << "\n";
+      return 3;
+    }
+    std::unique_ptr<exc::telemetry::TelemetryPublisher> publisher;
+    if (!lcm_url.empty()) {
+      exc::telemetry::TelemetryConfig tc;
+      tc.lcm_url = lcm_url;
+      publisher = std::make_unique<exc::telemetry::TelemetryPublisher>(tc);
+      if (!publisher->start(&error)) {
+        std::cerr << "excavator-plant: --lcm: " << error << "\n";
+        return 2;
+      }
+    }
+    exc::hal::PlantCanPort port(*bus);
+    exc::app::PlantNode node(plant, port, publisher.get());
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+
+    const double total = duration > 0 ? duration : plant.scene().duration;
+    const auto cycles = static_cast<std::uint64_t>(std::llround(total / plant.scene().cycle));
+    const std::int64_t slice_ns = 50'000'000;  // wake at least every 50 ms to watch for silence
+    double silent_ms = 0;
+    bool announced = false;
+    std::printf("excavator-plant: %s on %s, %llu cycles, waiting for SYNC\n", plant.scene().name.c_str(),
+                iface.c_str(), static_cast<unsigned long long>(cycles));
+    std::fflush(stdout);
+    while (!g_stop && node.steps() < cycles) {
+      if (node.wait(slice_ns)) {
+        silent_ms = 0;
+        if (announced) {
+          std::printf("excavator-plant: SYNC is back at step %llu\n", static_cast<unsigned long long>(node.steps()));
+          std::fflush(stdout);
+          announced = false;
+        }
+        if (node.failed()) {
+          std::printf("excavator-plant: stopped: %s\n", plant.status().text());
+          return 4;
+        }
+        continue;
+      }
+      silent_ms += slice_ns * 1e-6;
+      if (node.steps() == 0 && silent_ms > startup_s * 1e3) {
+        std::fprintf(stderr, "excavator-plant: no SYNC on %s within %.0f s; is excavator-firmware running?\n",
+                     iface.c_str(), startup_s);
+        return 5;
+      }
+      if (node.steps() > 0 && silent_ms >= silence_ms && !announced) {
+        node.hold_for_silence();
+        std::printf("excavator-plant: no SYNC for %.0f ms after step %llu: hold (valves centred, machine braked)\n",
+                    silent_ms, static_cast<unsigned long long>(node.steps()));
+        std::fflush(stdout);
+        announced = true;
+      }
+    }
+    node.publish_counters();
+    if (publisher) publisher->stop();
+    std::printf("excavator-plant: %llu steps, %.3f s simulated, %llu holds, CAN rejects %llu\n",
+                static_cast<unsigned long long>(node.steps()), plant.state().time,
+                static_cast<unsigned long long>(node.holds()), static_cast<unsigned long long>(port.rx_stats().rejected()));
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "excavator-plant: " << e.what() << "\n";
+    return 2;
+  }
+}
