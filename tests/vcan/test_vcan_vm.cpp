@@ -99,7 +99,7 @@ TEST_CASE("vcan/vcan-vm rejects bad options, naming the option and its range") {
 }
 
 // One VM boot for everything that needs a running vcan0 (each boot costs 12-40 s of CI time).
-TEST_CASE("vcan/vcan-vm passes output, status, directory and environment; frames and the HAL run on its vcan0") {
+TEST_CASE("vcan/vcan-vm passes output and status and directory and environment and its vcan0 carries frames and the HAL test") {
   const fs::path dir = make_work_dir("one_vm");
   // Edge IDs and lengths: DLC 0..8, 11-bit extremes, one 29-bit ID.
   const std::vector<std::string> sent = {"123#DEADBEEF", "000#",           "7FF#0102030405060708",
