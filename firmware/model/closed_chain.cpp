@@ -1,6 +1,8 @@
 // The closed chain in independent coordinates (paper eqs. 3-7, 14-17; model.md s.4).
 #include "closed_chain.hpp"
 
+#include <Eigen/LU>
+
 #include "front_kinematics.hpp"
 #include "lie_group.hpp"
 #include "loop_closure.hpp"
@@ -24,13 +26,18 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   front_positions(model, ws.q, ws);
   front_loop_jacobian(model, ws, ws.H);  // H = dh/dq (eq. 4)
 
-  // Velocity level: qd = Psi qd_a, Psi = [I; -H_p^-1 H_a] (eq. 16a), in tree order.
+  // Velocity level: qd = Psi qd_a, Psi = [I; -H_p^-1 H_a] (eq. 16a), in tree order. At closure
+  // H_p is block diagonal (boom loop, arm loop, bucket four-bar), so it is inverted by blocks; the
+  // closed form has already reported a singular block (no assembly or toggle).
   Mat8 H_p;
   Mat8x4 H_a;
   for (int k = 0; k < kNumPassive; ++k) H_p.col(k) = ws.H.col(kPassiveJoints[k]);
   for (int k = 0; k < kNumActive; ++k) H_a.col(k) = ws.H.col(kActiveJoints[k]);
-  ws.lu_Hp.compute(H_p);
-  const Mat8x4 dqp_dqa = -(ws.lu_Hp.solve(H_a));
+  ws.Hp_inv.setZero();
+  ws.Hp_inv.block<2, 2>(0, 0) = H_p.block<2, 2>(0, 0).inverse();
+  ws.Hp_inv.block<2, 2>(2, 2) = H_p.block<2, 2>(2, 2).inverse();
+  ws.Hp_inv.block<4, 4>(4, 4) = H_p.block<4, 4>(4, 4).inverse();
+  const Mat8x4 dqp_dqa = -(ws.Hp_inv.lazyProduct(H_a));
   ws.Psi.setZero();
   for (int k = 0; k < kNumActive; ++k) ws.Psi(kActiveJoints[k], k) = 1.0;
   for (int k = 0; k < kNumPassive; ++k) ws.Psi.row(kPassiveJoints[k]) = dqp_dqa.row(k);
@@ -39,7 +46,7 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   // Acceleration bias: with qdd = 0 the cut pins accelerate apart by Hd qd; gamma = (0; -H_p^-1 Hd qd).
   front_rates(model, ws.qd, Vec12::Zero(), ws);
   front_loop_acceleration(model, ws, ws.Hd_qd);
-  const Vec8 gamma_p = -(ws.lu_Hp.solve(ws.Hd_qd));
+  const Vec8 gamma_p = -(ws.Hp_inv * ws.Hd_qd);
   ws.gamma.setZero();
   for (int k = 0; k < kNumPassive; ++k) ws.gamma[kPassiveJoints[k]] = gamma_p[k];
   if (!ws.Psi.allFinite() || !ws.gamma.allFinite()) {
@@ -67,13 +74,13 @@ void inverse_dynamics(const Model& model, Workspace& ws, const Vec4& qdd_a, cons
   // eq. 7a: tau_r = tau_act + H^T F_c with tau_act zero on the passive joints, so H_p^T F_c = tau_p.
   Vec8 tau_p;
   for (int k = 0; k < kNumPassive; ++k) tau_p[k] = ws.tau_r[kPassiveJoints[k]];
-  ws.F_c = ws.lu_Hp.transpose().solve(tau_p);
+  ws.F_c = ws.Hp_inv.transpose() * tau_p;
 }
 
 void mass_matrix(const Model& model, Workspace& ws, Mat4& M_a) {
   Mat12x4 MPsi;
   tree_inertia_times<4>(model, ws, ws.Psi, MPsi);
-  M_a = ws.Psi.transpose() * MPsi;  // eq. 17
+  M_a = ws.Psi.transpose().lazyProduct(MPsi);  // eq. 17
   M_a = (0.5 * (M_a + M_a.transpose())).eval();
 }
 

@@ -8,10 +8,9 @@ namespace exc {
 
 namespace {
 inline Vec2 perp(const Vec2& r) { return Vec2(-r.y(), r.x()); }
-inline Vec2 rotate(double phi, const Vec2& r) {
-  const double c = std::cos(phi), s = std::sin(phi);
-  return Vec2(c * r.x() - s * r.y(), s * r.x() + c * r.y());
-}
+inline Vec2 rotate(double c, double s, const Vec2& r) { return Vec2(c * r.x() - s * r.y(), s * r.x() + c * r.y()); }
+// Rotation by the angle of link i (cosine and sine computed once in front_positions).
+inline Vec2 rotate_by(const Workspace& ws, int i, const Vec2& r) { return rotate(ws.cos_phi[i], ws.sin_phi[i], r); }
 inline Vec2 planar(const Vec3& p) { return Vec2(p.x(), p.z()); }
 // Joint 0 (swing) is the base of the planar front: its children hang off the swing frame.
 inline bool in_front(int i) { return i > 0; }
@@ -19,17 +18,22 @@ inline bool in_front(int i) { return i > 0; }
 
 void front_positions(const Model& model, const Vec12& q, Workspace& ws) {
   ws.phi[0] = 0;
+  ws.cos_phi[0] = 1;
+  ws.sin_phi[0] = 0;
   ws.origin[0].setZero();
   for (int i = 1; i < kNumJoints; ++i) {
     const int p = model.parent[i];
-    const double phi_p = ws.phi[p];
     const Vec2 offset = planar(model.home[i].topRightCorner<3, 1>());
     if (model.prismatic[i]) {
-      ws.phi[i] = phi_p;
-      ws.origin[i] = ws.origin[p] + rotate(phi_p, offset + Vec2(q[i], 0.0));
+      ws.phi[i] = ws.phi[p];
+      ws.cos_phi[i] = ws.cos_phi[p];
+      ws.sin_phi[i] = ws.sin_phi[p];
+      ws.origin[i] = ws.origin[p] + rotate_by(ws, p, offset + Vec2(q[i], 0.0));
     } else {
-      ws.phi[i] = phi_p + q[i];
-      ws.origin[i] = ws.origin[p] + rotate(phi_p, offset);
+      ws.phi[i] = ws.phi[p] + q[i];
+      ws.cos_phi[i] = std::cos(ws.phi[i]);
+      ws.sin_phi[i] = std::sin(ws.phi[i]);
+      ws.origin[i] = ws.origin[p] + rotate_by(ws, p, offset);
     }
   }
 }
@@ -45,7 +49,7 @@ void front_rates(const Model& model, const Vec12& qd, const Vec12& qdd, Workspac
     Vec2 v = ws.origin_d[p] + w * perp(r);
     Vec2 acc = ws.origin_dd[p] + a * perp(r) - w * w * r;
     if (model.prismatic[i]) {
-      const Vec2 u = rotate(ws.phi[i], Vec2(1, 0));
+      const Vec2 u(ws.cos_phi[i], ws.sin_phi[i]);
       v += u * qd[i];
       acc += u * qdd[i] + 2.0 * w * perp(u) * qd[i];  // Coriolis of a slider on a turning link
       ws.omega[i] = w;
@@ -60,7 +64,7 @@ void front_rates(const Model& model, const Vec12& qd, const Vec12& qdd, Workspac
 }
 
 Vec2 front_point(const Workspace& ws, int link, const Vec3& local) {
-  return ws.origin[link] + rotate(ws.phi[link], planar(local));
+  return ws.origin[link] + rotate_by(ws, link, planar(local));
 }
 
 namespace {
@@ -70,14 +74,14 @@ void add_point_jacobian(const Model& model, const Workspace& ws, int link, const
                         int row, Eigen::Matrix<double, Rows, 12>& J) {
   for (int j = link; in_front(j); j = model.parent[j]) {
     if (model.prismatic[j])
-      J.template block<2, 1>(row, j) += sign * rotate(ws.phi[j], Vec2(1, 0));
+      J.template block<2, 1>(row, j) += sign * Vec2(ws.cos_phi[j], ws.sin_phi[j]);
     else
       J.template block<2, 1>(row, j) += sign * perp(point - ws.origin[j]);
   }
 }
 
 Vec2 point_acceleration(const Workspace& ws, int link, const Vec3& local) {
-  const Vec2 r = rotate(ws.phi[link], planar(local));
+  const Vec2 r = rotate_by(ws, link, planar(local));
   const double w = ws.omega[link];
   return ws.origin_dd[link] + ws.alpha[link] * perp(r) - w * w * r;
 }

@@ -58,6 +58,21 @@ inline SE3 exp_se3(const Twist& S, double q) {
   return make_se3(R, V * v);
 }
 
+// A * B by blocks (R_A R_B, R_A p_B + p_A): a quarter of the work of a 4x4 product.
+inline SE3 compose(const SE3& A, const SE3& B) {
+  const Mat3 R_A = rotation(A);
+  return make_se3(R_A * rotation(B), R_A * translation(B) + translation(A));
+}
+
+// exp([S] q) for a joint screw: a unit rotation axis through the origin (w, 0) or a unit slide
+// (0, v). Rodrigues as R = c I + s [w] + (1 - c) w w^T; equals exp_se3 for these screws.
+inline SE3 joint_motion(const Twist& S, double q, bool prismatic) {
+  if (prismatic) return translation_se3(S.tail<3>() * q);
+  const Vec3 w = S.head<3>();
+  const double s = std::sin(q), c = std::cos(q);
+  return make_se3(c * Mat3::Identity() + s * skew(w) + (1 - c) * w * w.transpose(), Vec3::Zero());
+}
+
 // Ad_T (6x6): maps a twist in frame B to frame A for T = X_AB.
 inline Mat6 Ad(const SE3& T) {
   const Mat3 R = rotation(T);
@@ -77,49 +92,58 @@ inline Mat6 ad(const Twist& V) {
   return a;
 }
 
+// The vector forms below run 10^2 times per dynamics call: forced inline, and written on blocks of the
+// 4x4 transform so no rotation is copied out.
+#define EXC_HOT_INLINE [[gnu::always_inline]] inline
+
 // Ad_T V without forming the 6x6 matrix.
-inline Twist Ad_apply(const SE3& T, const Twist& V) {
-  const Mat3 R = rotation(T);
-  const Vec3 w = R * V.head<3>();
+EXC_HOT_INLINE Twist Ad_apply(const SE3& T, const Twist& V) {
+  const Vec3 w = T.topLeftCorner<3, 3>() * V.head<3>();
+  const Vec3 p = T.topRightCorner<3, 1>();
   Twist out;
   out.head<3>() = w;
-  out.tail<3>() = translation(T).cross(w) + R * V.tail<3>();
+  out.tail<3>() = p.cross(w) + T.topLeftCorner<3, 3>() * V.tail<3>();
   return out;
 }
 
 // Ad_{T^-1} V: a twist of frame A expressed in frame B, for T = X_AB (the forward pass of eq. 1).
-inline Twist Ad_inv_apply(const SE3& T, const Twist& V) {
-  const Mat3 R = rotation(T);
+EXC_HOT_INLINE Twist Ad_inv_apply(const SE3& T, const Twist& V) {
+  const Vec3 p = T.topRightCorner<3, 1>();
+  const Vec3 w = V.head<3>();
+  const Vec3 v = V.tail<3>() - p.cross(w);
   Twist out;
-  out.head<3>() = R.transpose() * V.head<3>();
-  out.tail<3>() = R.transpose() * (V.tail<3>() - translation(T).cross(V.head<3>()));
+  out.head<3>().noalias() = T.topLeftCorner<3, 3>().transpose() * w;
+  out.tail<3>().noalias() = T.topLeftCorner<3, 3>().transpose() * v;
   return out;
 }
 
 // Ad*_{T^-1} F = Ad_{T^-1}^T F: a wrench in frame B expressed in frame A, for T = X_AB
 // (the backward pass of eq. 1 with T = f_{i,k}).
-inline Wrench Ad_inv_dual_apply(const SE3& T, const Wrench& F) {
-  const Mat3 R = rotation(T);
-  const Vec3 f = R * F.tail<3>();
+EXC_HOT_INLINE Wrench Ad_inv_dual_apply(const SE3& T, const Wrench& F) {
+  const Vec3 p = T.topRightCorner<3, 1>();
+  const Vec3 f = T.topLeftCorner<3, 3>() * F.tail<3>();
+  const Vec3 m = T.topLeftCorner<3, 3>() * F.head<3>();
   Wrench out;
-  out.head<3>() = R * F.head<3>() + translation(T).cross(f);
+  out.head<3>() = m + p.cross(f);
   out.tail<3>() = f;
   return out;
 }
 
 // ad_V W.
-inline Twist ad_apply(const Twist& V, const Twist& W) {
+EXC_HOT_INLINE Twist ad_apply(const Twist& V, const Twist& W) {
+  const Vec3 vw = V.head<3>(), vv = V.tail<3>(), ww = W.head<3>(), wv = W.tail<3>();
   Twist out;
-  out.head<3>() = V.head<3>().cross(W.head<3>());
-  out.tail<3>() = V.tail<3>().cross(W.head<3>()) + V.head<3>().cross(W.tail<3>());
+  out.head<3>() = vw.cross(ww);
+  out.tail<3>() = vv.cross(ww) + vw.cross(wv);
   return out;
 }
 
 // ad*_V F = ad_V^T F.
-inline Wrench ad_dual_apply(const Twist& V, const Wrench& F) {
+EXC_HOT_INLINE Wrench ad_dual_apply(const Twist& V, const Wrench& F) {
+  const Vec3 vw = V.head<3>(), vv = V.tail<3>(), fm = F.head<3>(), ff = F.tail<3>();
   Wrench out;
-  out.head<3>() = -V.head<3>().cross(F.head<3>()) - V.tail<3>().cross(F.tail<3>());
-  out.tail<3>() = -V.head<3>().cross(F.tail<3>());
+  out.head<3>() = fm.cross(vw) + ff.cross(vv);
+  out.tail<3>() = ff.cross(vw);
   return out;
 }
 

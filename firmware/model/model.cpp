@@ -78,6 +78,8 @@ Workspace::Workspace(const Model& model) {
     F[i].setZero();
   }
   phi.fill(0.0);
+  cos_phi.fill(1.0);
+  sin_phi.fill(0.0);
   omega.fill(0.0);
   alpha.fill(0.0);
   for (int i = 0; i < kNumJoints; ++i) {

@@ -11,13 +11,14 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
   ws.qd = qd;
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
-    ws.f_parent[i] = model.home[i] * exp_se3(model.screw[i], q[i]);  // eq. 1: f = M exp([S] q)
+    // eq. 1: f = M exp([S] q), with the closed form for a revolute or prismatic screw.
+    ws.f_parent[i] = compose(model.home[i], joint_motion(model.screw[i], q[i], model.prismatic[i]));
     const Twist S_qd = model.screw[i] * qd[i];
     if (p < 0) {
       ws.X_Wi[i] = ws.f_parent[i];
       ws.V[i] = S_qd;  // the base does not move
     } else {
-      ws.X_Wi[i] = ws.X_Wi[p] * ws.f_parent[i];
+      ws.X_Wi[i] = compose(ws.X_Wi[p], ws.f_parent[i]);
       ws.V[i] = Ad_inv_apply(ws.f_parent[i], ws.V[p]) + S_qd;  // eq. 1, velocity
     }
   }
@@ -59,21 +60,34 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
 template <int N>
 void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Matrix<double, 12, N>& A,
                         Eigen::Matrix<double, 12, N>& out) {
+  // The passes of tree_inverse_dynamics with V = 0 and no gravity, on N columns at once; the
+  // transforms act on 3 x N blocks (angular rows 0-2, linear rows 3-5).
   using Block = Eigen::Matrix<double, 6, N>;
   std::array<Block, kNumJoints> acc, force;
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
-    acc[i] = model.screw[i] * A.row(i);
+    acc[i].noalias() = model.screw[i] * A.row(i);
     if (p >= 0) {
-      for (int c = 0; c < N; ++c) acc[i].col(c) += Ad_inv_apply(ws.f_parent[i], acc[p].col(c));
+      const auto R = ws.f_parent[i].template topLeftCorner<3, 3>();
+      const Mat3 P = skew(ws.f_parent[i].template topRightCorner<3, 1>());
+      // Ad_{f^-1}: (R^T w, R^T (v - [p] w))
+      acc[i].template topRows<3>().noalias() += R.transpose() * acc[p].template topRows<3>();
+      const Eigen::Matrix<double, 3, N> lin = acc[p].template bottomRows<3>() - P * acc[p].template topRows<3>();
+      acc[i].template bottomRows<3>().noalias() += R.transpose() * lin;
     }
-    force[i] = model.inertia[i] * acc[i];
+    force[i].noalias() = model.inertia[i] * acc[i];
   }
   for (int i = kNumJoints - 1; i >= 0; --i) {
-    out.row(i) = model.screw[i].transpose() * force[i];
+    out.row(i).noalias() = model.screw[i].transpose() * force[i];
     const int p = model.parent[i];
     if (p >= 0) {
-      for (int c = 0; c < N; ++c) force[p].col(c) += Ad_inv_dual_apply(ws.f_parent[i], force[i].col(c));
+      const auto R = ws.f_parent[i].template topLeftCorner<3, 3>();
+      const Mat3 P = skew(ws.f_parent[i].template topRightCorner<3, 1>());
+      // Ad*_{f^-1}: (R m + [p] R f, R f)
+      const Eigen::Matrix<double, 3, N> f = R * force[i].template bottomRows<3>();
+      force[p].template topRows<3>().noalias() += R * force[i].template topRows<3>();
+      force[p].template topRows<3>().noalias() += P * f;
+      force[p].template bottomRows<3>() += f;
     }
   }
 }

@@ -38,12 +38,15 @@ struct Workspace {
 
   // Planar front kinematics in the swing plane (front_kinematics.hpp): absolute link angles,
   // angular rates, origins and their derivatives, per tree joint (entry 0, the swing, stays zero).
-  std::array<double, kNumJoints> phi{}, omega{}, alpha{};
+  std::array<double, kNumJoints> phi{}, cos_phi{}, sin_phi{}, omega{}, alpha{};
   std::array<Vec2, kNumJoints> origin, origin_d, origin_dd;
   Vec8 Hd_qd = Vec8::Zero();                    // Hd qd: cut-pin relative acceleration at qdd = 0
   Eigen::Matrix<double, 2, 12> J_tip_tree = Eigen::Matrix<double, 2, 12>::Zero();  // d rho / d q
   Vec2 tip_acc_tree = Vec2::Zero();             // rho acceleration at qdd = 0 (tree)
-  Eigen::PartialPivLU<Mat8> lu_Hp;              // factor of H_p, reused by Psi, gamma and F_c
+  // H_p^-1 at a closed configuration. There H_p is block diagonal in kPassiveJoints order (boom
+  // loop, arm loop, bucket four-bar): the links common to both sides of a cut cancel.
+  Mat8 Hp_inv = Mat8::Zero();
+  Eigen::PartialPivLU<Mat8> lu_Hp;              // full factor of H_p (Newton loop closure)
 };
 
 }  // namespace exc
