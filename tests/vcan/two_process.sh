@@ -76,6 +76,9 @@ if [ "$inside" = 0 ]; then
   mkdir -p "$work" || exit 2
   work=$(cd "$work" && pwd -P)
   self=$(cd "$(dirname "$0")" && pwd -P)/$(basename "$0")
+  # Absolute paths: the scenarios run in the work directory.
+  plant=$(realpath "$plant") firmware=$(realpath "$firmware") sim=$(realpath "$sim")
+  capture_check=$(realpath "$capture_check") scene=$(realpath "$scene")
   exec "$vcan_vm" --timeout "$timeout_s" --share "$work" -- "$self" --inside \
     --plant "$plant" --firmware "$firmware" --sim "$sim" --capture-check "$capture_check" \
     --scene "$scene" --work "$work" --duration "$duration" --watchdog-cycles "$watchdog_cycles" --scenario "$scenario"
@@ -231,6 +234,9 @@ scenario_kill_firmware() {
 }
 
 current=setup
+# The programs may write defaults (telemetry logs, out/) relative to the working directory: the
+# work directory is the one place the VM can write that the host sees.
+cd "$work" || { fail "cannot enter $work"; exit 1; }
 command -v candump > /dev/null || { fail "candump not found: install the Debian package can-utils"; exit 1; }
 case $scenario in
   all) scenario_run; note "done at ${SECONDS} s"; scenario_kill_plant; note "done at ${SECONDS} s"; scenario_kill_firmware; note "done at ${SECONDS} s" ;;
