@@ -20,7 +20,7 @@ endif()
 # becomes its own ctest test, named exactly as the case (names start with the component:
 # "hal/codec rejects stale counter"), so `ctest -R ^hal` runs one area.
 function(exc_add_doctest target)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;ENV" ${ARGN})
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;ENV;PROPERTIES" ${ARGN})
   add_executable(${target} ${ARG_SOURCES})
   target_link_libraries(${target} PRIVATE doctest::doctest exc_test_support ${ARG_LIBS})
   target_compile_definitions(${target} PRIVATE
@@ -33,5 +33,6 @@ function(exc_add_doctest target)
   if(ARG_ENV)
     list(APPEND _props ENVIRONMENT "${ARG_ENV}")
   endif()
+  list(APPEND _props ${ARG_PROPERTIES})
   doctest_discover_tests(${target} PROPERTIES ${_props})
 endfunction()
