@@ -36,17 +36,19 @@ class Section {
  public:
   Section(const std::string& file, const std::string& prefix, const YAML::Node& node)
       : file_(file), prefix_(prefix), node_(node) {
-    if (node_ && !node_.IsMap()) fail("", "must be a mapping");
+    if (present() && !node_.IsMap()) fail("", "must be a mapping");
   }
 
-  bool has(const char* key) const { return node_ && node_[key]; }
+  // An absent or empty section ("checks:" with nothing after it) takes every default.
+  bool present() const { return node_.IsDefined() && !node_.IsNull(); }
+  bool has(const char* key) const { return present() && node_[key]; }
   std::string field(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
   [[noreturn]] void fail(const std::string& key, const std::string& reason) const {
     throw SceneError(file_, key.empty() ? prefix_ : field(key), reason);
   }
 
   void only(std::initializer_list<const char*> allowed) const {
-    if (!node_) return;
+    if (!present()) return;
     for (const auto& kv : node_) {
       const std::string key = kv.first.as<std::string>();
       bool ok = false;
