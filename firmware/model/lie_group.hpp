@@ -69,8 +69,13 @@ inline SE3 compose(const SE3& A, const SE3& B) {
 inline SE3 joint_motion(const Twist& S, double q, bool prismatic) {
   if (prismatic) return translation_se3(S.tail<3>() * q);
   const Vec3 w = S.head<3>();
-  const double s = std::sin(q), c = std::cos(q);
-  return make_se3(c * Mat3::Identity() + s * skew(w) + (1 - c) * w * w.transpose(), Vec3::Zero());
+  const double s = std::sin(q), c = std::cos(q), k = 1 - c;
+  SE3 T;
+  T << c + k * w.x() * w.x(), k * w.x() * w.y() - s * w.z(), k * w.x() * w.z() + s * w.y(), 0,
+      k * w.x() * w.y() + s * w.z(), c + k * w.y() * w.y(), k * w.y() * w.z() - s * w.x(), 0,
+      k * w.x() * w.z() - s * w.y(), k * w.y() * w.z() + s * w.x(), c + k * w.z() * w.z(), 0,
+      0, 0, 0, 1;
+  return T;
 }
 
 // Ad_T (6x6): maps a twist in frame B to frame A for T = X_AB.

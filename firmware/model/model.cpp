@@ -26,6 +26,7 @@ Model build_model(const Machine& machine) {
     m.home[i] = translation_se3(origin_in_parent);
     m.screw[i] = screw;
     m.prismatic[i] = prismatic;
+    m.home_is_translation[i] = true;
   };
   const Vec3 zero = Vec3::Zero();
   set(kSwing, -1, Vec3(0, 0, k.swing_height), about_z, false);

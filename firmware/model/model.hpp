@@ -17,6 +17,7 @@ struct Model {
   std::array<SE3, kNumJoints> home;        // M_i: parent frame -> frame i at q_i = 0
   std::array<Twist, kNumJoints> screw;     // S_i in frame i
   std::array<bool, kNumJoints> prismatic;
+  std::array<bool, kNumJoints> home_is_translation;  // M_i has no rotation (true for this machine)
   std::array<Mat6, kNumJoints> inertia;    // J_i about the frame origin, (w, v) ordering
   std::array<LoopCut, kNumLoops> loops;
   Vec3 tip_in_bucket;                      // T in the bucket frame

@@ -12,7 +12,12 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
     // eq. 1: f = M exp([S] q), with the closed form for a revolute or prismatic screw.
-    ws.f_parent[i] = compose(model.home[i], joint_motion(model.screw[i], q[i], model.prismatic[i]));
+    if (model.home_is_translation[i]) {
+      ws.f_parent[i] = joint_motion(model.screw[i], q[i], model.prismatic[i]);
+      ws.f_parent[i].topRightCorner<3, 1>() += model.home[i].topRightCorner<3, 1>();
+    } else {
+      ws.f_parent[i] = compose(model.home[i], joint_motion(model.screw[i], q[i], model.prismatic[i]));
+    }
     const Twist S_qd = model.screw[i] * qd[i];
     if (p < 0) {
       ws.X_Wi[i] = ws.f_parent[i];
