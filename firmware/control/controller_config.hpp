@@ -27,10 +27,14 @@ struct ControllerConfig {
   // Order: swing (rad), boom, arm, bucket (m).
   PidGains gains = default_gains();
 
-  // Adaptive law (eqs. 21-28): Q of A^T P + P A + Q = 0, diagonal, x = [e; ed] order.
-  Vec8 lyapunov_q = (Vec8() << 1, 1, 1, 1, 1, 1, 1, 1).finished();
-  // Adaptation rates Gamma^-1 = diag(rate); Theta = [M_x B_x K_x M_z B_z K_z].
-  Vec6 adaptation_rate = (Vec6() << 2e7, 2e10, 1e12, 2e7, 2e10, 1e12).finished();
+  // Adaptive law (eqs. 21-28): Q of A^T P + P A + Q = 0, diagonal, x = [e; ed] order. Position
+  // weights ~kp make B^T P x lean on e (less on the filtered, lagging ed). Per joint the weights
+  // offset the inverse-inertia scaling of Phi = M_a^-1 Y: the light bucket would otherwise dominate
+  // the update and the heavy arm learn slowly (tuned on the dig scene: docs/control.md).
+  Vec8 lyapunov_q = (Vec8() << 64, 64, 640, 6.4, 1, 1, 10, 0.1).finished();
+  // Adaptation rates Gamma^-1 = diag(rate); Theta = [M_x B_x K_x M_z B_z K_z]. Scaled so that each
+  // column of Y (rhodd ~0.5 m/s^2, rhod ~0.5 m/s, rho - rho_env ~0.1 m) adapts at a similar pace.
+  Vec6 adaptation_rate = (Vec6() << 6e7, 6e10, 3e12, 6e7, 6e10, 3e12).finished();
   // Physical bounds of the soil parameters (machine.md): M 50..500 kg, B 1e3..3e4 N s/m,
   // K 1e4..1e6 N/m; and the initial estimate.
   Vec6 theta_min = (Vec6() << 50, 1e3, 1e4, 50, 1e3, 1e4).finished();
@@ -39,9 +43,10 @@ struct ControllerConfig {
   RegressorAcceleration regressor_acceleration = RegressorAcceleration::filtered;
 
   // Slotine-Li: s = ed + lambda e; tau = ... - kd s (kd in 1/s, scaled by M_a: see slotine_li.hpp).
-  Vec4 sl_lambda = Vec4::Constant(20);
-  Vec4 sl_kd = Vec4::Constant(20);
-  Vec6 sl_adaptation_rate = (Vec6() << 1e3, 1e5, 1e7, 1e3, 1e5, 1e7).finished();
+  // Same error bandwidth as the computed-torque laws: kv = lambda + kd, kp = lambda kd.
+  Vec4 sl_lambda = Vec4::Constant(8);
+  Vec4 sl_kd = Vec4::Constant(8);
+  Vec6 sl_adaptation_rate = (Vec6() << 3e3, 3e5, 3e7, 3e3, 3e5, 3e7).finished();
 
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop
@@ -49,9 +54,11 @@ struct ControllerConfig {
 
   static PidGains default_gains() {
     PidGains g;
-    g.kp = Vec4::Constant(400);   // 1/s^2: omega_n = 20 rad/s
-    g.kv = Vec4::Constant(40);    // 1/s:   critically damped
-    g.ki = Vec4::Constant(1000);  // 1/s^3: kv kp = 16000 > ki, stable
+    // omega_n = 8 rad/s (1.3 Hz), critically damped: below the oil-column frequencies of a 20 t
+    // machine (1.5-6 Hz, machine.md), so the same gains suit a scene with hydraulics.
+    g.kp = Vec4::Constant(64);    // 1/s^2
+    g.kv = Vec4::Constant(16);    // 1/s
+    g.ki = Vec4::Constant(100);   // 1/s^3: kv kp = 1024 > ki, stable (Routh)
     g.integral_limit = Vec4::Constant(0.05);
     return g;
   }

@@ -19,15 +19,16 @@ task:
     - {t: 10.0, x: 6.4, z: 0.8,   pitch_deg: 35}
 )";
 
-// Free motion of every joint (the paper's 5.1), inside the strokes, tip well above the ground.
+// Free motion of every joint (the paper's 5.1), inside the strokes, tip well above the ground,
+// slow enough for the swing torque limit (the swing inertia is ~1.5e5 kg m^2).
 inline const char* kFreeMotionTask = R"(
 task:
   type: joint_waypoints
   waypoints:
     - {t: 0.0, q: [0.0, 2.45, 2.40, 2.10]}
-    - {t: 2.0, q: [0.4, 2.60, 2.30, 1.95]}
-    - {t: 4.0, q: [0.1, 2.50, 2.55, 2.20]}
-    - {t: 6.0, q: [-0.3, 2.40, 2.45, 2.00]}
+    - {t: 2.0, q: [0.2, 2.60, 2.30, 1.95]}
+    - {t: 4.0, q: [0.05, 2.50, 2.55, 2.20]}
+    - {t: 6.0, q: [-0.15, 2.40, 2.45, 2.00]}
     - {t: 8.0, q: [0.0, 2.45, 2.40, 2.10]}
 )";
 

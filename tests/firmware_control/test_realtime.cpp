@@ -2,6 +2,7 @@
 #include <time.h>
 
 #include <chrono>
+#include <string>
 
 #include "allocation_counter.hpp"
 #include "control/perf_counter.hpp"
@@ -70,7 +71,7 @@ TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, 
       }
       allocations = counter.count();
     }
-    MESSAGE(to_string(kind) << ": " << steps << " steps, allocations = " << allocations);
+    MESSAGE(std::string(to_string(kind)) << ": " << steps << " steps, allocations = " << allocations);
     CHECK(allocations == 0);
     CHECK(perf.count() == static_cast<std::uint64_t>(steps));
   }

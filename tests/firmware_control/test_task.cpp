@@ -35,7 +35,7 @@ TEST_CASE("firmware/task joint waypoints parse into a spline through them") {
   CHECK(task.end_time() == 8.0);
   Vec4 q, qd, qdd;
   task.trajectory.evaluate(2.0, q, qd, qdd);
-  CHECK((q - Vec4(0.4, 2.60, 2.30, 1.95)).norm() < 1e-12);
+  CHECK((q - Vec4(0.2, 2.60, 2.30, 1.95)).norm() < 1e-12);
 }
 
 TEST_CASE("firmware/task dig path: the tip follows the given poses through the model (sub-mm)") {
