@@ -1,0 +1,255 @@
+#include "bench_runs.hpp"
+
+#include <time.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "app/firmware_node.hpp"
+#include "hal/memory_bus.hpp"
+#include "model/closed_chain.hpp"
+#include "plant_node.hpp"
+#include "sim_plant/plant.hpp"
+
+namespace exc::bench {
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// How many plant cycles make one profile hold (both are multiples of the step).
+int cycles_per_hold(double cycle) { return static_cast<int>(std::lround(kProfileHold / cycle)); }
+
+}  // namespace
+
+BenchScene load_bench_scene(const std::string& path, double start, double horizon) {
+  BenchScene b;
+  b.scene = plant::load_scene(path);
+  if (!b.scene.has_task) throw std::runtime_error(path + ": field 'task' is missing: the bench needs the task");
+  b.task = control::load_task(path, b.scene.machine);
+  b.controller = control::load_controller_config(path);
+  b.name = b.scene.name;
+  b.start = start;
+  b.horizon = horizon;
+  return b;
+}
+
+EffortProfile effort_profile(const BenchScene& s, double speed) {
+  const Model model = build_model(s.scene.machine);
+  Workspace ws(model);
+  EffortProfile p;
+  Vec4 q, qd, qdd;
+  s.task.trajectory.evaluate(s.task.start_time() + s.start, q, qd, qdd);
+  p.q_a0 = q;
+  p.qd_a0 = qd * speed;
+  const int n = static_cast<int>(std::lround(s.horizon / kProfileHold));
+  for (int k = 0; k < n; ++k) {
+    // The effort of the interval is the feed-forward at its midpoint (a fair zero-order hold).
+    s.task.trajectory.evaluate(s.task.start_time() + s.start + speed * (k + 0.5) * kProfileHold, q, qd, qdd);
+    qd *= speed;
+    qdd *= speed * speed;
+    const ModelReport r = update_closed_chain(model, ws, q, qd);
+    if (!r.ok()) throw std::runtime_error(s.name + ": the task's trajectory leaves the mechanism's assembly");
+    Vec4 tau;
+    inverse_dynamics(model, ws, qdd, Vec2::Zero(), tau);
+    p.tau.push_back(tau);
+  }
+  return p;
+}
+
+OpenLoopResult run_open_loop(const BenchScene& s, const EffortProfile& profile, const OpenLoopSettings& settings,
+                             bool record_states) {
+  plant::Scene scene = s.scene;
+  scene.integrator = settings.integrator;
+  const double h = settings.integrator.step;
+  scene.cycle = h > 1e-3 ? h : 1e-3;
+  scene.q_a0 = profile.q_a0;
+  scene.qd_a0 = profile.qd_a0;
+  scene.soil.stiffness *= settings.soil_stiffness_scale;
+  scene.soil.damping *= std::sqrt(settings.soil_stiffness_scale);  // keeps the soil's damping ratio
+  scene.checks.constraint_tolerance = settings.constraint_tolerance;
+  if (!settings.plant_energy_check) {
+    scene.checks.energy_tolerance = 1e12;
+    scene.checks.energy_relative_tolerance = 1e6;
+  }
+  scene.actuators.fidelity = plant::ActuatorFidelity::ideal;
+  scene.sensors.position_noise.setZero();
+  scene.sensors.velocity_noise.setZero();
+  plant::Plant plant(scene);
+
+  OpenLoopResult r;
+  const int per_hold = cycles_per_hold(scene.cycle);
+  r.tip.reserve(profile.tau.size() + 1);
+  r.tip.push_back(plant.state().tip_world);
+  if (record_states) {
+    r.q.push_back(plant.state().q);
+    r.qd.push_back(plant.state().qd);
+  }
+  std::vector<double> step_us;
+  step_us.reserve(std::min<std::size_t>(profile.tau.size() * static_cast<std::size_t>(per_hold), 200000));
+  plant::ActuatorCommand command;
+  command.mode = plant::ActuatorCommand::effort;
+  const double cpu0 = thread_cpu_seconds();
+  for (std::size_t k = 0; k < profile.tau.size() && r.ok; ++k) {
+    command.value = profile.tau[k];
+    for (int c = 0; c < per_hold; ++c) {
+      const auto t0 = std::chrono::steady_clock::now();
+      const plant::PlantStatus st = plant.step(command);
+      const auto t1 = std::chrono::steady_clock::now();
+      if (step_us.size() < step_us.capacity())
+        step_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+      if (!st.ok()) {
+        r.ok = false;
+        r.failure = st.text();
+        break;
+      }
+      r.max_constraint_residual = std::max(r.max_constraint_residual, plant.state().constraint_residual);
+      r.max_energy_error = std::max(r.max_energy_error, std::abs(plant.state().energy_error));
+    }
+    if (!r.ok) break;
+    r.tip.push_back(plant.state().tip_world);
+    r.effort.push_back(plant.state().effort);
+    if (record_states) {
+      r.q.push_back(plant.state().q);
+      r.qd.push_back(plant.state().qd);
+    }
+  }
+  r.cpu_seconds = thread_cpu_seconds() - cpu0;
+  r.simulated = plant.state().time;
+  r.step_median_us = median(step_us);
+  return r;
+}
+
+double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+  const std::size_t n = std::min(a.size(), b.size());
+  if (n == 0) return std::numeric_limits<double>::infinity();
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) sum += (a[i] - b[i]).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(n));
+}
+
+namespace {
+
+// The bus is stamped with simulated time (as in excavator-sim), so runs are deterministic.
+struct SimClock {
+  std::int64_t now_ns = 0;
+  static std::int64_t read(void* self) { return static_cast<SimClock*>(self)->now_ns; }
+};
+
+constexpr std::array<int, 6> kCylinderBodies = {kBoomBarrel, kBoomRod, kArmBarrel, kArmRod, kBucketBarrel, kBucketRod};
+
+}  // namespace
+
+ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v) {
+  plant::Scene scene = s.scene;
+  scene.actuators.fidelity = v.fidelity;
+  if (!v.soil) {
+    scene.soil = plant::SoilParameters{};
+    scene.soil_preset = plant::SoilPreset::none;
+  }
+  if (v.massless_cylinders)
+    for (int k : kCylinderBodies) {
+      scene.machine.bodies[k].mass *= 1e-3;
+      scene.machine.bodies[k].inertia *= 1e-3;
+    }
+  scene.sensors.position_noise = Vec4::Constant(v.position_noise);
+  scene.sensors.latency_cycles = v.delay_cycles;
+  // The dig scene's file leaves the initial state to the task: start where the task starts.
+  Vec4 q0, qd0, qdd0;
+  s.task.trajectory.evaluate(s.task.start_time(), q0, qd0, qdd0);
+  scene.q_a0 = q0;
+  scene.qd_a0 = qd0;
+  plant::Plant plant(scene);
+
+  // The firmware's model: the full machine, with its masses off by the given error.
+  Machine fw_machine = s.scene.machine;
+  for (BodyInertia& b : fw_machine.bodies) {
+    b.mass *= 1 + v.model_mass_error;
+    b.inertia *= 1 + v.model_mass_error;
+  }
+  const Model fw_model = build_model(fw_machine);
+
+  control::ControllerConfig cc = s.controller;
+  const double g = v.gain_scale;
+  cc.gains.kp *= g * g;
+  cc.gains.kv *= g;
+  cc.gains.ki *= g * g * g;
+  cc.sl_lambda *= g;
+  cc.sl_kd *= g;
+  cc.adaptation_rate *= v.adaptation_scale;
+  cc.sl_adaptation_rate *= v.adaptation_scale;
+
+  SimClock clock;
+  hal::MemoryBusHub hub(&SimClock::read, &clock);
+  hal::MemoryBusNode* firmware_bus = hub.attach();
+  hal::MemoryBusNode* plant_bus = hub.attach();
+  hal::FirmwareCanPort firmware_port(*firmware_bus);
+  hal::PlantCanPort plant_port(*plant_bus);
+  app::FirmwareNodeConfig fc;
+  fc.kind = v.controller;
+  fc.controller = cc;
+  fc.terrain_height = scene.terrain.height;
+  app::FirmwareNode firmware(fw_model, s.task, fc, firmware_port, nullptr);
+  app::PlantNode plant_node(plant, plant_port, nullptr);
+
+  ClosedLoopResult r;
+  const double duration = v.duration > 0 ? v.duration : scene.duration;
+  const auto cycles = static_cast<std::int64_t>(std::llround(duration / scene.cycle));
+  const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
+  const int per_hold = cycles_per_hold(scene.cycle);
+  double sum_sq[4] = {0, 0, 0, 0};
+  std::int64_t samples = 0;
+  const double cpu0 = thread_cpu_seconds();
+  for (std::int64_t k = 0; k < cycles; ++k) {
+    clock.now_ns = k * period_ns;
+    firmware.begin_cycle();
+    plant_node.poll();
+    firmware.end_cycle();
+    if (plant_node.failed()) {
+      r.ok = false;
+      r.failure = std::string("plant stopped: ") + plant.status().text();
+      break;
+    }
+    if (firmware.safe_stops() > 0) {
+      r.ok = false;
+      r.failure = "the firmware went to its safe state (" + std::string(control::to_string(firmware.mode())) + ")";
+      break;
+    }
+    if (firmware.tracking()) {
+      const Vec4 e = plant.state().q_a - firmware.q_desired();
+      for (int j = 0; j < 4; ++j) {
+        sum_sq[j] += e[j] * e[j];
+        r.tracking_max = std::max(r.tracking_max, std::abs(e[j]));
+      }
+      ++samples;
+    }
+    if ((k + 1) % per_hold == 0) {
+      r.tip.push_back(plant.state().tip_world);
+      r.effort.push_back(plant.state().effort);
+    }
+  }
+  r.cpu_seconds = thread_cpu_seconds() - cpu0;
+  r.simulated = plant.state().time;
+  for (int j = 0; j < 4; ++j) r.tracking_rms[j] = samples ? std::sqrt(sum_sq[j] / static_cast<double>(samples)) : 0;
+  if (r.ok && samples == 0) {
+    r.ok = false;
+    r.failure = "the firmware never tracked";
+  }
+  return r;
+}
+
+}  // namespace exc::bench

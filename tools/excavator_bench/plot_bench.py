@@ -1,0 +1,163 @@
+#!/usr/bin/python3
+"""Plots the CSV files of excavator-bench (matplotlib, Agg): one PNG per chart.
+
+usage: plot_bench.py OUT_DIR     (reads OUT_DIR/*.csv, writes OUT_DIR/*.png)
+"""
+import csv
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def rows(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def num(x):
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        return math.nan
+    return v
+
+
+def work_precision(out):
+    data = rows(os.path.join(out, "work_precision.csv"))
+    scenes = sorted({r["scene"] for r in data})
+    metrics = [("tip_rms_m", "tip position RMS (m)"), ("constraint_residual_m", "constraint residual max (m)"),
+               ("energy_drift_J", "energy drift max (J)")]
+    fig, axes = plt.subplots(len(scenes), len(metrics), figsize=(6 * len(metrics), 4.8 * len(scenes)), squeeze=False)
+    for i, scene in enumerate(scenes):
+        for j, (key, label) in enumerate(metrics):
+            ax = axes[i][j]
+            for method in sorted({r["method"] for r in data if r["scene"] == scene}):
+                pts = [(num(r["cpu_s_per_sim_s"]), num(r[key])) for r in data
+                       if r["scene"] == scene and r["method"] == method and r["ok"] == "1"]
+                pts = [(x, max(y, 1e-16)) for x, y in pts if x > 0 and not math.isnan(y)]
+                if pts:
+                    ax.loglog(*zip(*pts), marker="o", ms=3, label=method)
+            front = sorted((num(r["cpu_s_per_sim_s"]), num(r[key])) for r in data
+                           if r["scene"] == scene and r["pareto"] == "1" and key == "tip_rms_m")
+            if front:
+                ax.loglog(*zip(*front), "k--", lw=1.5, label="Pareto front")
+            ax.set_xlabel("CPU time per simulated second (s)")
+            ax.set_ylabel(label)
+            ax.set_title(f"{scene}: {label}")
+            ax.grid(True, which="both", alpha=0.3)
+        axes[i][0].legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "work_precision.png"), dpi=110)
+    plt.close(fig)
+
+
+def fidelity(out):
+    data = [r for r in rows(os.path.join(out, "fidelity.csv")) if r["ok"] == "1"]
+    scenes = sorted({r["scene"] for r in data})
+    fig, axes = plt.subplots(1, max(1, len(scenes)), figsize=(7 * max(1, len(scenes)), 5), squeeze=False)
+    for i, scene in enumerate(scenes):
+        ax = axes[0][i]
+        for r in (r for r in data if r["scene"] == scene):
+            x, y = num(r["cpu_s_per_sim_s"]), max(num(r["tip_rms_m"]), 1e-9)
+            style = "*" if r["recommended"] == "1" else ("o" if r["within_tolerance"] == "1" else "x")
+            ax.loglog([x], [y], style, ms=12 if style == "*" else 7,
+                      label=r["fidelity"] + (" (recommended)" if r["recommended"] == "1" else ""))
+        ax.axhline(0.01, color="grey", ls="--", lw=1, label="tolerance 10 mm")
+        ax.set_xlabel("CPU time per simulated second (s)")
+        ax.set_ylabel("tip path RMS against the most complete model (m)")
+        ax.set_title(f"fidelity: {scene}")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "fidelity.png"), dpi=110)
+    plt.close(fig)
+
+
+def stability(out):
+    data = rows(os.path.join(out, "stability_step.csv"))
+    axes_names = [("soil_stiffness_N_per_m", "soil stiffness K_t (N/m)"), ("joint_speed_factor", "joint speed factor")]
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5))
+    for ax, (axis, label) in zip(axes, axes_names):
+        for method in sorted({r["method"] for r in data}):
+            pts = [(num(r["value"]), num(r["largest_stable_step_s"])) for r in data
+                   if r["method"] == method and r["axis"] == axis]
+            pts = [(x, y if not math.isnan(y) else 1e-6) for x, y in pts]
+            if pts:
+                ax.semilogy(*zip(*pts), marker="o", ms=4, label=method)
+        if axis == "soil_stiffness_N_per_m":
+            ax.set_xscale("log")
+        ax.set_xlabel(label)
+        ax.set_ylabel("largest stable step (s); 1e-6 = none")
+        ax.set_title(f"largest stable step against {label}")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=6)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "stability_step.png"), dpi=110)
+    plt.close(fig)
+
+    data = rows(os.path.join(out, "stability_control.csv"))
+    axis_list = sorted({r["axis"] for r in data})
+    fig, axes = plt.subplots(1, len(axis_list), figsize=(4.5 * len(axis_list), 4.5), squeeze=False)
+    for ax, axis in zip(axes[0], axis_list):
+        for ctrl in sorted({r["controller"] for r in data}):
+            pts = [(num(r["value"]), num(r["tracking_rms_worst"]), r["ok"] == "1") for r in data
+                   if r["controller"] == ctrl and r["axis"] == axis]
+            if not pts:
+                continue
+            line, = ax.plot([p[0] for p in pts], [max(p[1], 1e-7) for p in pts], marker="o", ms=4, label=ctrl)
+            bad = [p for p in pts if not p[2]]
+            if bad:
+                ax.plot([p[0] for p in bad], [max(p[1], 1e-7) for p in bad], "x", color=line.get_color(), ms=12, mew=2)
+        ax.set_yscale("log")
+        if axis in ("gain_scale", "adaptation_scale"):
+            ax.set_xscale("log")
+        ax.set_xlabel(axis)
+        ax.set_ylabel("worst joint tracking RMS (m / rad); x = failed")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "stability_control.png"), dpi=110)
+    plt.close(fig)
+
+
+def peer(out):
+    data = rows(os.path.join(out, "peer_tip.csv"))
+    scenes = sorted({r["scene"] for r in data})
+    fig, axes = plt.subplots(1, max(1, len(scenes)), figsize=(7 * max(1, len(scenes)), 5), squeeze=False)
+    for ax, scene in zip(axes[0], scenes):
+        sel = [r for r in data if r["scene"] == scene]
+        for key, label, style in (("reference", "fine-step reference", "k-"), ("plant", "plant, Euler 1 ms", "b--"),
+                                  ("mujoco", "MuJoCo, Euler 1 ms", "r:")):
+            xs = [num(r[key + "_x"]) for r in sel]
+            zs = [num(r[key + "_z"]) for r in sel]
+            if any(not math.isnan(v) for v in xs):
+                ax.plot(xs, zs, style, label=label)
+        ax.set_xlabel("tip radius from the swing axis (m)")
+        ax.set_ylabel("tip height (m)")
+        ax.set_title(f"tip path, same efforts: {scene}")
+        ax.axis("equal")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, "peer.png"), dpi=110)
+    plt.close(fig)
+
+
+def main():
+    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+        print(__doc__.strip())
+        return 0 if len(sys.argv) == 2 else 2
+    out = sys.argv[1]
+    for chart in (work_precision, fidelity, stability, peer):
+        chart(out)
+    print(f"plots: {', '.join(n for n in sorted(os.listdir(out)) if n.endswith('.png'))} in {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
