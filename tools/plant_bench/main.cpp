@@ -1,0 +1,192 @@
+// excavator-plant-bench: the plant's figures (README "Plant figures"). Build without EXC_TEST_BUILD
+// (Release) for meaningful times.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "control/task.hpp"
+#include "model/closed_chain.hpp"
+#include "sim_plant/plant.hpp"
+
+using namespace exc;
+using namespace exc::plant;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+const IntegrationMethod kMethods[] = {IntegrationMethod::semi_implicit_euler, IntegrationMethod::rk4,
+                                      IntegrationMethod::implicit_midpoint};
+const Formulation kFormulations[] = {Formulation::independent, Formulation::augmented_baumgarte,
+                                     Formulation::augmented_projection};
+
+struct Stats {
+  double median = 0, p99 = 0, max = 0;
+};
+
+Stats stats(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  Stats s;
+  s.median = v[v.size() / 2];
+  s.p99 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.99 * v.size()))];
+  s.max = v.back();
+  return s;
+}
+
+// Joint-space computed torque on the scene's task (no soil compensation): what drives the dig scene
+// here, so that the plant's cost is measured on the real motion. Not the firmware's controller.
+struct TaskDriver {
+  control::Task task;
+  Model model;
+  Workspace ws;
+  TaskDriver(const std::string& path, const Machine& m) : task(control::load_task(path, m)), model(build_model(m)), ws(model) {}
+  Vec4 effort(double t, const PlantState& s) {
+    Vec4 q, qd, qdd;
+    task.trajectory.evaluate(std::min(t, task.end_time()), q, qd, qdd);
+    const Vec4 kp(400, 400, 400, 400), kd(40, 40, 40, 40);
+    const Vec4 a = qdd + kp.cwiseProduct(q - s.q_a) + kd.cwiseProduct(qd - s.qd_a);
+    Vec4 tau = Vec4::Zero();
+    if (update_closed_chain(model, ws, s.q_a, s.qd_a).ok()) inverse_dynamics(model, ws, a, Vec2::Zero(), tau);
+    return tau;
+  }
+};
+
+// The stiff-clay stability probe (as tests/plant/test_stability.cpp): the reference pose with the
+// tip 0.1 m deep, moving into the soil, efforts holding the weight, 2 s.
+bool stable_in_stiff_clay(const Scene& base, IntegrationMethod m, Formulation f, double h, std::string& why) {
+  Scene s = base;
+  s.integrator.method = m;
+  s.integrator.formulation = f;
+  s.integrator.step = h;
+  s.cycle = h;
+  s.q_a0 = Vec4(0.0, 2.4626, 2.3231, 2.1447);
+  s.qd_a0 = Vec4(0.05, -0.1, 0.05, -0.05);
+  s.terrain = Terrain{};
+  s.terrain.height = 1.93;
+  s.soil = soil_preset(SoilPreset::stiff_clay);
+  s.actuators.fidelity = ActuatorFidelity::ideal;
+  Plant p(s);
+  ActuatorCommand c;
+  c.value = p.hold_effort();
+  const long n = std::lround(2.0 / h);
+  for (long k = 0; k < n; ++k) {
+    const PlantStatus st = p.step(c);
+    if (!st.ok()) {
+      why = st.text();
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Plant figures: step time per integrator x formulation (dig scene, 1 kHz), the dig scene's "
+               "real-time factor, and the largest stable step per integrator in stiff clay.",
+               "excavator-plant-bench"};
+  std::string scene_path = std::string(EXC_SOURCE_DIR_BENCH) + "/scenes/dig.yaml";
+  int repeats = 3;
+  app.add_option("--scene", scene_path, "the dig scene (default: scenes/dig.yaml)");
+  app.add_option("--repeats", repeats, "runs of the dig scene for the real-time factor (best is reported)");
+  CLI11_PARSE(app, argc, argv);
+
+  Scene base;
+  try {
+    base = load_scene(scene_path);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "excavator-plant-bench: %s\n", e.what());
+    return 2;
+  }
+
+  std::printf("## Plant step time, dig scene at 1 kHz (step = cycle = 1 ms), per integrator x formulation\n\n");
+  std::printf("| method | formulation | median us | p99 us | max us | real-time factor | finished |\n|---|---|---|---|---|---|---|\n");
+  for (IntegrationMethod m : kMethods) {
+    for (Formulation f : kFormulations) {
+      Scene s = base;
+      s.integrator.method = m;
+      s.integrator.formulation = f;
+      TaskDriver driver(scene_path, s.machine);
+      Plant p(s);
+      std::vector<double> us;
+      const long n = std::lround(s.duration / s.cycle);
+      us.reserve(n);
+      bool ok = true;
+      ActuatorCommand c;
+      for (long k = 0; k < n && ok; ++k) {
+        c.value = driver.effort(p.state().time, p.state());
+        const auto a = Clock::now();
+        ok = p.step(c).ok();
+        us.push_back(std::chrono::duration<double, std::micro>(Clock::now() - a).count());
+      }
+      const Stats st = stats(us);
+      double total = 0;
+      for (double x : us) total += x;
+      std::printf("| %s | %s | %.2f | %.2f | %.1f | %.0fx | %s |\n", to_string(m), to_string(f), st.median, st.p99,
+                  st.max, p.state().time / (total * 1e-6), ok ? "yes" : p.status().text());
+    }
+  }
+
+  // Real-time factor of the scene as shipped (its own integrator), best of 'repeats'.
+  double best = 0, reanchors = 0, depth = 0, best_median = 1e9;
+  for (int r = 0; r < repeats; ++r) {
+    TaskDriver driver(scene_path, base.machine);
+    Plant p(base);
+    ActuatorCommand c;
+    double plant_s = 0;
+    const long n = std::lround(base.duration / base.cycle);
+    std::vector<double> us;
+    us.reserve(n);
+    for (long k = 0; k < n; ++k) {
+      c.value = driver.effort(p.state().time, p.state());
+      const auto a = Clock::now();
+      if (!p.step(c).ok()) break;
+      const double dt = std::chrono::duration<double>(Clock::now() - a).count();
+      plant_s += dt;
+      us.push_back(dt * 1e6);
+      depth = std::max(depth, p.state().depth);
+    }
+    best = std::max(best, p.state().time / plant_s);
+    best_median = std::min(best_median, stats(us).median);
+    reanchors = p.state().reanchor_count;
+  }
+  std::printf("\n## Dig scene as shipped (%s / %s, %g ms): real-time factor %.0fx over the whole run (1 s in %.2f ms), "
+              "%.0fx at the median step of %.2f us (target >= 200x: 1 s in 5 ms); deepest %.2f m, %g re-anchorings\n",
+              to_string(base.integrator.method), to_string(base.integrator.formulation), base.integrator.step * 1e3,
+              best, 1e3 / best, base.cycle * 1e6 / best_median, best_median, depth, reanchors);
+
+  std::printf("\n## Largest stable step in stiff clay (tip 0.1 m in, moving into it, 2 s; bisection)\n\n");
+  std::printf("| method | formulation | largest stable step ms | first failure |\n|---|---|---|---|\n");
+  for (IntegrationMethod m : kMethods) {
+    for (Formulation f : kFormulations) {
+      double lo = 0, hi = 0;
+      std::string why, why_hi;
+      for (double h = 1e-3; h <= 1.0; h *= 2) {
+        if (stable_in_stiff_clay(base, m, f, h, why)) {
+          lo = h;
+        } else {
+          hi = h;
+          why_hi = why;
+          break;
+        }
+      }
+      if (hi > 0 && lo > 0) {
+        for (int i = 0; i < 6; ++i) {
+          const double mid = std::sqrt(lo * hi);
+          if (stable_in_stiff_clay(base, m, f, mid, why)) lo = mid;
+          else {
+            hi = mid;
+            why_hi = why;
+          }
+        }
+      }
+      const std::string short_why = why_hi.empty() ? "none up to 1 s" : why_hi.substr(why_hi.find(": ") + 2, 70);
+      std::printf("| %s | %s | %.1f | %s |\n", to_string(m), to_string(f), lo * 1e3, short_why.c_str());
+    }
+  }
+  return 0;
+}
