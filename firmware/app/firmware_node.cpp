@@ -4,8 +4,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "app/can_stats_message.hpp"
 #include "control/make_controller.hpp"
-#include "exlcm/can_stats_t.hpp"
 #include "exlcm/command_t.hpp"
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/fault_t.hpp"
@@ -223,18 +223,7 @@ void FirmwareNode::publish_counters() {
   fill_timing(control_timing_, 2, utime, m);
   telemetry_->publish(telemetry::Channel::timing, m);
 
-  const hal::RxStats& rx = port_.rx_stats();
-  exlcm::can_stats_t cs{};
-  cs.utime = utime;
-  cs.node = 0;
-  cs.tx = static_cast<std::int64_t>(port_.tx_stats().frames_sent);
-  cs.rx_ok = static_cast<std::int64_t>(rx.ok);
-  cs.stale = static_cast<std::int64_t>(rx.stale);
-  cs.repeated = static_cast<std::int64_t>(rx.repeated);
-  cs.corrupt = static_cast<std::int64_t>(rx.corrupt);
-  cs.wrong_dlc = static_cast<std::int64_t>(rx.wrong_dlc);
-  cs.unknown = static_cast<std::int64_t>(rx.unknown_id);
-  cs.dropped = static_cast<std::int64_t>(port_.tx_stats().send_failed);
+  const exlcm::can_stats_t cs = can_stats_message(port_.rx_stats(), port_.tx_stats(), 0, utime);
   telemetry_->publish(telemetry::Channel::can_stats, cs);
 }
 

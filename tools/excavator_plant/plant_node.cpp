@@ -1,6 +1,6 @@
 #include "plant_node.hpp"
 
-#include "exlcm/can_stats_t.hpp"
+#include "app/can_stats_message.hpp"
 #include "exlcm/machine_state_t.hpp"
 #include "model/closed_chain.hpp"
 #include "telemetry/telemetry_publisher.hpp"
@@ -121,18 +121,8 @@ void PlantNode::publish_state() {
 
 void PlantNode::publish_counters() {
   if (telemetry_ == nullptr) return;
-  const hal::RxStats& rx = port_.rx_stats();
-  exlcm::can_stats_t cs{};
-  cs.utime = static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5);
-  cs.node = 1;
-  cs.tx = static_cast<std::int64_t>(port_.tx_stats().frames_sent);
-  cs.rx_ok = static_cast<std::int64_t>(rx.ok);
-  cs.stale = static_cast<std::int64_t>(rx.stale);
-  cs.repeated = static_cast<std::int64_t>(rx.repeated);
-  cs.corrupt = static_cast<std::int64_t>(rx.corrupt);
-  cs.wrong_dlc = static_cast<std::int64_t>(rx.wrong_dlc);
-  cs.unknown = static_cast<std::int64_t>(rx.unknown_id);
-  cs.dropped = static_cast<std::int64_t>(port_.tx_stats().send_failed);
+  const exlcm::can_stats_t cs =
+      can_stats_message(port_.rx_stats(), port_.tx_stats(), 1, static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5));
   telemetry_->publish(telemetry::Channel::can_stats, cs);
 }
 
