@@ -71,6 +71,8 @@ class FirmwareNode {
   // Desired and measured q_a of the last cycle (valid while tracking or holding).
   const Vec4& q_desired() const { return q_d_; }
   const hal::SensorState& sensors() const { return sensors_; }
+  // A complete, valid sensor set has arrived at least once.
+  bool has_sensors() const { return have_valid_; }
   const control::ControlOutput& last_output() const { return out_; }
   const hal::CommandState& last_command() const { return command_; }
   // Time of the control computation (estimate + trajectory + control law), and of the whole

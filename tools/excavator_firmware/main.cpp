@@ -47,6 +47,7 @@ int main(int argc, char** argv) {
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README)."};
   std::string iface, scene_path, controller = "adaptive", json_path, lcm_url;
   double duration = 0, sensor_timeout_ms = 250;
+  double startup_s = 60;
   bool realtime = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--scene", scene_path, "scene file (task, controller section, machine)")->required();
@@ -58,6 +59,9 @@ int main(int argc, char** argv) {
   app.add_option("--lcm", lcm_url, "publish telemetry to this LCM URL (default: none)");
   app.add_option("--sensor-timeout-ms", sensor_timeout_ms,
                  "lockstep: how long a cycle waits for the plant's sensor set (wall clock)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--startup-timeout", startup_s,
+                 "lockstep: how long the first cycle waits for the plant's first answer (s)")
       ->check(CLI::PositiveNumber);
   app.add_flag("--realtime", realtime, "run on absolute 1 ms deadlines instead of lockstep");
   CLI11_PARSE(app, argc, argv);
@@ -98,6 +102,7 @@ int main(int argc, char** argv) {
     const double cycle_s = bundle.controller.period;
     const auto cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : bundle.scene.duration) / cycle_s));
     const auto wait_ns = static_cast<std::int64_t>(realtime ? 0.8 * cycle_s * 1e9 : sensor_timeout_ms * 1e6);
+    const auto startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
     exc::hal::DeadlineSleeper sleeper(static_cast<std::int64_t>(std::llround(cycle_s * 1e9)));
     sleeper.start(exc::hal::monotonic_now_ns());
     std::printf("excavator-firmware: %s on %s, %lld cycles, %s\n", controller.c_str(), iface.c_str(),
@@ -106,7 +111,10 @@ int main(int argc, char** argv) {
     for (std::int64_t k = 0; k < cycles && !g_stop; ++k) {
       if (realtime) sleeper.wait_next();
       node.begin_cycle();
-      const std::int64_t deadline = exc::hal::monotonic_now_ns() + wait_ns;
+      // Until the plant has answered once, lockstep waits as long as start-up takes (a slow first
+      // cycle must not desynchronise the counters); afterwards the sensor timeout feeds the watchdog.
+      const std::int64_t wait = (realtime || node.has_sensors()) ? wait_ns : startup_wait_ns;
+      const std::int64_t deadline = exc::hal::monotonic_now_ns() + wait;
       while (!node.receive()) {
         const std::int64_t left = deadline - exc::hal::monotonic_now_ns();
         if (left <= 0) break;
