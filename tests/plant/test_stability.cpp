@@ -87,7 +87,7 @@ TEST_CASE("plant/stability limit of every integrator with stiff soil is found, r
   }
 }
 
-TEST_CASE("plant/a huge step in stiff clay is stopped with a message naming the integrator; 1 ms is stable") {
+TEST_CASE("plant/a huge step in stiff clay is stopped with a message naming the integrator, and 1 ms is stable") {
   test::SceneText t;
   t.terrain = "height: 1.93";
   t.soil = "preset: stiff_clay";
