@@ -76,7 +76,7 @@ TEST_CASE("plant/a failure report allocates nothing either") {
   CHECK(allocations == 0);
 }
 
-TEST_CASE("plant/end stop: ideal actuators report a cylinder driven through it; limited ones hold it") {
+TEST_CASE("plant/end stop: ideal actuators report a cylinder driven through it, limited ones hold it") {
   exc::plant::test::SceneText t;
   Plant ideal(t.scene());
   ActuatorCommand cmd;
