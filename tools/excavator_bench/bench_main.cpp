@@ -48,6 +48,8 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+constexpr int kBatch = 10;
+
 void progress(const char* format, const std::string& a, const std::string& b = "") {
   std::fprintf(stderr, format, a.c_str(), b.c_str());
   std::fflush(stderr);
@@ -157,6 +159,7 @@ struct PeerResult {
   double augmented_constraint_error = NAN;                                     // ours, augmented + Baumgarte
   double mujoco_step_us = NAN, mujoco_constraint_error = NAN, mujoco_tip_rms = NAN;
   double control_step_us = NAN, mujoco_inverse_us = NAN, inverse_dynamics_us = NAN;
+  double dynamics_step_us = NAN;  // the plant's integrator step alone (dynamics + integration)
   std::string mujoco_status = "not available, peer skipped";
   std::vector<Vec3> reference_tip, ours_tip, mujoco_tip;
 };
@@ -170,7 +173,7 @@ void time_controller(const BenchScene& s, const OpenLoopResult& run, PeerResult&
   std::vector<double> control_us, id_us;
   control::ControlInput in;
   in.soil.terrain_height = s.scene.terrain.height;
-  const int repeats = 20;
+  const int repeats = 2;
   for (int rep = 0; rep < repeats; ++rep)
     for (std::size_t k = 0; k < run.q.size(); ++k) {
       Vec4 q_d, qd_d, qdd_d;
@@ -184,20 +187,50 @@ void time_controller(const BenchScene& s, const OpenLoopResult& run, PeerResult&
       in.qd_d = qd_d;
       in.qdd_d = qdd_d;
       in.t = static_cast<double>(k) * kProfileHold;
-      auto t0 = std::chrono::steady_clock::now();
-      const control::ControlOutput o = controller->update(in);
-      auto t1 = std::chrono::steady_clock::now();
-      control_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
-      (void)o;
+      // Batches of kBatch calls in thread CPU time (the clock costs ~0.3 us a read).
+      double t0 = thread_cpu_seconds();
+      for (int b = 0; b < kBatch; ++b) {
+        in.t += 1e-3;
+        const control::ControlOutput o = controller->update(in);
+        (void)o;
+      }
+      control_us.push_back(1e6 * (thread_cpu_seconds() - t0) / kBatch);
       Vec4 tau;
-      t0 = std::chrono::steady_clock::now();
-      update_closed_chain(model, ws, in.q, in.qd);
-      inverse_dynamics(model, ws, qdd_d, Vec2::Zero(), tau);
-      t1 = std::chrono::steady_clock::now();
-      id_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+      t0 = thread_cpu_seconds();
+      for (int b = 0; b < kBatch; ++b) {
+        update_closed_chain(model, ws, in.q, in.qd);
+        inverse_dynamics(model, ws, qdd_d, Vec2::Zero(), tau);
+      }
+      id_us.push_back(1e6 * (thread_cpu_seconds() - t0) / kBatch);
     }
   out.control_step_us = median(control_us);
   out.inverse_dynamics_us = median(id_us);
+}
+
+// The integrator's step alone (forward dynamics + semi-implicit Euler, soil load, no sensors, energy
+// balance or checks): the part of the plant step that mj_step corresponds to.
+void time_dynamics_step(const BenchScene& s, const EffortProfile& profile, const OpenLoopResult& run, PeerResult& out) {
+  const Model model = build_model(s.scene.machine);
+  Workspace ws(model);
+  plant::Integrator integrator(model, settings_of(plant::IntegrationMethod::semi_implicit_euler,
+                                                  plant::Formulation::independent, 1e-3));
+  plant::SoilModel soil(s.scene.terrain, s.scene.soil);
+  std::vector<double> us;
+  for (std::size_t k = 0; k + 1 < run.q.size() && k < profile.tau.size(); ++k) {
+    plant::MechanicalState m;
+    m.q = run.q[k];
+    m.qd = run.qd[k];
+    for (int a = 0; a < kNumActive; ++a) {
+      m.q_a[a] = run.q[k][kActiveJoints[a]];
+      m.qd_a[a] = run.qd[k][kActiveJoints[a]];
+    }
+    integrator.invalidate_cache();
+    plant::Evaluation start;
+    const double t0 = thread_cpu_seconds();
+    for (int b = 0; b < kBatch; ++b) integrator.step(ws, soil, profile.tau[k], 1e-3, m, start);
+    us.push_back(1e6 * (thread_cpu_seconds() - t0) / kBatch);
+  }
+  out.dynamics_step_us = median(us);
 }
 
 #ifdef EXC_HAVE_MUJOCO
@@ -220,6 +253,8 @@ void run_mujoco(const BenchScene& s, const EffortProfile& profile, const OpenLoo
   plant::SoilModel soil(s.scene.terrain, s.scene.soil);
   const int per_hold = static_cast<int>(std::lround(kProfileHold / 1e-3));
   std::vector<double> step_us;
+  std::vector<Vec3> tip_forces;
+  tip_forces.reserve(profile.tau.size() * static_cast<std::size_t>(per_hold));
   out.mujoco_tip.push_back(peer->tip_world());
   double worst = peer->constraint_error();
   Vec2 rho_prev = Vec2::Zero(), rhod_prev = Vec2::Zero();
@@ -238,14 +273,13 @@ void run_mujoco(const BenchScene& s, const EffortProfile& profile, const OpenLoo
       const TipLoad load = soil.load(rho, rhod);
       const Vec2 f_soil = load.force + load.added_mass.cwiseProduct(rhodd);
       // The bucket feels -F_soil, in the swing plane.
-      peer->set_tip_force(Vec3(-std::cos(sw) * f_soil.x(), -std::sin(sw) * f_soil.x(), -f_soil.y()));
+      const Vec3 f_bucket(-std::cos(sw) * f_soil.x(), -std::sin(sw) * f_soil.x(), -f_soil.y());
+      peer->set_tip_force(f_bucket);
+      tip_forces.push_back(f_bucket);
       rho_prev = rho;
       rhod_prev = rhod;
       have_prev = true;
-      const auto t0 = std::chrono::steady_clock::now();
       peer->step();
-      const auto t1 = std::chrono::steady_clock::now();
-      step_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
       if (!peer->finite()) {
         ok = false;
         break;
@@ -258,18 +292,31 @@ void run_mujoco(const BenchScene& s, const EffortProfile& profile, const OpenLoo
     out.mujoco_tip.push_back(peer->tip_world());
   }
   if (!ok) out.mujoco_status = "diverged (non-finite state)";
+  // Step time: a second pass over the same efforts and soil forces with nothing but mj_step in the
+  // timed blocks (one clock read per hold interval; a read costs ~0.3 us).
+  peer->set_state(ours.q.front(), ours.qd.front());
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < profile.tau.size() && n < tip_forces.size(); ++k) {
+    peer->set_effort(profile.tau[k]);
+    const double block0 = thread_cpu_seconds();
+    int stepped = 0;
+    for (int c = 0; c < per_hold && n < tip_forces.size(); ++c, ++n, ++stepped) {
+      peer->set_tip_force(tip_forces[n]);
+      peer->step();
+    }
+    if (stepped > 0) step_us.push_back(1e6 * (thread_cpu_seconds() - block0) / stepped);
+  }
   out.mujoco_step_us = median(step_us);
   out.mujoco_constraint_error = worst;
   // mj_inverse on the states of our run, with the accelerations between them.
   std::vector<double> inverse_us;
   Vec12 tau;
-  for (int rep = 0; rep < 20; ++rep)
+  for (int rep = 0; rep < 2; ++rep)
     for (std::size_t k = 0; k + 1 < ours.q.size(); ++k) {
       const Vec12 qdd = (ours.qd[k + 1] - ours.qd[k]) / kProfileHold;
-      const auto t0 = std::chrono::steady_clock::now();
-      peer->inverse(ours.q[k], ours.qd[k], qdd, tau);
-      const auto t1 = std::chrono::steady_clock::now();
-      inverse_us.push_back(std::chrono::duration<double, std::micro>(t1 - t0).count());
+      const double t0 = thread_cpu_seconds();
+      for (int b = 0; b < kBatch; ++b) peer->inverse(ours.q[k], ours.qd[k], qdd, tau);
+      inverse_us.push_back(1e6 * (thread_cpu_seconds() - t0) / kBatch);
     }
   out.mujoco_inverse_us = median(inverse_us);
 }
@@ -295,6 +342,7 @@ std::vector<PeerResult> peer_comparison(const std::vector<BenchScene>& scenes,
     st.integrator.formulation = plant::Formulation::augmented_baumgarte;
     p.augmented_constraint_error = run_open_loop(s, profile, st).max_constraint_residual;
     time_controller(s, ours, p);
+    time_dynamics_step(s, profile, ours, p);
 #ifdef EXC_HAVE_MUJOCO
     progress("peer %s: MuJoCo (Euler, 1 ms)%s\n", s.name);
     run_mujoco(s, profile, ours, out_dir, p);
@@ -607,6 +655,7 @@ int run_bench(const Options& o) {
   j["mujoco_constraint_error"] = number_or_null(head.mujoco_constraint_error);
   j["control_step_us"] = number_or_null(head.control_step_us);
   j["mujoco_inverse_us"] = number_or_null(head.mujoco_inverse_us);
+  j["plant_dynamics_step_us"] = number_or_null(head.dynamics_step_us);
   j["mujoco"] = head.mujoco_status;
   j["step_speed_ratio"] = number_or_null(head.mujoco_step_us / head.plant_step_us);
   j["constraint_error_ratio"] = number_or_null(head.mujoco_constraint_error / std::max(head.constraint_error, 1e-16));
@@ -627,6 +676,7 @@ int run_bench(const Options& o) {
                            {"mujoco_tip_rms_m", number_or_null(p.mujoco_tip_rms)},
                            {"control_step_us", number_or_null(p.control_step_us)},
                            {"inverse_dynamics_us", number_or_null(p.inverse_dynamics_us)},
+                           {"plant_dynamics_step_us", number_or_null(p.dynamics_step_us)},
                            {"mujoco_inverse_us", number_or_null(p.mujoco_inverse_us)}});
   j["recommended_fidelity"] = json::object();
   for (const FidelityRow& r : fidelity)
@@ -648,11 +698,14 @@ int run_bench(const Options& o) {
                 p.mujoco_step_us, p.mujoco_constraint_error, p.mujoco_tip_rms, p.mujoco_inverse_us,
                 p.mujoco_status.c_str());
   }
+  for (const PeerResult& p : peers)
+    std::printf("%-12s %-8s %12.2f   (integrator step alone: dynamics + Euler, no sensors/checks; our inverse "
+                "dynamics %.2f us)\n", p.scene.c_str(), "plant", p.dynamics_step_us, p.inverse_dynamics_us);
   std::printf("ratios (free motion): mj_step / plant step = %.2f (target >= 2), constraint error MuJoCo / plant = "
-              "%.3g (target >= 100), mj_inverse / control step = %.2f (target > 1)\n",
+              "%.3g (target >= 100), mj_inverse / control step = %.2f (target > 1); mj_step / integrator step = %.2f\n",
               head.mujoco_step_us / head.plant_step_us,
               head.mujoco_constraint_error / std::max(head.constraint_error, 1e-16),
-              head.mujoco_inverse_us / head.control_step_us);
+              head.mujoco_inverse_us / head.control_step_us, head.mujoco_step_us / head.dynamics_step_us);
   std::printf("\nPareto front (work-precision, tip RMS against CPU per simulated second):\n");
   for (const WorkPoint& p : work)
     if (p.pareto)
