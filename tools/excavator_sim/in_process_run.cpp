@@ -12,6 +12,7 @@
 #include "app/firmware_node.hpp"
 #include "app/tracking_metrics.hpp"
 #include "hal/memory_bus.hpp"
+#include "model/model.hpp"
 #include "plant_node.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/lcm_output.hpp"
@@ -73,7 +74,18 @@ RunResult run_one(const SceneBundle& bundle, control::ControllerKind kind, const
   fc.terrain_height = bundle.scene.terrain.height;
   fc.theta_known = true;
   fc.theta_true = theta_of(bundle.scene.soil);
-  app::FirmwareNode firmware(plant.model(), bundle.task, fc, firmware_port, publisher.get());
+  // The controller's own model: the plant's, or one with wrong masses for the robustness runs.
+  std::unique_ptr<Model> wrong_model;
+  if (options.controller_mass_scale != 1.0) {
+    Machine m = plant.model().machine;
+    for (BodyInertia& b : m.bodies) {
+      b.mass *= options.controller_mass_scale;
+      b.inertia *= options.controller_mass_scale;
+    }
+    wrong_model = std::make_unique<Model>(build_model(m));
+  }
+  app::FirmwareNode firmware(wrong_model ? *wrong_model : plant.model(), bundle.task, fc, firmware_port,
+                             publisher.get());
   app::PlantNode plant_node(plant, plant_port, publisher.get());
 
   const double duration = options.duration_override > 0 ? options.duration_override : bundle.scene.duration;

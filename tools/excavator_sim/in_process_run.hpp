@@ -29,6 +29,9 @@ struct RunOptions {
   double duration_override = 0;          // s; 0: the scene's duration
   std::string lcm_url;                   // empty: no telemetry
   bool progress = true;
+  // Robustness: the firmware's model has every link's mass and inertia scaled by this factor while
+  // the plant keeps the true machine (1: exact model).
+  double controller_mass_scale = 1.0;
 };
 
 struct Timing {

@@ -1,0 +1,134 @@
+// excavator-sim end to end: the main job's JSON summary, the robustness table and the errors a user
+// sees, through the program itself (firmware and plant over the in-memory CAN bus).
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+  fs::path dir;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel).
+Run run_sim(const std::string& args) {
+  static int call = 0;
+  Run r;
+  r.dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("run_" + std::to_string(getpid()) + "_" + std::to_string(call++));
+  fs::remove_all(r.dir);
+  fs::create_directories(r.dir);
+  const std::string cmd = "cd '" + r.dir.string() + "' && " + EXC_SIM_TOOL + " " + args + " > out.txt 2> err.txt";
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = slurp(r.dir / "out.txt");
+  r.err = slurp(r.dir / "err.txt");
+  return r;
+}
+
+const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+const char* const kJoints[4] = {"swing", "boom", "arm", "bucket"};
+
+}  // namespace
+
+TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive beats PID 5x on arm and bucket, no heap in the loop") {
+  const Run r = run_sim("run " + kDig + " --no-report --quiet --json summary.json --out out");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(r.dir / "summary.json"));
+  for (const char* c : {"pid", "adaptive"}) {
+    REQUIRE(j.contains(c));
+    for (const char* joint : kJoints) {
+      const double rms = j[c]["rms_error"][joint].get<double>();
+      const double max = j[c]["max_error"][joint].get<double>();
+      CHECK(std::isfinite(rms));
+      CHECK(rms >= 0);
+      CHECK(max >= rms);  // a maximum is never below the RMS of the same samples
+    }
+  }
+  for (const char* joint : {"arm", "bucket"}) {
+    const double pid = j["pid"]["rms_error"][joint].get<double>();
+    const double adaptive = j["adaptive"]["rms_error"][joint].get<double>();
+    INFO(joint << ": PID " << pid << " m, adaptive " << adaptive << " m");
+    CHECK(pid >= 5 * adaptive);
+  }
+  CHECK(j["heap_allocations_in_loop"].get<long long>() == 0);
+  CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.0).epsilon(1e-3));
+  const double median = j["control_step_us"]["median"].get<double>();
+  CHECK(median > 0);
+  CHECK(j["control_step_us"]["p99"].get<double>() >= median);
+  CHECK(j["control_step_us"]["max"].get<double>() >= j["control_step_us"]["p99"].get<double>());
+  // The telemetry log was written next to the summary.
+  CHECK(fs::file_size(r.dir / "out" / "run.lcm") > 1000000);
+}
+
+TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better than PID on arm and bucket in every variant") {
+  const Run r = run_sim("robustness " + kDig + " --quiet --json robust.json");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const nlohmann::json j = nlohmann::json::parse(slurp(r.dir / "robust.json"));
+  const nlohmann::json& rows = j["robustness"];
+  REQUIRE(rows.size() == 7);
+  CHECK(rows[0]["variant"] == "nominal");
+  for (const nlohmann::json& row : rows) {
+    const std::string name = row["variant"].get<std::string>();
+    INFO("variant " << name);
+    CHECK(row["ok"].get<bool>());
+    for (const char* joint : {"arm", "bucket"}) {
+      const double pid = row["pid"]["rms_error"][joint].get<double>();
+      const double adaptive = row["adaptive"]["rms_error"][joint].get<double>();
+      INFO(joint << ": PID " << pid << " m, adaptive " << adaptive << " m");
+      CHECK(std::isfinite(adaptive));
+      CHECK(pid >= 2 * adaptive);
+      CHECK(row["pid_over_adaptive_rms"][joint].get<double>() == doctest::Approx(pid / adaptive));
+    }
+  }
+  // Each variant changes something: none may reproduce the nominal figures exactly.
+  const double nominal_bucket = rows[0]["adaptive"]["rms_error"]["bucket"].get<double>();
+  for (std::size_t i = 1; i < rows.size(); ++i) CHECK(rows[i]["adaptive"]["rms_error"]["bucket"].get<double>() != nominal_bucket);
+  CHECK(r.out.find("PID/adapt.") != std::string::npos);
+}
+
+TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits 2") {
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
+  fs::create_directories(dir);
+  const fs::path bad = dir / ("bad_scene_" + std::to_string(getpid()) + ".yaml");
+  std::string text = slurp(kDig);
+  const std::string from = "duration: 10.0";
+  REQUIRE(text.find(from) != std::string::npos);
+  text.replace(text.find(from), from.size(), "duration: -3");
+  std::ofstream(bad) << text;
+  for (const char* sub : {"run", "robustness"}) {
+    const Run r = run_sim(std::string(sub) + " " + bad.string() + " --quiet");
+    INFO(sub << ": " << r.err);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(bad.string()) != std::string::npos);
+    CHECK(r.err.find("duration") != std::string::npos);
+    CHECK(r.err.find("nan") == std::string::npos);
+  }
+  fs::remove(bad);
+  const Run unknown = run_sim("run " + kDig + " --controller lqr --quiet --no-report");
+  CHECK(unknown.status == 2);
+  CHECK(unknown.err.find("pid, adaptive, slotine_li") != std::string::npos);
+  const Run help = run_sim("robustness --help");
+  CHECK(help.status == 0);
+  CHECK(help.out.find("--json") != std::string::npos);
+}
