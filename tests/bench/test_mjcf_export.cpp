@@ -24,7 +24,7 @@ int count(const std::string& text, const std::string& what) {
   return n;
 }
 
-exc::Vec3 pin_of(const exc::ReferencePose& pose, const std::string& name) {
+[[maybe_unused]] exc::Vec3 pin_of(const exc::ReferencePose& pose, const std::string& name) {
   for (const auto& [n, p] : pose.pins_world)
     if (n == name) return p;
   FAIL("reference pose has no pin " << name);

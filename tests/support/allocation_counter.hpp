@@ -30,6 +30,10 @@ class EigenNoMallocScope {
 #ifdef EIGEN_RUNTIME_NO_MALLOC
   EigenNoMallocScope() { Eigen::internal::set_is_malloc_allowed(false); }
   ~EigenNoMallocScope() { Eigen::internal::set_is_malloc_allowed(true); }
+#else
+  // Release builds have no Eigen malloc switch; the scope still compiles (and is not "unused").
+  EigenNoMallocScope() {}
+  ~EigenNoMallocScope() {}
 #endif
   EigenNoMallocScope(const EigenNoMallocScope&) = delete;
   EigenNoMallocScope& operator=(const EigenNoMallocScope&) = delete;
