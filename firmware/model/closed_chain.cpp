@@ -62,8 +62,8 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   ws.rhod = ws.J_t * qd_a;
   ws.rhodd_bias = ws.tip_acc_tree + ws.J_tip_tree * ws.gamma;
 
-  // Tree poses and twists for Newton-Euler (also fills ws.tip_world).
-  tree_kinematics(model, ws, ws.q, ws.qd);
+  // Tree poses and twists for Newton-Euler (also fills ws.tip_world), from the planar pass above.
+  tree_kinematics_from_front(model, ws, ws.qd);
   return ws.report;
 }
 

@@ -2,6 +2,8 @@
 // acceleration, and the backward sum transforms each child's wrench with f_{i,k} of that child).
 #include "newton_euler.hpp"
 
+#include <cmath>
+
 #include "lie_group.hpp"
 
 namespace exc {
@@ -26,6 +28,69 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
       ws.X_Wi[i] = compose(ws.X_Wi[p], ws.f_parent[i]);
       ws.V[i] = Ad_inv_apply(ws.f_parent[i], ws.V[p]) + S_qd;  // eq. 1, velocity
     }
+  }
+  ws.tip_world = ws.X_Wi[kBucket].topLeftCorner<3, 3>() * model.tip_in_bucket +
+                 ws.X_Wi[kBucket].topRightCorner<3, 1>();
+}
+
+namespace {
+
+// Whether the tree is the planar front the fast pass assumes (true for every machine file: the
+// loader builds it so; the check keeps a future variant from silently using the wrong pass).
+bool is_planar_front(const Model& model) {
+  Twist swing, pin, slide;
+  swing << 0, 0, 1, 0, 0, 0;
+  pin << 0, -1, 0, 0, 0, 0;
+  slide << 0, 0, 0, 1, 0, 0;
+  if (model.parent[0] >= 0 || !model.home_is_translation[0] || model.screw[0] != swing) return false;
+  for (int i = 1; i < kNumJoints; ++i)
+    if (!model.home_is_translation[i] || model.parent[i] < 0 || model.screw[i] != (model.prismatic[i] ? slide : pin))
+      return false;
+  return true;
+}
+
+// Rotation about -y by the angle with cosine c and sine s (x turns toward +z).
+inline Mat3 pin_rotation(double c, double s) {
+  Mat3 R;
+  R << c, 0, -s, 0, 1, 0, s, 0, c;
+  return R;
+}
+
+}  // namespace
+
+void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& qd) {
+  if (!is_planar_front(model)) {
+    tree_kinematics(model, ws, Vec12(ws.q), qd);
+    return;
+  }
+  ws.qd = qd;
+  const double c0 = std::cos(ws.q[0]), s0 = std::sin(ws.q[0]);
+  ws.f_parent[0] = joint_motion(model.screw[0], ws.q[0], false);
+  ws.f_parent[0].topRightCorner<3, 1>() += model.home[0].topRightCorner<3, 1>();
+  ws.X_Wi[0] = ws.f_parent[0];
+  ws.V[0] = model.screw[0] * qd[0];
+  const Vec3 p0 = ws.X_Wi[0].topRightCorner<3, 1>();
+  std::array<double, kNumJoints> y{};  // out-of-plane offset of each origin (pin rotations keep it)
+  for (int i = 1; i < kNumJoints; ++i) {
+    const int p = model.parent[i];
+    const Vec3 home = model.home[i].topRightCorner<3, 1>();
+    y[i] = (p > 0 ? y[p] : 0.0) + home.y();
+    // Relative joint motion from the cached absolute angles: cos/sin of phi_i - phi_p.
+    SE3& f = ws.f_parent[i];
+    if (model.prismatic[i]) {
+      f = translation_se3(home + Vec3(ws.q[i], 0, 0));
+    } else {
+      const double c = ws.cos_phi[i] * ws.cos_phi[p] + ws.sin_phi[i] * ws.sin_phi[p];
+      const double s = ws.sin_phi[i] * ws.cos_phi[p] - ws.cos_phi[i] * ws.sin_phi[p];
+      f = make_se3(pin_rotation(c, s), home);
+    }
+    // World pose: swing about z, then the link's absolute angle about -y; origin from the planar pass.
+    const double c = ws.cos_phi[i], s = ws.sin_phi[i];
+    Mat3 R;
+    R << c0 * c, -s0, -c0 * s, s0 * c, c0, -s0 * s, s, 0, c;
+    const Vec2& o = ws.origin[i];
+    ws.X_Wi[i] = make_se3(R, p0 + Vec3(c0 * o.x() - s0 * y[i], s0 * o.x() + c0 * y[i], o.y()));
+    ws.V[i] = Ad_inv_apply(f, ws.V[p]) + model.screw[i] * qd[i];
   }
   ws.tip_world = ws.X_Wi[kBucket].topLeftCorner<3, 3>() * model.tip_in_bucket +
                  ws.X_Wi[kBucket].topRightCorner<3, 1>();

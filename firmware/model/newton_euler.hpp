@@ -9,6 +9,12 @@ namespace exc {
 // V_i = Ad_{f^-1} V_lambda(i) + S_i qd_i. Stores q, qd into ws.
 void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Vec12& qd);
 
+// The same forward pass at q = ws.q, reusing the planar front pass that front_positions(model, ws.q,
+// ws) has just made (link angles' cosines and sines, origins in the swing plane): no per-link trig and
+// no 3x3 products. Falls back to tree_kinematics when the machine is not the planar front it
+// assumes (front pins about -y, cylinders along x, homes pure translations).
+void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& qd);
+
 // Inverse dynamics of the tree at the state of the last tree_kinematics, with joint accelerations
 // qdd, gravity (base acceleration Vd_0), and the force f_soil that the bucket exerts on the soil at
 // the tip (swing-plane x, z; its reaction acts on the bucket). Fills ws.Vd, ws.F and tau.

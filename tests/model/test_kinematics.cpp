@@ -97,6 +97,42 @@ TEST_CASE("model/the planar loop residual equals the 3-D tree transforms") {
   }
 }
 
+TEST_CASE("model/tree kinematics from the planar front pass equals the general Lie-group pass") {
+  const Model& m = reference_model();
+  Workspace fast(m), general(m);
+  test::RandomStates rs(31);
+  for (int trial = 0; trial < 200; ++trial) {
+    Vec12 q, qd;  // arbitrary tree states: the fast pass needs no loop closure
+    for (int i = 0; i < kNumJoints; ++i) {
+      q[i] = m.prismatic[i] ? rs.uniform(1.5, 3.0) : rs.uniform(-M_PI, M_PI);
+      qd[i] = rs.uniform(-1, 1);
+    }
+    fast.q = q;
+    front_positions(m, q, fast);
+    tree_kinematics_from_front(m, fast, qd);
+    tree_kinematics(m, general, q, qd);
+    for (int i = 0; i < kNumJoints; ++i) {
+      CHECK((fast.X_Wi[i] - general.X_Wi[i]).cwiseAbs().maxCoeff() < 1e-12);
+      CHECK((fast.f_parent[i] - general.f_parent[i]).cwiseAbs().maxCoeff() < 1e-12);
+      CHECK((fast.V[i] - general.V[i]).cwiseAbs().maxCoeff() < 1e-12);
+    }
+    CHECK((fast.tip_world - general.tip_world).norm() < 1e-12);
+  }
+  // A home with an out-of-plane offset (a barrel pinned beside the boom) takes the same path.
+  Machine shifted = m.machine;
+  Model m2 = build_model(shifted);
+  m2.home[kBoomBarrel](1, 3) += 0.15;
+  Workspace f2(m2), g2(m2);
+  Vec12 q = Vec12::Constant(0.3), qd = Vec12::Constant(0.2);
+  for (int i = 0; i < kNumJoints; ++i)
+    if (m2.prismatic[i]) q[i] = 2.0;
+  f2.q = q;
+  front_positions(m2, q, f2);
+  tree_kinematics_from_front(m2, f2, qd);
+  tree_kinematics(m2, g2, q, qd);
+  for (int i = 0; i < kNumJoints; ++i) CHECK((f2.X_Wi[i] - g2.X_Wi[i]).cwiseAbs().maxCoeff() < 1e-12);
+}
+
 TEST_CASE("model/Psi, gamma and the tip Jacobian match finite differences of the loop closure") {
   const Model& m = reference_model();
   Workspace ws(m), wp(m), wm(m);
