@@ -16,6 +16,21 @@ constexpr std::uint64_t kSyncCycleMask = (1u << 20) - 1;  // SYNC's Cycle signal
 
 std::uint8_t nibble(std::uint64_t cycle) { return static_cast<std::uint8_t>(cycle & 0x0F); }
 
+// Both ends send the same way: encode (counting saturated and non-finite signals), send, count.
+bool encode_and_send(CanBus& bus, TxStats& tx, const MessageSpec& message, std::uint8_t counter,
+                     const double* values) {
+  CanFrame frame;
+  const EncodeReport report = encode_message(message, counter, values, frame);
+  tx.saturated += report.saturated;
+  tx.non_finite += report.non_finite;
+  if (!bus.send(frame)) {
+    ++tx.send_failed;
+    return false;
+  }
+  ++tx.frames_sent;
+  return true;
+}
+
 }  // namespace
 
 std::size_t receive_ids(Node receiver, std::uint32_t* out, std::size_t capacity) {
@@ -32,16 +47,7 @@ std::size_t receive_ids(Node receiver, std::uint32_t* out, std::size_t capacity)
 FirmwareCanPort::FirmwareCanPort(CanBus& bus, CanFrameCodec::Config config) : bus_(bus), codec_(config) {}
 
 bool FirmwareCanPort::transmit(const MessageSpec& message, std::uint8_t counter, const double* values) {
-  CanFrame frame;
-  const EncodeReport report = encode_message(message, counter, values, frame);
-  tx_.saturated += report.saturated;
-  tx_.non_finite += report.non_finite;
-  if (!bus_.send(frame)) {
-    ++tx_.send_failed;
-    return false;
-  }
-  ++tx_.frames_sent;
-  return true;
+  return encode_and_send(bus_, tx_, message, counter, values);
 }
 
 bool FirmwareCanPort::send_sync(std::uint64_t cycle) {
@@ -126,16 +132,7 @@ bool FirmwareCanPort::read(SensorState& state) {
 PlantCanPort::PlantCanPort(CanBus& bus, CanFrameCodec::Config config) : bus_(bus), codec_(config) {}
 
 bool PlantCanPort::transmit(const MessageSpec& message, std::uint8_t counter, const double* values) {
-  CanFrame frame;
-  const EncodeReport report = encode_message(message, counter, values, frame);
-  tx_.saturated += report.saturated;
-  tx_.non_finite += report.non_finite;
-  if (!bus_.send(frame)) {
-    ++tx_.send_failed;
-    return false;
-  }
-  ++tx_.frames_sent;
-  return true;
+  return encode_and_send(bus_, tx_, message, counter, values);
 }
 
 std::uint64_t PlantCanPort::cycle_of_counter(std::uint8_t counter) const {

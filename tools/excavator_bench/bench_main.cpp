@@ -639,10 +639,14 @@ int run_bench(const Options& o) {
   dig_window.horizon = o.quick ? 0.2 : 1.0;
   BenchScene free_window = scenes[0];
   free_window.horizon = o.quick ? 0.2 : 1.0;
-  const std::vector<double> stiffness = o.quick ? std::vector<double>{2e4, 9e5}
-                                                : std::vector<double>{2e4, 7e4, 2e5, 4e5, 9e5};
+  // Loose sand (2e4 N/m) to loads far past stiff clay (2e7 N/m: a full bucket pressed on rock): the
+  // map has to reach the failures. Steps stop at the effort profile's 10 ms hold.
+  const std::vector<double> stiffness = o.quick ? std::vector<double>{2e4, 2e7}
+                                                : std::vector<double>{2e4, 7e4, 2e5, 9e5, 4e6, 2e7};
+  const std::vector<double> map_steps = o.quick ? std::vector<double>{1e-2, 1e-3, 1e-4}
+                                                : std::vector<double>{1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5};
   const std::vector<double> speeds = o.quick ? std::vector<double>{1, 3} : std::vector<double>{0.5, 1, 2, 3};
-  const std::vector<StepStability> step_map = step_stability_map(dig_window, free_window, steps, stiffness, speeds);
+  const std::vector<StepStability> step_map = step_stability_map(dig_window, free_window, map_steps, stiffness, speeds);
   const std::vector<ControlStability> control_map = control_stability_map(scenes[1], o.quick ? 1.0 : 0.0);
   write_stability_csvs(o.out, step_map, control_map);
 

@@ -93,6 +93,9 @@ OpenLoopResult run_open_loop(const BenchScene& s, const EffortProfile& profile, 
 
   OpenLoopResult r;
   const int per_hold = cycles_per_hold(scene.cycle);
+  if (per_hold < 1)  // a step longer than the hold would skip efforts (and take no step at all)
+    throw std::invalid_argument("excavator-bench: step " + std::to_string(h) + " s is longer than the effort profile's hold of " +
+                                std::to_string(kProfileHold) + " s");
   r.tip.reserve(profile.tau.size() + 1);
   r.tip.push_back(plant.state().tip_world);
   if (record_states) {
