@@ -129,6 +129,27 @@ TEST_CASE("tools/plot-run draws every figure and the report from a small recorde
   CHECK(report.str().find("| quantity | pid | adaptive |") != std::string::npos);
   // The RMS of a sine over whole periods is its amplitude / sqrt(2): 0.05 and 0.01 here.
   CHECK(report.str().find("| arm (m) | 0.03536 | 0.007071 |") != std::string::npos);
+  // excavator-sim's summary shape: figures per controller, the baseline first, in mm.
+  {
+    std::ofstream summary(dir / "sim_summary.json");
+    const char* run = R"({"rms_error": {"swing": 0, "boom": 0.0015, "arm": 0.0073, "bucket": 0.052},
+      "max_error": {"swing": 0, "boom": 0.004, "arm": 0.02, "bucket": 0.11}, "peak_soil_force": 13100,
+      "reanchor_count": 25, "control_step_us": {"median": 7, "p99": 10.5, "max": 200},
+      "heap_allocations_in_loop": 0, "simulated_seconds": 10, "ok": true,
+      "theta_hat": {"M_x": 1, "B_x": 2, "K_x": 3, "M_z": 4, "B_z": 5, "K_z": 6},
+      "theta_true": {"M_x": 1, "B_x": 2, "K_x": 3, "M_z": 4, "B_z": 5, "K_z": 6}})";
+    summary << "{\"adaptive\": " << run << ", \"pid\": " << run << ", \"scene\": \"dig\"}";
+  }
+  const std::string sim_out = (dir / "sim_report").string();
+  REQUIRE(std::system((std::string(EXC_EXCAVATOR_LOG) + " report " + log_path.string() + " --out " + sim_out +
+                       " --summary " + (dir / "sim_summary.json").string() + " >/dev/null")
+                          .c_str()) == 0);
+  std::ifstream sim_file(fs::path(sim_out) / "report.md");
+  std::stringstream sim_report;
+  sim_report << sim_file.rdbuf();
+  CHECK(sim_report.str().find("| quantity | pid | adaptive |") != std::string::npos);
+  CHECK(sim_report.str().find("| RMS error arm (mm) | 7.3 | 7.3 |") != std::string::npos);
+  CHECK(sim_report.str().find("| peak soil force (kN) | 13.1 | 13.1 |") != std::string::npos);
   for (const char* name :
        {"tracking_swing.png", "tracking_boom.png", "tracking_arm.png", "tracking_bucket.png",
         "tracking_error.png", "soil_force.png", "soil_estimates.png", "loop_timing.png"}) {

@@ -4,7 +4,8 @@
 Input: one or more CSV directories written by `excavator-log export run.lcm --csv DIR`. Each
 controller's run is recognised by its channel suffix (EXC_STATE__pid.csv is channel EXC_STATE/pid)
 or, without a suffix, by the directory name. Output (in --out): PNG files of a fixed pixel size and
-report.md embedding them with the summary table (--summary JSON, rendered generically) and the RMS
+report.md embedding them with the summary table (--summary JSON: excavator-sim's as a table of
+figures per controller, any other rendered generically) and the RMS
 tracking errors computed from the CSVs.
 
 Figures (paper: Kim, Yoo, Lee): tracking_<joint>.png, desired against actual with one panel per
@@ -229,6 +230,48 @@ def format_value(value):
     return str(value)
 
 
+SIM_JOINTS = (("swing", "mrad"), ("boom", "mm"), ("arm", "mm"), ("bucket", "mm"))
+
+
+def sim_runs(summary):
+    """The per-controller runs of an excavator-sim summary (objects with an rms_error per joint)."""
+    if not isinstance(summary, dict):
+        return {}
+    runs = {k: v for k, v in summary.items() if isinstance(v, dict) and isinstance(v.get("rms_error"), dict)}
+    order = ["pid", "adaptive", "slotine_li"]  # the baseline first, as in the paper's figures
+    return dict(sorted(runs.items(), key=lambda kv: (order.index(kv[0]) if kv[0] in order else len(order), kv[0])))
+
+
+def sim_table(runs):
+    """excavator-sim's summary as engineers read it: one row per figure, one column per controller."""
+    names = list(runs)
+    lines = ["| quantity | " + " | ".join(names) + " |", "|---|" + "---|" * len(names)]
+
+    def row(label, get):
+        cells = []
+        for r in runs.values():
+            try:
+                cells.append(get(r))
+            except (KeyError, TypeError, ValueError):
+                cells.append("n/a")
+        lines.append("| %s | " % label + " | ".join(cells) + " |")
+
+    for key, what in (("rms_error", "RMS error"), ("max_error", "max error")):
+        for joint, unit in SIM_JOINTS:
+            row("%s %s (%s)" % (what, joint, unit), lambda r, k=key, j=joint: "%.4g" % (1e3 * r[k][j]))
+    row("peak soil force (kN)", lambda r: "%.1f" % (1e-3 * r["peak_soil_force"]))
+    row("shear re-anchorings", lambda r: "%d" % r["reanchor_count"])
+    for q in ("median", "p99", "max"):
+        row("control step %s (us)" % q, lambda r, q=q: "%.1f" % r["control_step_us"][q])
+    row("heap allocations in the loop", lambda r: "%d" % r["heap_allocations_in_loop"])
+    row("simulated (s)", lambda r: "%.3g" % r["simulated_seconds"])
+    for name in ("M_x", "B_x", "K_x", "M_z", "B_z", "K_z"):
+        row("soil estimate %s (true)" % name,
+            lambda r, n=name: "%.4g (%.4g)" % (r["theta_hat"][n], r["theta_true"][n]))
+    row("status", lambda r: "ok" if r.get("ok", True) else "FAILED: %s" % r.get("failure", ""))
+    return lines
+
+
 def summary_table(summary):
     """Markdown for any JSON: a table of runs x keys if every value is an object, else key/value."""
     lines = []
@@ -254,8 +297,12 @@ def summary_table(summary):
 def write_report(runs, summary, title, out_dir, written):
     lines = ["# %s" % title, ""]
     if summary is not None:
-        lines += ["## Summary", ""] + summary_table(summary) + [""]
-    lines += ["## RMS tracking error (from the telemetry)", ""]
+        runs_in_summary = sim_runs(summary)
+        table = sim_table(runs_in_summary) if runs_in_summary else summary_table(summary)
+        lines += ["## Summary", ""] + table + [""]
+    # From the log: the controller's own error e (estimated state against q_d) over every logged
+    # cycle, hold included; the summary's figures are the plant's true state while tracking.
+    lines += ["## RMS of the controller's error e over the whole log (telemetry)", ""]
     lines.append("| joint | " + " | ".join(runs) + " |")
     lines.append("|---|" + "---|" * len(runs))
     for j, (joint, unit) in enumerate(JOINTS):
