@@ -81,7 +81,9 @@ TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive bea
 }
 
 TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better than PID on arm and bucket in every variant") {
-  const Run r = run_sim("robustness " + kDig + " --quiet --json robust.json");
+  const bool have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' 2>/dev/null") == 0;
+  const Run r = run_sim("robustness " + kDig + " --quiet --json robust.json --out rob" +
+                        (have_matplotlib ? "" : " --no-plots"));
   INFO(r.err);
   REQUIRE(r.status == 0);
   const nlohmann::json j = nlohmann::json::parse(slurp(r.dir / "robust.json"));
@@ -105,6 +107,13 @@ TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better tha
   const double nominal_bucket = rows[0]["adaptive"]["rms_error"]["bucket"].get<double>();
   for (std::size_t i = 1; i < rows.size(); ++i) CHECK(rows[i]["adaptive"]["rms_error"]["bucket"].get<double>() != nominal_bucket);
   CHECK(r.out.find("PID/adapt.") != std::string::npos);
+  // The same table next to its chart (1200 x 700 PNG; skipped only without matplotlib).
+  CHECK(slurp(r.dir / "rob" / "robustness.json") == slurp(r.dir / "robust.json"));
+  if (have_matplotlib) {
+    CHECK(fs::file_size(r.dir / "rob" / "robustness.png") > 20000);
+  } else {
+    MESSAGE("matplotlib missing: robustness.png not checked");
+  }
 }
 
 TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits 2") {

@@ -50,7 +50,8 @@ int main(int argc, char** argv) {
   auto* robust = app.add_subcommand(
       "robustness", "run a scene with the controller's model, sensors or soil made wrong on purpose: model "
                     "mass -20 % and +20 %, sensor noise, 2 cycles of sensor delay, 3x stiffer soil, all at once");
-  std::string robust_scene, robust_json;
+  std::string robust_scene, robust_json, robust_out;
+  bool robust_no_plots = false;
   std::vector<std::string> robust_controllers;
   double robust_duration = 0;
   bool robust_quiet = false;
@@ -61,6 +62,9 @@ int main(int argc, char** argv) {
   robust->add_option("--duration", robust_duration, "simulated seconds per run (default: the scene's duration)")
       ->check(CLI::PositiveNumber);
   robust->add_flag("--quiet", robust_quiet, "no progress output");
+  robust->add_option("--out", robust_out,
+                     "output directory for robustness.json and robustness.png (default: out/<scene name>-robustness)");
+  robust->add_flag("--no-plots", robust_no_plots, "skip robustness.png");
   CLI11_PARSE(app, argc, argv);
 
   if (robust->parsed()) {
@@ -74,13 +78,26 @@ int main(int argc, char** argv) {
       const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(robust_scene);
       const auto rows = exc::sim::run_robustness(bundle, options, exc::sim::standard_robustness_variants());
       exc::sim::print_robustness(rows, std::cout);
-      if (!robust_json.empty()) {
-        std::ofstream f(robust_json);
+      if (robust_out.empty()) robust_out = (fs::path("out") / (bundle.name + "-robustness")).string();
+      fs::create_directories(robust_out);
+      const fs::path table = fs::path(robust_out) / "robustness.json";
+      for (const std::string& path : {table.string(), robust_json}) {
+        if (path.empty()) continue;
+        std::ofstream f(path);
         f << exc::sim::robustness_json(rows).dump(2) << "\n";
         if (!f) {
-          std::cerr << "excavator-sim: cannot write " << robust_json << "\n";
+          std::cerr << "excavator-sim: cannot write " << path << "\n";
           return 2;
         }
+      }
+      if (!robust_no_plots) {
+        const int rc = exc::sim::plot_robustness(table, robust_out);
+        if (rc != 0) {
+          std::cerr << "excavator-sim: the robustness chart failed (exit " << rc << "); the table is in " << table.string()
+                    << "\n";
+          return 1;
+        }
+        std::cout << "chart: " << (fs::path(robust_out) / "robustness.png").string() << "\n";
       }
       // A variant may fail (that is a finding, printed in the table); the program itself succeeded.
       return 0;

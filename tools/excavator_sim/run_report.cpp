@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace exc::sim {
 namespace {
@@ -112,21 +113,35 @@ nlohmann::json to_json(const Summary& summary) {
   return j;
 }
 
-int write_report(const char* /*argv0*/, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json) {
-  const std::string log = (out_dir / "run.lcm").string();
-  const std::string report = (out_dir / "report").string();
-  const std::string summary = summary_json.string();
+namespace {
+
+// fork + exec + wait: the program's exit status, 127 if it could not run, 128 if it was killed.
+int run_program(const std::vector<std::string>& argv) {
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
   const pid_t pid = fork();
   if (pid < 0) return 127;
   if (pid == 0) {
-    execl(EXC_LOG_TOOL, EXC_LOG_TOOL, "report", log.c_str(), "--out", report.c_str(), "--summary", summary.c_str(),
-          "--title", "Digging scene: PID against adaptive computed torque", static_cast<char*>(nullptr));
-    std::perror("excavator-sim: cannot run " EXC_LOG_TOOL);
+    execv(args[0], args.data());
+    std::fprintf(stderr, "excavator-sim: cannot run %s\n", args[0]);
     _exit(127);
   }
   int status = 0;
   if (waitpid(pid, &status, 0) < 0) return 127;
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+}
+
+}  // namespace
+
+int write_report(const char* /*argv0*/, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json) {
+  return run_program({EXC_LOG_TOOL, "report", (out_dir / "run.lcm").string(), "--out", (out_dir / "report").string(),
+                      "--summary", summary_json.string(), "--title",
+                      "Digging scene: PID against adaptive computed torque"});
+}
+
+int plot_robustness(const std::filesystem::path& json, const std::filesystem::path& out_dir) {
+  return run_program({EXC_PLOT_RUN, "--robustness", json.string(), "--out", out_dir.string()});
 }
 
 }  // namespace exc::sim

@@ -13,5 +13,7 @@ void print_summary(const Summary& summary, std::ostream& out);
 nlohmann::json to_json(const Summary& summary);
 // Runs `excavator-log report` on out_dir/run.lcm; returns its exit status.
 int write_report(const char* argv0, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json);
+// Runs `plot-run --robustness JSON --out DIR` (robustness.png); returns its exit status.
+int plot_robustness(const std::filesystem::path& json, const std::filesystem::path& out_dir);
 
 }  // namespace exc::sim

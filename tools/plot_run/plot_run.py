@@ -12,6 +12,8 @@ Figures (paper: Kim, Yoo, Lee): tracking_<joint>.png, desired against actual wit
 controller side by side (Figs. 4-7 free motion, 9-12 digging); tracking_error.png; soil_force.png
 (the zig-zag of Fig. 8); soil_estimates.png (Theta_hat against the true values); loop_timing.png
 (histogram of the control cycle).
+
+`plot-run --robustness JSON --out DIR` draws robustness.png from `excavator-sim robustness --json`.
 """
 import argparse
 import csv
@@ -330,7 +332,46 @@ def write_report(runs, summary, title, out_dir, written):
     return path
 
 
+def plot_robustness(plt, path, out_dir):
+    """robustness.png from `excavator-sim robustness --json`: RMS error per variant, one panel per
+    joint, one bar per controller (log scale: the variants span two decades)."""
+    try:
+        with open(path) as f:
+            rows = json.load(f)["robustness"]
+    except (OSError, ValueError, KeyError, TypeError) as error:
+        fail("%s: not an excavator-sim robustness JSON (%s)" % (path, error))
+    variants = [r["variant"] for r in rows]
+    controllers = [c for c in ("pid", "adaptive", "slotine_li") if c in rows[0]] if rows else []
+    fig, axes = new_figure(plt, 1, 3, "Robustness: RMS tracking error on the dig pass per variant")
+    width = 0.8 / max(1, len(controllers))
+    for ax, joint in zip(axes[0], ("boom", "arm", "bucket")):
+        for k, c in enumerate(controllers):
+            xs = [i + (k - (len(controllers) - 1) / 2) * width for i in range(len(rows))]
+            ax.bar(xs, [1e3 * r[c]["rms_error"][joint] for r in rows], width, label=c)
+        ax.set_yscale("log")
+        ax.set_title(joint)
+        ax.set_ylabel("RMS error [mm]")
+        ax.set_xticks(range(len(rows)))
+        ax.set_xticklabels(variants, rotation=35, ha="right", fontsize=8)
+        ax.grid(True, axis="y", which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    written = []
+    save(fig, out_dir, "robustness.png", written)
+    return written
+
+
 def main(argv):
+    if argv and argv[0] == "--robustness":
+        parser = argparse.ArgumentParser(prog="plot-run --robustness",
+                                         description="Draw robustness.png from excavator-sim robustness's JSON.")
+        parser.add_argument("--robustness", required=True, metavar="JSON")
+        parser.add_argument("--out", required=True, help="output directory for robustness.png")
+        args = parser.parse_args(argv)
+        plt = load_matplotlib()
+        os.makedirs(args.out, exist_ok=True)
+        written = plot_robustness(plt, args.robustness, args.out)
+        print("plot-run: wrote %s in %s" % (", ".join(written), args.out))
+        return 0
     parser = argparse.ArgumentParser(
         prog="plot-run",
         description="Draw the paper's figures (tracking, soil force, soil estimates, loop timing) "
