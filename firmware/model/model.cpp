@@ -10,6 +10,15 @@ namespace exc {
 
 namespace {
 Vec3 in_plane(const Vec2& p) { return Vec3(p.x(), 0.0, p.y()); }
+
+// Checked on the built tree rather than assumed, so that a future variant cannot silently take the
+// planar fast pass of tree_kinematics_from_front.
+bool is_planar_front(const Model& m, const Twist& swing, const Twist& pin, const Twist& slide) {
+  if (m.parent[0] >= 0 || !m.home_is_translation[0] || m.screw[0] != swing) return false;
+  for (int i = 1; i < kNumJoints; ++i)
+    if (!m.home_is_translation[i] || m.parent[i] < 0 || m.screw[i] != (m.prismatic[i] ? slide : pin)) return false;
+  return true;
+}
 }  // namespace
 
 Model build_model(const Machine& machine) {
@@ -41,6 +50,7 @@ Model build_model(const Machine& machine) {
   set(kBucketRod, kBucketBarrel, zero, along_x, true);
   set(kLink11, kBucketRod, zero, front_pin, false);
   set(kLink12, kBucketRod, zero, front_pin, false);
+  m.planar_front = is_planar_front(m, about_z, front_pin, along_x);
 
   for (int i = 0; i < kNumJoints; ++i) {
     const BodyInertia& b = k.bodies[i];

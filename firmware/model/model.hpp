@@ -18,6 +18,9 @@ struct Model {
   std::array<Twist, kNumJoints> screw;     // S_i in frame i
   std::array<bool, kNumJoints> prismatic;
   std::array<bool, kNumJoints> home_is_translation;  // M_i has no rotation (true for this machine)
+  // Swing about z at the base, every other joint a pin about -y or a slide along x, all homes
+  // translations: the tree poses can then come from the planar front pass (set by build_model).
+  bool planar_front = false;
   std::array<Mat6, kNumJoints> inertia;    // J_i about the frame origin, (w, v) ordering
   std::array<LoopCut, kNumLoops> loops;
   Vec3 tip_in_bucket;                      // T in the bucket frame

@@ -2,8 +2,6 @@
 // acceleration, and the backward sum transforms each child's wrench with f_{i,k} of that child).
 #include "newton_euler.hpp"
 
-#include <cmath>
-
 #include "lie_group.hpp"
 
 namespace exc {
@@ -35,20 +33,6 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
 
 namespace {
 
-// Whether the tree is the planar front the fast pass assumes (true for every machine file: the
-// loader builds it so; the check keeps a future variant from silently using the wrong pass).
-bool is_planar_front(const Model& model) {
-  Twist swing, pin, slide;
-  swing << 0, 0, 1, 0, 0, 0;
-  pin << 0, -1, 0, 0, 0, 0;
-  slide << 0, 0, 0, 1, 0, 0;
-  if (model.parent[0] >= 0 || !model.home_is_translation[0] || model.screw[0] != swing) return false;
-  for (int i = 1; i < kNumJoints; ++i)
-    if (!model.home_is_translation[i] || model.parent[i] < 0 || model.screw[i] != (model.prismatic[i] ? slide : pin))
-      return false;
-  return true;
-}
-
 // Rotation about -y by the angle with cosine c and sine s (x turns toward +z).
 inline Mat3 pin_rotation(double c, double s) {
   Mat3 R;
@@ -59,14 +43,14 @@ inline Mat3 pin_rotation(double c, double s) {
 }  // namespace
 
 void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& qd) {
-  if (!is_planar_front(model)) {
+  if (!model.planar_front) {
     tree_kinematics(model, ws, Vec12(ws.q), qd);
     return;
   }
   ws.qd = qd;
-  const double c0 = std::cos(ws.q[0]), s0 = std::sin(ws.q[0]);
   ws.f_parent[0] = joint_motion(model.screw[0], ws.q[0], false);
   ws.f_parent[0].topRightCorner<3, 1>() += model.home[0].topRightCorner<3, 1>();
+  const double c0 = ws.f_parent[0](0, 0), s0 = ws.f_parent[0](1, 0);  // the swing's cos, sin (about z)
   ws.X_Wi[0] = ws.f_parent[0];
   ws.V[0] = model.screw[0] * qd[0];
   const Vec3 p0 = ws.X_Wi[0].topRightCorner<3, 1>();

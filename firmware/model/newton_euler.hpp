@@ -11,8 +11,8 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
 
 // The same forward pass at q = ws.q, reusing the planar front pass that front_positions(model, ws.q,
 // ws) has just made (link angles' cosines and sines, origins in the swing plane): no per-link trig and
-// no 3x3 products. Falls back to tree_kinematics when the machine is not the planar front it
-// assumes (front pins about -y, cylinders along x, homes pure translations).
+// no 3x3 products. Falls back to tree_kinematics when the tree is not a planar front
+// (model.planar_front, decided once by build_model).
 void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& qd);
 
 // Inverse dynamics of the tree at the state of the last tree_kinematics, with joint accelerations
