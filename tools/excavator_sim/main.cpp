@@ -81,10 +81,11 @@ int main(int argc, char** argv) {
       if (robust_out.empty()) robust_out = (fs::path("out") / (bundle.name + "-robustness")).string();
       fs::create_directories(robust_out);
       const fs::path table = fs::path(robust_out) / "robustness.json";
+      const std::string text = exc::sim::robustness_json(rows).dump(2) + "\n";
       for (const std::string& path : {table.string(), robust_json}) {
         if (path.empty()) continue;
         std::ofstream f(path);
-        f << exc::sim::robustness_json(rows).dump(2) << "\n";
+        f << text;
         if (!f) {
           std::cerr << "excavator-sim: cannot write " << path << "\n";
           return 2;

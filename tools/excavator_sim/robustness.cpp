@@ -14,35 +14,47 @@ const RunResult* find(const Summary& s, const std::string& controller) {
   return nullptr;
 }
 
+// PID's RMS error over the adaptive law's, arm and bucket; false unless both ran.
+bool pid_over_adaptive(const Summary& s, double& arm, double& bucket) {
+  const RunResult* pid = find(s, "pid");
+  const RunResult* ad = find(s, "adaptive");
+  if (!pid || !ad) return false;
+  arm = pid->rms_error[2] / ad->rms_error[2];
+  bucket = pid->rms_error[3] / ad->rms_error[3];
+  return true;
+}
+
+}  // namespace
+
+namespace {
+
+// The single faults; the "all" variant applies every one of them (mass +20 %).
+void heavier_model(SceneBundle&, RunOptions& o) { o.controller_mass_scale = 1.2; }
+void lighter_model(SceneBundle&, RunOptions& o) { o.controller_mass_scale = 0.8; }
+// Noise of the order of a good encoder chain: 0.1 mm on a stroke, 0.2 mrad on the swing, and a
+// velocity signal (differentiated in the drive) ten times noisier than a clean one.
+void sensor_noise(SceneBundle& b, RunOptions&) {
+  b.scene.sensors.position_noise = Vec4(2e-4, 1e-4, 1e-4, 1e-4);
+  b.scene.sensors.velocity_noise = Vec4(5e-3, 5e-3, 5e-3, 5e-3);
+}
+void sensor_delay(SceneBundle& b, RunOptions&) { b.scene.sensors.latency_cycles = 2; }
+void stiffer_soil(SceneBundle& b, RunOptions&) { b.scene.soil.stiffness *= 3.0; }
+
 }  // namespace
 
 std::vector<RobustnessVariant> standard_robustness_variants() {
-  std::vector<RobustnessVariant> v;
-  v.push_back({"nominal", "exact model, the scene's sensors and soil", [](SceneBundle&, RunOptions&) {}});
-  v.push_back({"mass-20%", "controller's model: every link 20 % lighter than the plant",
-               [](SceneBundle&, RunOptions& o) { o.controller_mass_scale = 0.8; }});
-  v.push_back({"mass+20%", "controller's model: every link 20 % heavier than the plant",
-               [](SceneBundle&, RunOptions& o) { o.controller_mass_scale = 1.2; }});
-  // Noise of the order of a good encoder chain: 0.1 mm on a stroke, 0.2 mrad on the swing, and a
-  // velocity signal (differentiated in the drive) ten times noisier than a clean one.
-  v.push_back({"noise", "sensor noise: position 0.2 mrad / 0.1 mm, velocity 5 mrad/s / 5 mm/s (1 sigma)",
-               [](SceneBundle& b, RunOptions&) {
-                 b.scene.sensors.position_noise = Vec4(2e-4, 1e-4, 1e-4, 1e-4);
-                 b.scene.sensors.velocity_noise = Vec4(5e-3, 5e-3, 5e-3, 5e-3);
-               }});
-  v.push_back({"delay2", "sensor frames 2 cycles late (2 ms)",
-               [](SceneBundle& b, RunOptions&) { b.scene.sensors.latency_cycles = 2; }});
-  v.push_back({"soil-K x3", "plant's soil 3x stiffer than the controller's initial estimate",
-               [](SceneBundle& b, RunOptions&) { b.scene.soil.stiffness *= 3.0; }});
-  v.push_back({"all", "mass+20%, noise, 2-cycle delay and 3x stiffer soil at once",
-               [](SceneBundle& b, RunOptions& o) {
-                 o.controller_mass_scale = 1.2;
-                 b.scene.sensors.position_noise = Vec4(2e-4, 1e-4, 1e-4, 1e-4);
-                 b.scene.sensors.velocity_noise = Vec4(5e-3, 5e-3, 5e-3, 5e-3);
-                 b.scene.sensors.latency_cycles = 2;
-                 b.scene.soil.stiffness *= 3.0;
-               }});
-  return v;
+  return {
+      {"nominal", "exact model, the scene's sensors and soil", [](SceneBundle&, RunOptions&) {}},
+      {"mass-20%", "controller's model: every link 20 % lighter than the plant", lighter_model},
+      {"mass+20%", "controller's model: every link 20 % heavier than the plant", heavier_model},
+      {"noise", "sensor noise: position 0.2 mrad / 0.1 mm, velocity 5 mrad/s / 5 mm/s (1 sigma)", sensor_noise},
+      {"delay2", "sensor frames 2 cycles late (2 ms)", sensor_delay},
+      {"soil-K x3", "plant's soil 3x stiffer than the controller's initial estimate", stiffer_soil},
+      {"all", "mass+20%, noise, 2-cycle delay and 3x stiffer soil at once",
+       [](SceneBundle& b, RunOptions& o) {
+         for (auto* fault : {heavier_model, sensor_noise, sensor_delay, stiffer_soil}) fault(b, o);
+       }},
+  };
 }
 
 std::vector<RobustnessRow> run_robustness(const SceneBundle& nominal, const RunOptions& options,
@@ -74,11 +86,9 @@ void print_robustness(const std::vector<RobustnessRow>& rows, std::ostream& out)
                     1e3 * r.rms_error[3], r.ok ? "ok" : r.failure.c_str());
       out << line;
     }
-    const RunResult* pid = find(row.summary, "pid");
-    const RunResult* ad = find(row.summary, "adaptive");
-    if (pid && ad) {
-      std::snprintf(line, sizeof line, "%-10s %-10s %8s %8s %7.1fx %7.1fx\n", "", "PID/adapt.", "", "",
-                    pid->rms_error[2] / ad->rms_error[2], pid->rms_error[3] / ad->rms_error[3]);
+    double arm = 0, bucket = 0;
+    if (pid_over_adaptive(row.summary, arm, bucket)) {
+      std::snprintf(line, sizeof line, "%-10s %-10s %8s %8s %7.1fx %7.1fx\n", "", "PID/adapt.", "", "", arm, bucket);
       out << line;
     }
   }
@@ -92,11 +102,8 @@ nlohmann::json robustness_json(const std::vector<RobustnessRow>& rows) {
     nlohmann::json v = to_json(row.summary);
     v["variant"] = row.variant;
     v["description"] = row.description;
-    const RunResult* pid = find(row.summary, "pid");
-    const RunResult* ad = find(row.summary, "adaptive");
-    if (pid && ad)
-      v["pid_over_adaptive_rms"] = {{"arm", pid->rms_error[2] / ad->rms_error[2]},
-                                    {"bucket", pid->rms_error[3] / ad->rms_error[3]}};
+    double arm = 0, bucket = 0;
+    if (pid_over_adaptive(row.summary, arm, bucket)) v["pid_over_adaptive_rms"] = {{"arm", arm}, {"bucket", bucket}};
     j.push_back(v);
   }
   return {{"robustness", j}};
