@@ -20,10 +20,10 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
     ws.report = ModelReport{ModelStatus::non_finite_input, -1, 0};
     return ws.report;
   }
-  // Position level: q_p from q_a in closed form (Table 2).
+  // Position level: q_p from q_a in closed form (Table 2), with each pin's cos q, sin q.
   ws.report = solve_loop_closure(model, ws, q_a);
   if (!ws.report.ok()) return ws.report;
-  front_positions(model, ws.q, ws);
+  front_positions_from_joint_trig(model, ws.q, ws);
   front_loop_jacobian(model, ws, ws.H);  // H = dh/dq (eq. 4)
 
   // Velocity level: qd = Psi qd_a, Psi = [I; -H_p^-1 H_a] (eq. 16a), in tree order. At closure

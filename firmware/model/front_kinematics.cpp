@@ -17,6 +17,18 @@ inline bool in_front(int i) { return i > 0; }
 }  // namespace
 
 void front_positions(const Model& model, const Vec12& q, Workspace& ws) {
+  for (int i = 1; i < kNumJoints; ++i) {
+    if (model.prismatic[i]) {
+      ws.joint_cos[i] = 1.0;
+      ws.joint_sin[i] = 0.0;
+    } else {
+      ::sincos(q[i], &ws.joint_sin[i], &ws.joint_cos[i]);
+    }
+  }
+  front_positions_from_joint_trig(model, q, ws);
+}
+
+void front_positions_from_joint_trig(const Model& model, const Vec12& q, Workspace& ws) {
   ws.phi[0] = 0;
   ws.cos_phi[0] = 1;
   ws.sin_phi[0] = 0;
@@ -30,9 +42,11 @@ void front_positions(const Model& model, const Vec12& q, Workspace& ws) {
       ws.sin_phi[i] = ws.sin_phi[p];
       ws.origin[i] = ws.origin[p] + rotate_by(ws, p, offset + Vec2(q[i], 0.0));
     } else {
+      // phi_i = phi_p + q_i by the angle-sum formulas: no trig per link.
+      const double c = ws.joint_cos[i], s = ws.joint_sin[i];
       ws.phi[i] = ws.phi[p] + q[i];
-      ws.cos_phi[i] = std::cos(ws.phi[i]);
-      ws.sin_phi[i] = std::sin(ws.phi[i]);
+      ws.cos_phi[i] = ws.cos_phi[p] * c - ws.sin_phi[p] * s;
+      ws.sin_phi[i] = ws.sin_phi[p] * c + ws.cos_phi[p] * s;
       ws.origin[i] = ws.origin[p] + rotate_by(ws, p, offset);
     }
   }

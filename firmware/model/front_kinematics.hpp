@@ -7,8 +7,13 @@
 
 namespace exc {
 
-// Angles and origins of every link from q (positions only); fills ws.phi, ws.origin.
+// Angles and origins of every link from q (positions only); fills ws.joint_cos,
+// ws.joint_sin, ws.phi, ws.cos_phi, ws.sin_phi, ws.origin.
 void front_positions(const Model& model, const Vec12& q, Workspace& ws);
+
+// The same with ws.joint_cos, ws.joint_sin already set for q (the closed-form loop closure has
+// them from its intersection vectors, without trig).
+void front_positions_from_joint_trig(const Model& model, const Vec12& q, Workspace& ws);
 
 // Rates from qd and qdd (after front_positions): ws.omega, ws.alpha, ws.origin_d, ws.origin_dd.
 void front_rates(const Model& model, const Vec12& qd, const Vec12& qdd, Workspace& ws);

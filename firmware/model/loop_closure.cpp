@@ -17,8 +17,6 @@ namespace {
 constexpr double kToggleSine = 0.1;
 constexpr double kTriangleSine = 0.01;
 
-inline double angle_of(const Vec2& v) { return std::atan2(v.y(), v.x()); }
-inline double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
 
 struct Intersection {
   Vec2 point;
@@ -71,13 +69,15 @@ ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_
   double conditioning = 1.0;
 
   // Loop 0, boom triangle C-D-E in the swing frame.
-  const Intersection E = intersect_circles(m.D, q_a[1], m.C, m.E.norm(), kBoomSide);
+  const double boom_E_radius = m.E.norm();
+  const Intersection E = intersect_circles(m.D, q_a[1], m.C, boom_E_radius, kBoomSide);
   if (!E.exists) return fail(ModelStatus::no_assembly, 0, 0);
   if (E.sine < kTriangleSine) return fail(ModelStatus::near_toggle, 0, E.sine);
   conditioning = std::min(conditioning, E.sine);
 
   // Loop 1, arm triangle F-H-G in the boom frame.
-  const Intersection G = intersect_circles(m.F, q_a[2], m.H, m.G.norm(), kArmSide);
+  const double arm_G_radius = m.G.norm();
+  const Intersection G = intersect_circles(m.F, q_a[2], m.H, arm_G_radius, kArmSide);
   if (!G.exists) return fail(ModelStatus::no_assembly, 1, 0);
   if (G.sine < kTriangleSine) return fail(ModelStatus::near_toggle, 1, G.sine);
   conditioning = std::min(conditioning, G.sine);
@@ -92,19 +92,36 @@ ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_
   if (L.sine < kToggleSine) return fail(ModelStatus::near_toggle, 3, L.sine);
   conditioning = std::min({conditioning, J.sine, L.sine});
 
+  // Each pin angle from a vector of known length (a radius of its circle): cos q and sin q are
+  // its components over that length, turned back by the reference direction where there is one;
+  // one atan2 per pin and no further trig in the passes that follow.
   Vec12& q = ws.q;
   q[kSwing] = q_a[0];
   q[kBoomRod] = q_a[1];
   q[kArmRod] = q_a[2];
   q[kBucketRod] = q_a[3];
-  q[kBoom] = wrap(angle_of(E.point - m.C) - angle_of(m.E));
-  q[kBoomBarrel] = wrap(angle_of(E.point - m.D));
-  q[kArm] = wrap(angle_of(G.point - m.H) - angle_of(m.G));
-  q[kArmBarrel] = wrap(angle_of(G.point - m.F));
-  q[kBucketBarrel] = wrap(angle_of(J.point - m.I));
-  q[kBucket] = wrap(angle_of(L.point - m.M));  // L lies on the bucket x axis
-  q[kLink11] = wrap(angle_of(L.point - J.point) - q[kBucketBarrel]);
-  q[kLink12] = wrap(angle_of(m.K - J.point) - q[kBucketBarrel]);
+  for (const int i : {kBoomRod, kArmRod, kBucketRod}) {
+    ws.joint_cos[i] = 1.0;
+    ws.joint_sin[i] = 0.0;
+  }
+  auto set_pin = [&](int i, const Vec2& unit) {
+    ws.joint_cos[i] = unit.x();
+    ws.joint_sin[i] = unit.y();
+    q[i] = std::atan2(unit.y(), unit.x());
+  };
+  // The unit vector of 'v' seen from the unit reference direction 'ref' (its angle minus ref's).
+  auto relative = [](const Vec2& v, const Vec2& ref) {
+    return Vec2(v.x() * ref.x() + v.y() * ref.y(), v.y() * ref.x() - v.x() * ref.y());
+  };
+  set_pin(kBoom, relative((E.point - m.C) / boom_E_radius, m.E / boom_E_radius));
+  set_pin(kBoomBarrel, (E.point - m.D) / q_a[1]);
+  set_pin(kArm, relative((G.point - m.H) / arm_G_radius, m.G / arm_G_radius));
+  set_pin(kArmBarrel, (G.point - m.F) / q_a[2]);
+  set_pin(kBucketBarrel, (J.point - m.I) / q_a[3]);
+  set_pin(kBucket, (L.point - m.M) / m.L.x());  // L lies on the bucket x axis
+  const Vec2 bucket_barrel(ws.joint_cos[kBucketBarrel], ws.joint_sin[kBucketBarrel]);
+  set_pin(kLink11, relative((L.point - J.point) / m.JL, bucket_barrel));
+  set_pin(kLink12, relative((m.K - J.point) / m.JK, bucket_barrel));
 
   ModelReport r;
   r.conditioning = conditioning;

@@ -9,6 +9,7 @@ namespace exc {
 void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Vec12& qd) {
   ws.q = q;
   ws.qd = qd;
+  ws.pin_valid = false;
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
     // eq. 1: f = M exp([S] q), with the closed form for a revolute or prismatic screw.
@@ -59,23 +60,22 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
     const int p = model.parent[i];
     const Vec3 home = model.home[i].topRightCorner<3, 1>();
     y[i] = (p > 0 ? y[p] : 0.0) + home.y();
-    // Relative joint motion from the cached absolute angles: cos/sin of phi_i - phi_p.
+    // Relative joint motion from the front pass's cos q_i, sin q_i.
     SE3& f = ws.f_parent[i];
-    if (model.prismatic[i]) {
+    if (model.prismatic[i])
       f = translation_se3(home + Vec3(ws.q[i], 0, 0));
-    } else {
-      const double c = ws.cos_phi[i] * ws.cos_phi[p] + ws.sin_phi[i] * ws.sin_phi[p];
-      const double s = ws.sin_phi[i] * ws.cos_phi[p] - ws.cos_phi[i] * ws.sin_phi[p];
-      f = make_se3(pin_rotation(c, s), home);
-    }
+    else
+      f = make_se3(pin_rotation(ws.joint_cos[i], ws.joint_sin[i]), home);
     // World pose: swing about z, then the link's absolute angle about -y; origin from the planar pass.
     const double c = ws.cos_phi[i], s = ws.sin_phi[i];
     Mat3 R;
     R << c0 * c, -s0, -c0 * s, s0 * c, c0, -s0 * s, s, 0, c;
     const Vec2& o = ws.origin[i];
     ws.X_Wi[i] = make_se3(R, p0 + Vec3(c0 * o.x() - s0 * y[i], s0 * o.x() + c0 * y[i], o.y()));
-    ws.V[i] = Ad_inv_apply(f, ws.V[p]) + model.screw[i] * qd[i];
+    ws.V[i] = Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], f.topRightCorner<3, 1>(), ws.V[p]) +
+              model.screw[i] * qd[i];
   }
+  ws.pin_valid = true;
   ws.tip_world = ws.X_Wi[kBucket].topLeftCorner<3, 3>() * model.tip_in_bucket +
                  ws.X_Wi[kBucket].topRightCorner<3, 1>();
 }
@@ -89,9 +89,13 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
     const Twist Vd_parent = p < 0 ? model.base_acceleration : Twist(ws.Vd[p]);
     // eq. 1 (corrected): Vd_i = Ad_{f^-1} Vd_p - ad_{S qd} Ad_{f^-1} V_p + S qdd; ad_{V_i} S qd is
     // the same term since ad_{S qd} S qd = 0.
-    ws.Vd[i] = Ad_inv_apply(ws.f_parent[i], Vd_parent) + ad_apply(ws.V[i], S_qd) + model.screw[i] * qdd[i];
-    const Wrench momentum = model.inertia[i] * ws.V[i];
-    ws.F[i] = model.inertia[i] * ws.Vd[i] - ad_dual_apply(ws.V[i], momentum);
+    const Twist Vd_moved = ws.pin_valid && i > 0
+                               ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), Vd_parent)
+                               : Ad_inv_apply(ws.f_parent[i], Vd_parent);
+    ws.Vd[i] = Vd_moved + ad_apply(ws.V[i], S_qd) + model.screw[i] * qdd[i];
+    const BodyInertia& b = model.machine.bodies[i];
+    const Wrench momentum = inertia_apply(b.mass, b.com, b.inertia, ws.V[i]);
+    ws.F[i] = inertia_apply(b.mass, b.com, b.inertia, ws.Vd[i]) - ad_dual_apply(ws.V[i], momentum);
   }
   // The soil pushes on the bucket with -f_soil at the tip T: the joints must supply +f_soil there
   // (paper eq. 2). f_soil is in the swing plane of the swing frame.
@@ -106,7 +110,11 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
   for (int i = kNumJoints - 1; i >= 0; --i) {
     tau[i] = model.screw[i].dot(ws.F[i]);  // eq. 1: tau_i = S_i^T F_i
     const int p = model.parent[i];
-    if (p >= 0) ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
+    if (p < 0) continue;
+    if (ws.pin_valid)
+      ws.F[p] += Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.F[i]);
+    else
+      ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
   }
   ws.tau_r = tau;
 }

@@ -19,6 +19,9 @@ struct Workspace {
   std::array<SE3, kNumJoints> X_Wi;
   std::array<SE3, kNumJoints> f_parent;
   std::array<Twist, kNumJoints> V, Vd;
+  // f_parent of the front links is a pin rotation about -y by q_i (cosine, sine in joint_cos,
+  // joint_sin) and f_parent's offset: set by tree_kinematics_from_front, cleared by tree_kinematics.
+  bool pin_valid = false;
   std::array<Wrench, kNumJoints> F;
   Vec12 tau_r = Vec12::Zero();
 
@@ -39,6 +42,9 @@ struct Workspace {
   // Planar front kinematics in the swing plane (front_kinematics.hpp): absolute link angles,
   // angular rates, origins and their derivatives, per tree joint (entry 0, the swing, stays zero).
   std::array<double, kNumJoints> phi{}, cos_phi{}, sin_phi{}, omega{}, alpha{};
+  // cos q_i and sin q_i of each front pin (1 and 0 for a slide), from the loop closure's vectors or
+  // from front_positions.
+  std::array<double, kNumJoints> joint_cos{}, joint_sin{};
   std::array<Vec2, kNumJoints> origin, origin_d, origin_dd;
   Vec8 Hd_qd = Vec8::Zero();                    // Hd qd: cut-pin relative acceleration at qdd = 0
   Eigen::Matrix<double, 2, 12> J_tip_tree = Eigen::Matrix<double, 2, 12>::Zero();  // d rho / d q

@@ -114,3 +114,13 @@ TEST_CASE("model/spatial inertia gives the kinetic energy of a body about its ce
   const double ke = 0.5 * m * v_com.squaredNorm() + 0.5 * w.dot(Ic * w);
   CHECK(0.5 * V.dot(J * V) == doctest::Approx(ke).epsilon(1e-12));
 }
+
+TEST_CASE("model/inertia_apply equals the spatial inertia matrix times the twist") {
+  for (int trial = 0; trial < 50; ++trial) {
+    const double m = u(1, 100);
+    const Vec3 c(u(-1, 1), u(-1, 1), u(-1, 1)), Ic(u(1, 2), u(1, 2), u(1, 2));
+    const Twist V = random_twist();
+    const Wrench expected = spatial_inertia(m, c, Ic.asDiagonal()) * V;
+    CHECK((inertia_apply(m, c, Ic, V) - expected).cwiseAbs().maxCoeff() < 1e-12 * (1 + expected.norm()));
+  }
+}
