@@ -29,6 +29,7 @@ void front_positions(const Model& model, const Vec12& q, Workspace& ws) {
 }
 
 void front_positions_from_joint_trig(const Model& model, const Vec12& q, Workspace& ws) {
+  ws.pin_valid = false;  // f_parent no longer matches joint_cos, joint_sin
   ws.phi[0] = 0;
   ws.cos_phi[0] = 1;
   ws.sin_phi[0] = 0;

@@ -95,6 +95,7 @@ ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_
   // Each pin angle from a vector of known length (a radius of its circle): cos q and sin q are
   // its components over that length, turned back by the reference direction where there is one;
   // one atan2 per pin and no further trig in the passes that follow.
+  ws.pin_valid = false;  // f_parent no longer matches joint_cos, joint_sin
   Vec12& q = ws.q;
   q[kSwing] = q_a[0];
   q[kBoomRod] = q_a[1];

@@ -122,34 +122,29 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
 template <int N>
 void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Matrix<double, 12, N>& A,
                         Eigen::Matrix<double, 12, N>& out) {
-  // The passes of tree_inverse_dynamics with V = 0 and no gravity, on N columns at once; the
-  // transforms act on 3 x N blocks (angular rows 0-2, linear rows 3-5).
-  using Block = Eigen::Matrix<double, 6, N>;
-  std::array<Block, kNumJoints> acc, force;
-  for (int i = 0; i < kNumJoints; ++i) {
-    const int p = model.parent[i];
-    acc[i].noalias() = model.screw[i] * A.row(i);
-    if (p >= 0) {
-      const auto R = ws.f_parent[i].template topLeftCorner<3, 3>();
-      const Mat3 P = skew(ws.f_parent[i].template topRightCorner<3, 1>());
-      // Ad_{f^-1}: (R^T w, R^T (v - [p] w))
-      acc[i].template topRows<3>().noalias() += R.transpose() * acc[p].template topRows<3>();
-      const Eigen::Matrix<double, 3, N> lin = acc[p].template bottomRows<3>() - P * acc[p].template topRows<3>();
-      acc[i].template bottomRows<3>().noalias() += R.transpose() * lin;
+  // The passes of tree_inverse_dynamics with V = 0 and no gravity, one acceleration column at a
+  // time, with the same transform and inertia products.
+  std::array<Twist, kNumJoints> acc;
+  std::array<Wrench, kNumJoints> force;
+  for (int col = 0; col < N; ++col) {
+    for (int i = 0; i < kNumJoints; ++i) {
+      const int p = model.parent[i];
+      acc[i] = model.screw[i] * A(i, col);
+      if (p >= 0) {
+        acc[i] += ws.pin_valid ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i],
+                                                  ws.f_parent[i].template topRightCorner<3, 1>(), acc[p])
+                               : Ad_inv_apply(ws.f_parent[i], acc[p]);
+      }
+      const BodyInertia& b = model.machine.bodies[i];
+      force[i] = inertia_apply(b.mass, b.com, b.inertia, acc[i]);
     }
-    force[i].noalias() = model.inertia[i] * acc[i];
-  }
-  for (int i = kNumJoints - 1; i >= 0; --i) {
-    out.row(i).noalias() = model.screw[i].transpose() * force[i];
-    const int p = model.parent[i];
-    if (p >= 0) {
-      const auto R = ws.f_parent[i].template topLeftCorner<3, 3>();
-      const Mat3 P = skew(ws.f_parent[i].template topRightCorner<3, 1>());
-      // Ad*_{f^-1}: (R m + [p] R f, R f)
-      const Eigen::Matrix<double, 3, N> f = R * force[i].template bottomRows<3>();
-      force[p].template topRows<3>().noalias() += R * force[i].template topRows<3>();
-      force[p].template topRows<3>().noalias() += P * f;
-      force[p].template bottomRows<3>() += f;
+    for (int i = kNumJoints - 1; i >= 0; --i) {
+      out(i, col) = model.screw[i].dot(force[i]);
+      const int p = model.parent[i];
+      if (p < 0) continue;
+      force[p] += ws.pin_valid ? Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i],
+                                                       ws.f_parent[i].template topRightCorner<3, 1>(), force[i])
+                               : Ad_inv_dual_apply(ws.f_parent[i], force[i]);
     }
   }
 }
