@@ -51,7 +51,8 @@ ModelReport forward_dynamics_augmented(const Model& model, Workspace& ws, const 
   front_tip(model, ws, tip, ws.J_tip_tree, ws.tip_acc_tree);
 
   // C qd + g + J^T f at qdd = 0, with the soil's added-mass term moved to the left-hand side.
-  tree_kinematics(model, ws, q, qd);
+  ws.q = q;
+  tree_kinematics_from_front(model, ws, qd);
   const Mat2 M_t = load.added_mass.asDiagonal();
   const Vec2 f_known = load.force + M_t * ws.tip_acc_tree;
   Vec12 bias;

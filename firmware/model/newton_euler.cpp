@@ -34,11 +34,14 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
 
 namespace {
 
-// Rotation about -y by the angle with cosine c and sine s (x turns toward +z).
-inline Mat3 pin_rotation(double c, double s) {
-  Mat3 R;
-  R << c, 0, -s, 0, 1, 0, s, 0, c;
-  return R;
+// Homogeneous transforms written by columns (column-major storage), without temporaries: these run
+// 24 times per update.
+inline void set_pose(SE3& T, const Vec3& x, const Vec3& y, const Vec3& z, const Vec3& p) {
+  double* d = T.data();
+  d[0] = x.x(), d[1] = x.y(), d[2] = x.z(), d[3] = 0;
+  d[4] = y.x(), d[5] = y.y(), d[6] = y.z(), d[7] = 0;
+  d[8] = z.x(), d[9] = z.y(), d[10] = z.z(), d[11] = 0;
+  d[12] = p.x(), d[13] = p.y(), d[14] = p.z(), d[15] = 1;
 }
 
 }  // namespace
@@ -55,24 +58,25 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
   ws.X_Wi[0] = ws.f_parent[0];
   ws.V[0] = model.screw[0] * qd[0];
   const Vec3 p0 = ws.X_Wi[0].topRightCorner<3, 1>();
+  const Vec3 swing_y(-s0, c0, 0);  // every front link's y axis in the world
   std::array<double, kNumJoints> y{};  // out-of-plane offset of each origin (pin rotations keep it)
   for (int i = 1; i < kNumJoints; ++i) {
     const int p = model.parent[i];
     const Vec3 home = model.home[i].topRightCorner<3, 1>();
     y[i] = (p > 0 ? y[p] : 0.0) + home.y();
-    // Relative joint motion from the front pass's cos q_i, sin q_i.
+    // Relative motion: a pin rotation about -y by q_i (cos, sin from the front pass) or a slide.
     SE3& f = ws.f_parent[i];
+    const double c = ws.joint_cos[i], s = ws.joint_sin[i];
     if (model.prismatic[i])
-      f = translation_se3(home + Vec3(ws.q[i], 0, 0));
+      set_pose(f, Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), home + Vec3(ws.q[i], 0, 0));
     else
-      f = make_se3(pin_rotation(ws.joint_cos[i], ws.joint_sin[i]), home);
+      set_pose(f, Vec3(c, 0, s), Vec3::UnitY(), Vec3(-s, 0, c), home);
     // World pose: swing about z, then the link's absolute angle about -y; origin from the planar pass.
-    const double c = ws.cos_phi[i], s = ws.sin_phi[i];
-    Mat3 R;
-    R << c0 * c, -s0, -c0 * s, s0 * c, c0, -s0 * s, s, 0, c;
+    const double ca = ws.cos_phi[i], sa = ws.sin_phi[i];
     const Vec2& o = ws.origin[i];
-    ws.X_Wi[i] = make_se3(R, p0 + Vec3(c0 * o.x() - s0 * y[i], s0 * o.x() + c0 * y[i], o.y()));
-    ws.V[i] = Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], f.topRightCorner<3, 1>(), ws.V[p]) +
+    set_pose(ws.X_Wi[i], Vec3(c0 * ca, s0 * ca, sa), swing_y, Vec3(-c0 * sa, -s0 * sa, ca),
+             p0 + Vec3(c0 * o.x() - s0 * y[i], s0 * o.x() + c0 * y[i], o.y()));
+    ws.V[i] = Ad_inv_apply_pin(c, s, home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0), ws.V[p]) +
               model.screw[i] * qd[i];
   }
   ws.pin_valid = true;

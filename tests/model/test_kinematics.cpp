@@ -134,6 +134,39 @@ TEST_CASE("model/tree kinematics from the planar front pass equals the general L
   for (int i = 0; i < kNumJoints; ++i) CHECK((f2.X_Wi[i] - g2.X_Wi[i]).cwiseAbs().maxCoeff() < 1e-12);
 }
 
+TEST_CASE("model/Newton-Euler and M_r on the pin transforms equal the general Lie-group pass") {
+  const Model& m = reference_model();
+  REQUIRE(m.planar_front);
+  Workspace fast(m), general(m);
+  test::RandomStates rs(37);
+  for (int trial = 0; trial < 100; ++trial) {
+    Vec12 q, qd, qdd;
+    for (int i = 0; i < kNumJoints; ++i) {
+      q[i] = m.prismatic[i] ? rs.uniform(1.5, 3.0) : rs.uniform(-M_PI, M_PI);
+      qd[i] = rs.uniform(-1, 1);
+      qdd[i] = rs.uniform(-2, 2);
+    }
+    fast.q = q;
+    front_positions(m, q, fast);
+    tree_kinematics_from_front(m, fast, qd);
+    tree_kinematics(m, general, q, qd);
+    REQUIRE(fast.pin_valid);
+    REQUIRE_FALSE(general.pin_valid);
+    const Vec2 f_soil(rs.uniform(-5e4, 5e4), rs.uniform(-5e4, 5e4));
+    Vec12 tau_fast, tau_general;
+    tree_inverse_dynamics(m, fast, qdd, f_soil, tau_fast);
+    tree_inverse_dynamics(m, general, qdd, f_soil, tau_general);
+    CHECK((tau_fast - tau_general).cwiseAbs().maxCoeff() < 1e-9 * (1 + tau_general.cwiseAbs().maxCoeff()));
+    Mat12 M_fast, M_general;
+    tree_mass_matrix(m, fast, M_fast);
+    tree_mass_matrix(m, general, M_general);
+    CHECK((M_fast - M_general).cwiseAbs().maxCoeff() < 1e-9 * (1 + M_general.cwiseAbs().maxCoeff()));
+  }
+  // After new positions the pin transforms are stale until the tree pass runs again.
+  front_positions(m, Vec12::Constant(2.0), fast);
+  CHECK_FALSE(fast.pin_valid);
+}
+
 TEST_CASE("model/Psi, gamma and the tip Jacobian match finite differences of the loop closure") {
   const Model& m = reference_model();
   Workspace ws(m), wp(m), wm(m);
