@@ -76,8 +76,8 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
     const Vec2& o = ws.origin[i];
     set_pose(ws.X_Wi[i], Vec3(c0 * ca, s0 * ca, sa), swing_y, Vec3(-c0 * sa, -s0 * sa, ca),
              p0 + Vec3(c0 * o.x() - s0 * y[i], s0 * o.x() + c0 * y[i], o.y()));
-    ws.V[i] = Ad_inv_apply_pin(c, s, home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0), ws.V[p]) +
-              model.screw[i] * qd[i];
+    ws.V[i] = Ad_inv_apply_pin(c, s, home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0), ws.V[p]);
+    ws.V[i][model.prismatic[i] ? 3 : 1] += model.prismatic[i] ? qd[i] : -qd[i];  // + S_i qd_i
   }
   ws.pin_valid = true;
   ws.tip_world = ws.X_Wi[kBucket].topLeftCorner<3, 3>() * model.tip_in_bucket +
@@ -89,36 +89,65 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
   // Forward: accelerations, with gravity as the base acceleration Vd_0 (model.md s.3).
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
-    const Twist S_qd = model.screw[i] * ws.qd[i];
-    const Twist Vd_parent = p < 0 ? model.base_acceleration : Twist(ws.Vd[p]);
-    // eq. 1 (corrected): Vd_i = Ad_{f^-1} Vd_p - ad_{S qd} Ad_{f^-1} V_p + S qdd; ad_{V_i} S qd is
-    // the same term since ad_{S qd} S qd = 0.
-    const Twist Vd_moved = ws.pin_valid && i > 0
-                               ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), Vd_parent)
-                               : Ad_inv_apply(ws.f_parent[i], Vd_parent);
-    ws.Vd[i] = Vd_moved + ad_apply(ws.V[i], S_qd) + model.screw[i] * qdd[i];
+    const Twist& V = ws.V[i];
+    Twist& Vd = ws.Vd[i];
+    if (ws.pin_valid && i > 0) {
+      // The front's screws are known (build_model checked them): a pin S = (-e_y, 0) or a slide
+      // S = (0, e_x), so S qdd and ad_V (S qd) are a few products.
+      Vd = Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.Vd[p]);
+      const double rate = ws.qd[i];
+      if (model.prismatic[i]) {
+        Vd[3] += qdd[i];
+        Vd[4] += rate * V[2];
+        Vd[5] -= rate * V[1];
+      } else {
+        Vd[1] -= qdd[i];
+        Vd[0] += rate * V[2];
+        Vd[2] -= rate * V[0];
+        Vd[3] += rate * V[5];
+        Vd[5] -= rate * V[3];
+      }
+    } else {
+      const Twist S_qd = model.screw[i] * ws.qd[i];
+      const Twist Vd_parent = p < 0 ? model.base_acceleration : Twist(ws.Vd[p]);
+      // eq. 1 (corrected): Vd_i = Ad_{f^-1} Vd_p - ad_{S qd} Ad_{f^-1} V_p + S qdd; ad_{V_i} S qd is
+      // the same term since ad_{S qd} S qd = 0.
+      Vd = Ad_inv_apply(ws.f_parent[i], Vd_parent) + ad_apply(V, S_qd) + model.screw[i] * qdd[i];
+    }
     const BodyInertia& b = model.machine.bodies[i];
-    const Wrench momentum = inertia_apply(b.mass, b.com, b.inertia, ws.V[i]);
-    ws.F[i] = inertia_apply(b.mass, b.com, b.inertia, ws.Vd[i]) - ad_dual_apply(ws.V[i], momentum);
+    const Wrench momentum = inertia_apply(b.mass, b.com, b.inertia, V);
+    ws.F[i] = inertia_apply(b.mass, b.com, b.inertia, Vd) - ad_dual_apply(V, momentum);
   }
   // The soil pushes on the bucket with -f_soil at the tip T: the joints must supply +f_soil there
   // (paper eq. 2). f_soil is in the swing plane of the swing frame.
   if (f_soil.x() != 0.0 || f_soil.y() != 0.0) {
-    const Mat3 R_sw_bucket = ws.X_Wi[kSwing].topLeftCorner<3, 3>().transpose() *
-                             ws.X_Wi[kBucket].topLeftCorner<3, 3>();
-    const Vec3 f_b = R_sw_bucket.transpose() * Vec3(f_soil.x(), 0.0, f_soil.y());
+    Vec3 f_b;  // in the bucket frame
+    if (ws.pin_valid) {
+      // The bucket is turned from the swing frame about -y by its absolute angle in the plane.
+      const double c = ws.cos_phi[kBucket], s = ws.sin_phi[kBucket];
+      f_b << c * f_soil.x() + s * f_soil.y(), 0.0, c * f_soil.y() - s * f_soil.x();
+    } else {
+      const Mat3 R_sw_bucket = ws.X_Wi[kSwing].topLeftCorner<3, 3>().transpose() *
+                               ws.X_Wi[kBucket].topLeftCorner<3, 3>();
+      f_b = R_sw_bucket.transpose() * Vec3(f_soil.x(), 0.0, f_soil.y());
+    }
     ws.F[kBucket].head<3>() += model.tip_in_bucket.cross(f_b);
     ws.F[kBucket].tail<3>() += f_b;
   }
   // Backward: children have higher indices than their parents (Table 1 order).
   for (int i = kNumJoints - 1; i >= 0; --i) {
-    tau[i] = model.screw[i].dot(ws.F[i]);  // eq. 1: tau_i = S_i^T F_i
     const int p = model.parent[i];
-    if (p < 0) continue;
-    if (ws.pin_valid)
+    if (p < 0) {
+      tau[i] = model.screw[i].dot(ws.F[i]);  // eq. 1: tau_i = S_i^T F_i
+      continue;
+    }
+    if (ws.pin_valid) {
+      tau[i] = model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1];
       ws.F[p] += Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.F[i]);
-    else
+    } else {
+      tau[i] = model.screw[i].dot(ws.F[i]);
       ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
+    }
   }
   ws.tau_r = tau;
 }
