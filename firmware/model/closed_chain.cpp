@@ -13,6 +13,15 @@ namespace exc {
 namespace {
 // The soil and gravity are the only external loads; for M_a and h_a the soil is left out.
 const Vec2 kNoSoil = Vec2::Zero();
+
+// B A for B = H_p^-1 (or its transpose), block diagonal by loops (2, 2, 4): a third of the products of
+// the full 8 x 8 one.
+template <typename Block8, typename In, typename Out>
+void times_block_diagonal(const Block8& B, const In& A, Out& out) {
+  out.template topRows<2>().noalias() = B.template block<2, 2>(0, 0).lazyProduct(A.template topRows<2>());
+  out.template middleRows<2>(2).noalias() = B.template block<2, 2>(2, 2).lazyProduct(A.template middleRows<2>(2));
+  out.template bottomRows<4>().noalias() = B.template block<4, 4>(4, 4).lazyProduct(A.template bottomRows<4>());
+}
 }  // namespace
 
 ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a) {
@@ -37,18 +46,21 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   ws.Hp_inv.block<2, 2>(0, 0) = H_p.block<2, 2>(0, 0).inverse();
   ws.Hp_inv.block<2, 2>(2, 2) = H_p.block<2, 2>(2, 2).inverse();
   ws.Hp_inv.block<4, 4>(4, 4) = H_p.block<4, 4>(4, 4).inverse();
-  const Mat8x4 dqp_dqa = -(ws.Hp_inv.lazyProduct(H_a));
+  Mat8x4 dqp_dqa;
+  Vec8 gamma_p;
+  times_block_diagonal(ws.Hp_inv, H_a, dqp_dqa);
+  dqp_dqa = -dqp_dqa;
   ws.Psi.setZero();
   for (int k = 0; k < kNumActive; ++k) ws.Psi(kActiveJoints[k], k) = 1.0;
   for (int k = 0; k < kNumPassive; ++k) ws.Psi.row(kPassiveJoints[k]) = dqp_dqa.row(k);
-  ws.qd = ws.Psi * qd_a;
+  ws.qd.noalias() = ws.Psi.lazyProduct(qd_a);
 
   // Acceleration bias: with qdd = 0 the cut pins accelerate apart by Hd qd; gamma = (0; -H_p^-1 Hd qd).
   front_rates(model, ws.qd, Vec12::Zero(), ws);
   front_loop_acceleration(model, ws, ws.Hd_qd);
-  const Vec8 gamma_p = -(ws.Hp_inv * ws.Hd_qd);
+  times_block_diagonal(ws.Hp_inv, ws.Hd_qd, gamma_p);
   ws.gamma.setZero();
-  for (int k = 0; k < kNumPassive; ++k) ws.gamma[kPassiveJoints[k]] = gamma_p[k];
+  for (int k = 0; k < kNumPassive; ++k) ws.gamma[kPassiveJoints[k]] = -gamma_p[k];
   if (!ws.Psi.allFinite() || !ws.gamma.allFinite()) {
     ws.report = ModelReport{ModelStatus::singular, -1, 0};
     return ws.report;
@@ -58,9 +70,10 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   Vec2 tip;
   front_tip(model, ws, tip, ws.J_tip_tree, ws.tip_acc_tree);
   ws.rho = tip + Vec2(0.0, model.machine.swing_height);
-  ws.J_t = ws.J_tip_tree * ws.Psi;
-  ws.rhod = ws.J_t * qd_a;
-  ws.rhodd_bias = ws.tip_acc_tree + ws.J_tip_tree * ws.gamma;
+  ws.J_t.noalias() = ws.J_tip_tree.lazyProduct(ws.Psi);
+  ws.rhod.noalias() = ws.J_t.lazyProduct(qd_a);
+  ws.rhodd_bias = ws.tip_acc_tree;
+  ws.rhodd_bias.noalias() += ws.J_tip_tree.lazyProduct(ws.gamma);
 
   // Tree poses and twists for Newton-Euler (also fills ws.tip_world), from the planar pass above.
   tree_kinematics_from_front(model, ws, ws.qd);
@@ -68,13 +81,14 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
 }
 
 void inverse_dynamics(const Model& model, Workspace& ws, const Vec4& qdd_a, const Vec2& f_soil, Vec4& tau_a) {
-  ws.qdd = ws.Psi * qdd_a + ws.gamma;  // eq. 16a, differentiated
+  ws.qdd.noalias() = ws.Psi.lazyProduct(qdd_a);  // eq. 16a, differentiated
+  ws.qdd += ws.gamma;
   tree_inverse_dynamics(model, ws, ws.qdd, f_soil, ws.tau_r);
-  tau_a = ws.Psi.transpose() * ws.tau_r;  // eq. 16b
+  tau_a.noalias() = ws.Psi.transpose().lazyProduct(ws.tau_r);  // eq. 16b
   // eq. 7a: tau_r = tau_act + H^T F_c with tau_act zero on the passive joints, so H_p^T F_c = tau_p.
   Vec8 tau_p;
   for (int k = 0; k < kNumPassive; ++k) tau_p[k] = ws.tau_r[kPassiveJoints[k]];
-  ws.F_c = ws.Hp_inv.transpose() * tau_p;
+  times_block_diagonal(ws.Hp_inv.transpose(), tau_p, ws.F_c);
 }
 
 void mass_matrix(const Model& model, Workspace& ws, Mat4& M_a) {
@@ -87,7 +101,7 @@ void mass_matrix(const Model& model, Workspace& ws, Mat4& M_a) {
 void bias_forces(const Model& model, Workspace& ws, Vec4& h_a) {
   Vec12 tau;
   tree_inverse_dynamics(model, ws, ws.gamma, kNoSoil, tau);  // C_r qd + g_r + M_r gamma
-  h_a = ws.Psi.transpose() * tau;
+  h_a.noalias() = ws.Psi.transpose().lazyProduct(tau);
 }
 
 }  // namespace exc
