@@ -7,6 +7,7 @@
 #include "lie_group.hpp"
 #include "loop_closure.hpp"
 #include "newton_euler.hpp"
+#include "projected_inertia.hpp"
 
 namespace exc {
 
@@ -92,10 +93,7 @@ void inverse_dynamics(const Model& model, Workspace& ws, const Vec4& qdd_a, cons
 }
 
 void mass_matrix(const Model& model, Workspace& ws, Mat4& M_a) {
-  Mat12x4 MPsi;
-  tree_inertia_times<4>(model, ws, ws.Psi, MPsi);
-  M_a = ws.Psi.transpose().lazyProduct(MPsi);  // eq. 17
-  M_a = (0.5 * (M_a + M_a.transpose())).eval();
+  projected_mass_matrix(model, ws, ws.Psi, M_a);  // eq. 17
 }
 
 void bias_forces(const Model& model, Workspace& ws, Vec4& h_a) {

@@ -55,6 +55,9 @@ Model build_model(const Machine& machine) {
   for (int i = 0; i < kNumJoints; ++i) {
     const BodyInertia& b = k.bodies[i];
     m.inertia[i] = spatial_inertia(b.mass, b.com, b.inertia.asDiagonal());
+    constexpr std::array<int, 3> in_plane_rows = {1, 3, 5};
+    for (int a = 0; a < 3; ++a)
+      for (int c = 0; c < 3; ++c) m.inertia_in_plane[i](a, c) = m.inertia[i](in_plane_rows[a], in_plane_rows[c]);
   }
 
   // Table 2: P_l carries the pin at point_p, S_l reaches it at point_s.

@@ -22,6 +22,7 @@ struct Model {
   // translations: the tree poses can then come from the planar front pass (set by build_model).
   bool planar_front = false;
   std::array<Mat6, kNumJoints> inertia;    // J_i about the frame origin, (w, v) ordering
+  std::array<Mat3, kNumJoints> inertia_in_plane;  // J_i on (w_y, v_x, v_z): the planar front's block
   std::array<LoopCut, kNumLoops> loops;
   Vec3 tip_in_bucket;                      // T in the bucket frame
   Vec6 base_acceleration;                  // Vd_0 = (0, 0, 0, 0, 0, +g): gravity (model.md s.3)
