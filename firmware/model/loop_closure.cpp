@@ -31,11 +31,12 @@ Intersection intersect_circles(const Vec2& A, double ra, const Vec2& B, double r
   const Vec2 AB = B - A;
   const double d = AB.norm();
   if (!(d > 0) || !(ra > 0) || !(rb > 0)) return out;
-  const double a = (ra * ra - rb * rb + d * d) / (2.0 * d);
+  const double inv_d = 1.0 / d;  // one division; the rest are products (this runs 4 times per update)
+  const double a = 0.5 * (ra * ra - rb * rb + d * d) * inv_d;
   const double h2 = ra * ra - a * a;
   if (!(h2 >= 0)) return out;  // the circles do not meet: no assembly
   const double h = std::sqrt(h2);
-  const Vec2 e = AB / d;
+  const Vec2 e = AB * inv_d;
   out.point = A + a * e + side * h * Vec2(-e.y(), e.x());
   out.sine = h * d / (ra * rb);  // |cross(A - P, B - P)| / (ra rb)
   out.exists = true;
@@ -114,15 +115,16 @@ ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_
   auto relative = [](const Vec2& v, const Vec2& ref) {
     return Vec2(v.x() * ref.x() + v.y() * ref.y(), v.y() * ref.x() - v.x() * ref.y());
   };
-  set_pin(kBoom, relative((E.point - m.C) / boom_E_radius, m.E / boom_E_radius));
-  set_pin(kBoomBarrel, (E.point - m.D) / q_a[1]);
-  set_pin(kArm, relative((G.point - m.H) / arm_G_radius, m.G / arm_G_radius));
-  set_pin(kArmBarrel, (G.point - m.F) / q_a[2]);
-  set_pin(kBucketBarrel, (J.point - m.I) / q_a[3]);
-  set_pin(kBucket, (L.point - m.M) / m.L.x());  // L lies on the bucket x axis
+  // relative(v / r, ref / r) = relative(v, ref) / r^2.
+  set_pin(kBoom, relative(E.point - m.C, m.E) * (1.0 / (boom_E_radius * boom_E_radius)));
+  set_pin(kBoomBarrel, (E.point - m.D) * (1.0 / q_a[1]));
+  set_pin(kArm, relative(G.point - m.H, m.G) * (1.0 / (arm_G_radius * arm_G_radius)));
+  set_pin(kArmBarrel, (G.point - m.F) * (1.0 / q_a[2]));
+  set_pin(kBucketBarrel, (J.point - m.I) * (1.0 / q_a[3]));
+  set_pin(kBucket, (L.point - m.M) * (1.0 / m.L.x()));  // L lies on the bucket x axis
   const Vec2 bucket_barrel(ws.joint_cos[kBucketBarrel], ws.joint_sin[kBucketBarrel]);
-  set_pin(kLink11, relative((L.point - J.point) / m.JL, bucket_barrel));
-  set_pin(kLink12, relative((m.K - J.point) / m.JK, bucket_barrel));
+  set_pin(kLink11, relative(L.point - J.point, bucket_barrel) * (1.0 / m.JL));
+  set_pin(kLink12, relative(m.K - J.point, bucket_barrel) * (1.0 / m.JK));
 
   ModelReport r;
   r.conditioning = conditioning;

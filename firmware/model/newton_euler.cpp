@@ -52,9 +52,9 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
     return;
   }
   ws.qd = qd;
-  ws.f_parent[0] = joint_motion(model.screw[0], ws.q[0], false);
-  ws.f_parent[0].topRightCorner<3, 1>() += model.home[0].topRightCorner<3, 1>();
-  const double c0 = ws.f_parent[0](0, 0), s0 = ws.f_parent[0](1, 0);  // the swing's cos, sin (about z)
+  double s0, c0;  // the swing's sin, cos (about z)
+  ::sincos(ws.q[0], &s0, &c0);
+  set_pose(ws.f_parent[0], Vec3(c0, s0, 0), Vec3(-s0, c0, 0), Vec3::UnitZ(), model.home[0].topRightCorner<3, 1>());
   ws.X_Wi[0] = ws.f_parent[0];
   ws.V[0] = model.screw[0] * qd[0];
   const Vec3 p0 = ws.X_Wi[0].topRightCorner<3, 1>();
