@@ -1,5 +1,7 @@
 #include "sim_plant/mechanical_energy.hpp"
 
+#include "model/newton_euler.hpp"
+
 namespace exc::plant {
 
 double kinetic_energy(const Model& model, const Workspace& ws) {
@@ -8,7 +10,8 @@ double kinetic_energy(const Model& model, const Workspace& ws) {
   return t;
 }
 
-double potential_energy(const Model& model, const Workspace& ws) {
+double potential_energy(const Model& model, Workspace& ws) {
+  tree_world_poses(model, ws);  // the dynamics passes leave the front's world poses out
   double u = 0;
   for (int i = 0; i < kNumJoints; ++i) {
     const BodyInertia& b = model.machine.bodies[i];

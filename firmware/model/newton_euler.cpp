@@ -10,6 +10,7 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
   ws.q = q;
   ws.qd = qd;
   ws.pin_valid = false;
+  ws.front_world_poses_valid = true;
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
     // eq. 1: f = M exp([S] q), with the closed form for a revolute or prismatic screw.
@@ -46,6 +47,29 @@ inline void set_pose(SE3& T, const Vec3& x, const Vec3& y, const Vec3& z, const 
 
 }  // namespace
 
+namespace {
+
+// Out-of-plane offset of each front origin (pin rotations and slides keep it).
+std::array<double, kNumJoints> front_y_offsets(const Model& model) {
+  std::array<double, kNumJoints> y{};
+  for (int i = 1; i < kNumJoints; ++i)
+    y[i] = (model.parent[i] > 0 ? y[model.parent[i]] : 0.0) + model.home[i](1, 3);
+  return y;
+}
+
+// World pose of front link i: swing about z, then the link's absolute angle about -y; origin from
+// the planar pass.
+void set_front_world_pose(const Workspace& ws, int i, double y, SE3& X) {
+  const SE3& X0 = ws.X_Wi[0];
+  const double c0 = X0(0, 0), s0 = X0(1, 0);
+  const double ca = ws.cos_phi[i], sa = ws.sin_phi[i];
+  const Vec2& o = ws.origin[i];
+  set_pose(X, Vec3(c0 * ca, s0 * ca, sa), Vec3(-s0, c0, 0), Vec3(-c0 * sa, -s0 * sa, ca),
+           X0.topRightCorner<3, 1>() + Vec3(c0 * o.x() - s0 * y, s0 * o.x() + c0 * y, o.y()));
+}
+
+}  // namespace
+
 void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& qd) {
   if (!model.planar_front) {
     tree_kinematics(model, ws, Vec12(ws.q), qd);
@@ -57,13 +81,9 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
   set_pose(ws.f_parent[0], Vec3(c0, s0, 0), Vec3(-s0, c0, 0), Vec3::UnitZ(), model.home[0].topRightCorner<3, 1>());
   ws.X_Wi[0] = ws.f_parent[0];
   ws.V[0] = model.screw[0] * qd[0];
-  const Vec3 p0 = ws.X_Wi[0].topRightCorner<3, 1>();
-  const Vec3 swing_y(-s0, c0, 0);  // every front link's y axis in the world
-  std::array<double, kNumJoints> y{};  // out-of-plane offset of each origin (pin rotations keep it)
   for (int i = 1; i < kNumJoints; ++i) {
     const int p = model.parent[i];
     const Vec3 home = model.home[i].topRightCorner<3, 1>();
-    y[i] = (p > 0 ? y[p] : 0.0) + home.y();
     // Relative motion: a pin rotation about -y by q_i (cos, sin from the front pass) or a slide.
     SE3& f = ws.f_parent[i];
     const double c = ws.joint_cos[i], s = ws.joint_sin[i];
@@ -71,17 +91,21 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
       set_pose(f, Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), home + Vec3(ws.q[i], 0, 0));
     else
       set_pose(f, Vec3(c, 0, s), Vec3::UnitY(), Vec3(-s, 0, c), home);
-    // World pose: swing about z, then the link's absolute angle about -y; origin from the planar pass.
-    const double ca = ws.cos_phi[i], sa = ws.sin_phi[i];
-    const Vec2& o = ws.origin[i];
-    set_pose(ws.X_Wi[i], Vec3(c0 * ca, s0 * ca, sa), swing_y, Vec3(-c0 * sa, -s0 * sa, ca),
-             p0 + Vec3(c0 * o.x() - s0 * y[i], s0 * o.x() + c0 * y[i], o.y()));
     ws.V[i] = Ad_inv_apply_pin(c, s, home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0), ws.V[p]);
     ws.V[i][model.prismatic[i] ? 3 : 1] += model.prismatic[i] ? qd[i] : -qd[i];  // + S_i qd_i
   }
   ws.pin_valid = true;
-  ws.tip_world = ws.X_Wi[kBucket].topLeftCorner<3, 3>() * model.tip_in_bucket +
-                 ws.X_Wi[kBucket].topRightCorner<3, 1>();
+  ws.front_world_poses_valid = false;
+  SE3 X_bucket;
+  set_front_world_pose(ws, kBucket, front_y_offsets(model)[kBucket], X_bucket);
+  ws.tip_world = X_bucket.topLeftCorner<3, 3>() * model.tip_in_bucket + X_bucket.topRightCorner<3, 1>();
+}
+
+void tree_world_poses(const Model& model, Workspace& ws) {
+  if (ws.front_world_poses_valid) return;
+  const std::array<double, kNumJoints> y = front_y_offsets(model);
+  for (int i = 1; i < kNumJoints; ++i) set_front_world_pose(ws, i, y[i], ws.X_Wi[i]);
+  ws.front_world_poses_valid = true;
 }
 
 void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, const Vec2& f_soil,

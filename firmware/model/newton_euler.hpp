@@ -11,9 +11,14 @@ void tree_kinematics(const Model& model, Workspace& ws, const Vec12& q, const Ve
 
 // The same forward pass at q = ws.q, reusing the planar front pass that front_positions(model, ws.q,
 // ws) has just made (link angles' cosines and sines, origins in the swing plane): no per-link trig and
-// no 3x3 products. Falls back to tree_kinematics when the tree is not a planar front
-// (model.planar_front, decided once by build_model).
+// no 3x3 products. The front links' world poses X_Wi, which the dynamics does not use, are left to
+// tree_world_poses (X_Wi[0] and tip_world are set). Falls back to tree_kinematics when the tree is
+// not a planar front (model.planar_front, decided once by build_model).
 void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& qd);
+
+// Every X_Wi after tree_kinematics_from_front (or update_closed_chain), from the planar pass; a
+// no-op after tree_kinematics, which fills them itself.
+void tree_world_poses(const Model& model, Workspace& ws);
 
 // Inverse dynamics of the tree at the state of the last tree_kinematics, with joint accelerations
 // qdd, gravity (base acceleration Vd_0), and the force f_soil that the bucket exerts on the soil at

@@ -16,7 +16,8 @@ struct Workspace {
 
   // Kinematics of the tree: pose of each link in the base (swing-axis ground origin = world),
   // relative transforms f_{lambda(i),i}, body twists and accelerations, body wrenches.
-  std::array<SE3, kNumJoints> X_Wi;
+  std::array<SE3, kNumJoints> X_Wi;  // front links' entries only after tree_world_poses (see there)
+  bool front_world_poses_valid = true;
   std::array<SE3, kNumJoints> f_parent;
   std::array<Twist, kNumJoints> V, Vd;
   // f_parent of the front links is a pin rotation about -y by q_i (cosine, sine in joint_cos,

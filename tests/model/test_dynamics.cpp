@@ -78,6 +78,7 @@ TEST_CASE("model/closed-chain inverse dynamics satisfies the power balance tau_a
   const test::SmoothTrajectory tr(m);
   auto poses = [&](double t) {
     REQUIRE(update_closed_chain(m, ws, tr.q(t), tr.qd(t)).ok());
+    tree_world_poses(m, ws);
     return ws.X_Wi;
   };
   const double d = 1e-5, h = 1e-4;

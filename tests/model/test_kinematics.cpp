@@ -39,6 +39,7 @@ TEST_CASE("model/both reference poses are reproduced (0.5 mm, 0.01 deg)") {
   for (const ReferencePose& pose : m.machine.reference_poses) {
     CAPTURE(pose.q_a.transpose());
     REQUIRE(update_closed_chain(m, ws, pose.q_a, Vec4::Zero()).ok());
+    tree_world_poses(m, ws);
     CHECK(std::abs(ws.q[kBoom] * kDeg - pose.boom_angle_deg) < 0.01);
     CHECK(std::abs(ws.q[kArm] * kDeg - pose.arm_angle_deg) < 0.01);
     CHECK(std::abs(ws.q[kBucket] * kDeg - pose.bucket_angle_deg) < 0.01);
@@ -112,6 +113,8 @@ TEST_CASE("model/tree kinematics from the planar front pass equals the general L
     front_positions(m, q, fast);
     tree_kinematics_from_front(m, fast, qd);
     tree_kinematics(m, general, q, qd);
+    CHECK_FALSE(fast.front_world_poses_valid);
+    tree_world_poses(m, fast);
     for (int i = 0; i < kNumJoints; ++i) {
       CHECK((fast.X_Wi[i] - general.X_Wi[i]).cwiseAbs().maxCoeff() < 1e-12);
       CHECK((fast.f_parent[i] - general.f_parent[i]).cwiseAbs().maxCoeff() < 1e-12);
@@ -131,6 +134,7 @@ TEST_CASE("model/tree kinematics from the planar front pass equals the general L
   front_positions(m2, q, f2);
   tree_kinematics_from_front(m2, f2, qd);
   tree_kinematics(m2, g2, q, qd);
+  tree_world_poses(m2, f2);
   for (int i = 0; i < kNumJoints; ++i) CHECK((f2.X_Wi[i] - g2.X_Wi[i]).cwiseAbs().maxCoeff() < 1e-12);
 }
 
