@@ -9,6 +9,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
+#include <algorithm>
 
 namespace fs = std::filesystem;
 
@@ -23,7 +25,64 @@ int data_lines(const fs::path& p) {
 }
 }  // namespace
 
-TEST_CASE("tools/excavator-bench --quick writes its json and csvs") {
+namespace {
+// One recommended fidelity per scene: within tolerance, the cheapest up to the timing noise (15 %), and
+// no simpler model (a later row) within tolerance at an equal cost.
+void check_recommendations(const fs::path& csv) {
+  REQUIRE(fs::exists(csv));
+  std::ifstream f(csv);
+  std::string header, line;
+  std::getline(f, header);
+  auto column = [&](const std::string& name) {
+    int index = 0;
+    std::size_t start = 0;
+    for (std::size_t end; (end = header.find(',', start)) != std::string::npos; start = end + 1, ++index)
+      if (header.substr(start, end - start) == name) return index;
+    return header.substr(start) == name ? index : -1;
+  };
+  const int c_scene = column("scene"), c_within = column("within_tolerance"), c_rec = column("recommended"),
+            c_cpu = column("cpu_s_per_sim_s");
+  REQUIRE(c_scene >= 0);
+  REQUIRE(c_within >= 0);
+  REQUIRE(c_rec >= 0);
+  REQUIRE(c_cpu >= 0);
+  struct Row {
+    std::string scene;
+    bool within, recommended;
+    double cpu;
+  };
+  std::vector<Row> rows;
+  while (std::getline(f, line)) {
+    if (line.empty()) continue;
+    std::vector<std::string> cells;
+    std::size_t start = 0;
+    for (std::size_t end; (end = line.find(',', start)) != std::string::npos && line[start] != '"'; start = end + 1)
+      cells.push_back(line.substr(start, end - start));
+    cells.push_back(line.substr(start));
+    REQUIRE(static_cast<int>(cells.size()) > std::max({c_scene, c_within, c_rec, c_cpu}));
+    rows.push_back({cells[c_scene], cells[c_within] == "1", cells[c_rec] == "1",
+                    cells[c_cpu].empty() ? NAN : std::atof(cells[c_cpu].c_str())});
+  }
+  for (const char* scene : {"free_motion", "dig"}) {
+    INFO(scene);
+    int recommended = -1, count = 0;
+    double cheapest = INFINITY;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (rows[i].scene != scene) continue;
+      if (rows[i].recommended) recommended = static_cast<int>(i), ++count;
+      if (rows[i].within) cheapest = std::min(cheapest, rows[i].cpu);
+    }
+    REQUIRE(count == 1);
+    CHECK(rows[recommended].within);
+    CHECK(rows[recommended].cpu <= 1.15 * cheapest + 1e-12);
+    // No simpler model (a later row) within tolerance at an equal cost.
+    for (std::size_t i = recommended + 1; i < rows.size(); ++i)
+      if (rows[i].scene == scene) CHECK_FALSE((rows[i].within && rows[i].cpu <= 1.15 * cheapest));
+  }
+}
+}  // namespace
+
+TEST_CASE("tools/excavator-bench --quick writes its json and csvs and recommends one fidelity per scene") {
   const fs::path out = fs::path(EXC_BINARY_DIR) / "tests/bench/quick";
   fs::remove_all(out);
   const fs::path json_path = out / "summary.json";
@@ -70,4 +129,5 @@ TEST_CASE("tools/excavator-bench --quick writes its json and csvs") {
     INFO(csv);
     CHECK(data_lines(out / csv) > 0);
   }
+  check_recommendations(out / "fidelity.csv");
 }

@@ -392,6 +392,7 @@ struct FidelityRow {
 constexpr double kTipTolerance = 0.01;       // m, RMS tip path difference
 constexpr double kForceTolerance = 0.05;     // relative RMS cylinder-force difference
 constexpr double kTrackingTolerance = 0.002; // m or rad, change of the worst joint's RMS tracking error
+constexpr double kCostNoise = 0.15;          // CPU-time differences below this fraction are noise here
 
 double worst_tracking(const ClosedLoopResult& r) {
   return *std::max_element(std::begin(r.tracking_rms), std::end(r.tracking_rms));
@@ -437,8 +438,6 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
       for (const Vec4& e : results[ref].effort) ref_force += e.tail<3>().squaredNorm();
       ref_force = std::sqrt(ref_force / std::max<std::size_t>(1, results[ref].effort.size()));
     }
-    int best = -1;
-    double best_cost = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < results.size(); ++i) {
       const ClosedLoopResult& r = results[i];
       FidelityRow row;
@@ -458,14 +457,20 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
         row.tracking_diff = std::abs(row.tracking - worst_tracking(R));
         row.within = drivable(i) && row.tip_rms <= kTipTolerance && row.force_rel <= kForceTolerance &&
                      row.tracking_diff <= kTrackingTolerance;
-        if (row.within && row.cpu_per_s < best_cost) {
-          best = static_cast<int>(i);
-          best_cost = row.cpu_per_s;
-        }
       }
       rows.push_back(row);
     }
-    if (best >= 0) rows[rows.size() - results.size() + best].recommended = true;
+    // The cheapest within tolerance; costs within kCostNoise of it count as equal (this machine's
+    // timing noise), and among those the least model wins: variants run from the most complete down.
+    const std::size_t first = rows.size() - results.size();
+    double cheapest = std::numeric_limits<double>::infinity();
+    for (std::size_t i = first; i < rows.size(); ++i)
+      if (rows[i].within) cheapest = std::min(cheapest, rows[i].cpu_per_s);
+    for (std::size_t i = rows.size(); i-- > first;)
+      if (rows[i].within && rows[i].cpu_per_s <= cheapest * (1 + kCostNoise)) {
+        rows[i].recommended = true;
+        break;
+      }
   }
   return rows;
 }
