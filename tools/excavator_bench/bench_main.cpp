@@ -233,6 +233,9 @@ void time_dynamics_step(const BenchScene& s, const EffortProfile& profile, const
   out.dynamics_step_us = median(us);
 }
 
+// Passes over which the plant's and MuJoCo's step times are measured (the best median counts).
+constexpr int kTimingPasses = 3;
+
 #ifdef EXC_HAVE_MUJOCO
 void run_mujoco(const BenchScene& s, const EffortProfile& profile, const OpenLoopResult& ours,
                 const std::string& out_dir, PeerResult& out) {
@@ -292,21 +295,25 @@ void run_mujoco(const BenchScene& s, const EffortProfile& profile, const OpenLoo
     out.mujoco_tip.push_back(peer->tip_world());
   }
   if (!ok) out.mujoco_status = "diverged (non-finite state)";
-  // Step time: a second pass over the same efforts and soil forces with nothing but mj_step in the
-  // timed blocks (one clock read per hold interval; a read costs ~0.3 us).
-  peer->set_state(ours.q.front(), ours.qd.front());
-  std::size_t n = 0;
-  for (std::size_t k = 0; k < profile.tau.size() && n < tip_forces.size(); ++k) {
-    peer->set_effort(profile.tau[k]);
-    const double block0 = thread_cpu_seconds();
-    int stepped = 0;
-    for (int c = 0; c < per_hold && n < tip_forces.size(); ++c, ++n, ++stepped) {
-      peer->set_tip_force(tip_forces[n]);
-      peer->step();
+  // Step time: further passes over the same efforts and soil forces with nothing but mj_step in the
+  // timed blocks (one clock read per hold interval; a read costs ~0.3 us); best of kTimingPasses medians.
+  out.mujoco_step_us = INFINITY;
+  for (int pass = 0; pass < kTimingPasses; ++pass) {
+    peer->set_state(ours.q.front(), ours.qd.front());
+    step_us.clear();
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < profile.tau.size() && n < tip_forces.size(); ++k) {
+      peer->set_effort(profile.tau[k]);
+      const double block0 = thread_cpu_seconds();
+      int stepped = 0;
+      for (int c = 0; c < per_hold && n < tip_forces.size(); ++c, ++n, ++stepped) {
+        peer->set_tip_force(tip_forces[n]);
+        peer->step();
+      }
+      if (stepped > 0) step_us.push_back(1e6 * (thread_cpu_seconds() - block0) / stepped);
     }
-    if (stepped > 0) step_us.push_back(1e6 * (thread_cpu_seconds() - block0) / stepped);
+    out.mujoco_step_us = std::min(out.mujoco_step_us, median(step_us));
   }
-  out.mujoco_step_us = median(step_us);
   out.mujoco_constraint_error = worst;
   // mj_inverse on the states of our run, with the accelerations between them.
   std::vector<double> inverse_us;
@@ -334,7 +341,11 @@ std::vector<PeerResult> peer_comparison(const std::vector<BenchScene>& scenes,
     OpenLoopSettings st;
     st.integrator = settings_of(plant::IntegrationMethod::semi_implicit_euler, plant::Formulation::independent, 1e-3);
     const OpenLoopResult ours = run_open_loop(s, profile, st, true);
+    // Step times are the best of kTimingPasses medians, for both engines: a burst of load from
+    // elsewhere on this shared machine can cover a whole pass and would otherwise decide the ratio.
     p.plant_step_us = ours.step_median_us;
+    for (int pass = 1; pass < kTimingPasses; ++pass)
+      p.plant_step_us = std::min(p.plant_step_us, run_open_loop(s, profile, st, true).step_median_us);
     p.constraint_error = ours.max_constraint_residual;
     p.tip_rms = ours.ok ? rms_distance(ours.tip, references[i].tip) : NAN;
     p.reference_tip = references[i].tip;
