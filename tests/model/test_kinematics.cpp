@@ -98,21 +98,34 @@ TEST_CASE("model/the planar loop residual equals the 3-D tree transforms") {
   }
 }
 
+namespace {
+// A tree state with every joint anywhere (slides within 1.5-3 m): no loop closure needed.
+void random_tree_state(const Model& m, test::RandomStates& rs, Vec12& q, Vec12& qd, Vec12& qdd) {
+  for (int i = 0; i < kNumJoints; ++i) {
+    q[i] = m.prismatic[i] ? rs.uniform(1.5, 3.0) : rs.uniform(-M_PI, M_PI);
+    qd[i] = rs.uniform(-1, 1);
+    qdd[i] = rs.uniform(-2, 2);
+  }
+}
+
+// The planar front pass into 'fast' and the general Lie-group pass into 'general', at the same state.
+void both_tree_passes(const Model& m, const Vec12& q, const Vec12& qd, Workspace& fast, Workspace& general) {
+  fast.q = q;
+  front_positions(m, q, fast);
+  tree_kinematics_from_front(m, fast, qd);
+  tree_kinematics(m, general, q, qd);
+}
+}  // namespace
+
 TEST_CASE("model/tree kinematics from the planar front pass equals the general Lie-group pass") {
   const Model& m = reference_model();
   REQUIRE(m.planar_front);  // else the comparison below would test the fallback against itself
   Workspace fast(m), general(m);
   test::RandomStates rs(31);
   for (int trial = 0; trial < 200; ++trial) {
-    Vec12 q, qd;  // arbitrary tree states: the fast pass needs no loop closure
-    for (int i = 0; i < kNumJoints; ++i) {
-      q[i] = m.prismatic[i] ? rs.uniform(1.5, 3.0) : rs.uniform(-M_PI, M_PI);
-      qd[i] = rs.uniform(-1, 1);
-    }
-    fast.q = q;
-    front_positions(m, q, fast);
-    tree_kinematics_from_front(m, fast, qd);
-    tree_kinematics(m, general, q, qd);
+    Vec12 q, qd, qdd;  // arbitrary tree states: the fast pass needs no loop closure
+    random_tree_state(m, rs, q, qd, qdd);
+    both_tree_passes(m, q, qd, fast, general);
     CHECK_FALSE(fast.front_world_poses_valid);
     tree_world_poses(m, fast);
     for (int i = 0; i < kNumJoints; ++i) {
@@ -145,15 +158,8 @@ TEST_CASE("model/Newton-Euler and M_r on the pin transforms equal the general Li
   test::RandomStates rs(37);
   for (int trial = 0; trial < 100; ++trial) {
     Vec12 q, qd, qdd;
-    for (int i = 0; i < kNumJoints; ++i) {
-      q[i] = m.prismatic[i] ? rs.uniform(1.5, 3.0) : rs.uniform(-M_PI, M_PI);
-      qd[i] = rs.uniform(-1, 1);
-      qdd[i] = rs.uniform(-2, 2);
-    }
-    fast.q = q;
-    front_positions(m, q, fast);
-    tree_kinematics_from_front(m, fast, qd);
-    tree_kinematics(m, general, q, qd);
+    random_tree_state(m, rs, q, qd, qdd);
+    both_tree_passes(m, q, qd, fast, general);
     REQUIRE(fast.pin_valid);
     REQUIRE_FALSE(general.pin_valid);
     const Vec2 f_soil(rs.uniform(-5e4, 5e4), rs.uniform(-5e4, 5e4));
