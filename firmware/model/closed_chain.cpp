@@ -51,11 +51,10 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   ws.Hp_inv.block<4, 4>(4, 4) = H_p.block<4, 4>(4, 4).inverse();
   Mat8x4 dqp_dqa;
   Vec8 gamma_p;
-  times_block_diagonal(ws.Hp_inv, H_a, dqp_dqa);
-  dqp_dqa = -dqp_dqa;
+  times_block_diagonal(ws.Hp_inv, H_a, dqp_dqa);  // H_p^-1 H_a; Psi takes its negative
   ws.Psi.setZero();
   for (int k = 0; k < kNumActive; ++k) ws.Psi(kActiveJoints[k], k) = 1.0;
-  for (int k = 0; k < kNumPassive; ++k) ws.Psi.row(kPassiveJoints[k]) = dqp_dqa.row(k);
+  for (int k = 0; k < kNumPassive; ++k) ws.Psi.row(kPassiveJoints[k]) = -dqp_dqa.row(k);
   ws.qd.noalias() = ws.Psi.lazyProduct(qd_a);
 
   // Acceleration bias: with qdd = 0 the cut pins accelerate apart by Hd qd; gamma = (0; -H_p^-1 Hd qd).

@@ -17,7 +17,6 @@ namespace {
 constexpr double kToggleSine = 0.1;
 constexpr double kTriangleSine = 0.01;
 
-
 struct Intersection {
   Vec2 point;
   double sine = 0;  // |sin| of the angle at 'point' between the radii: 0 at tangency (toggle)

@@ -45,9 +45,6 @@ inline void set_pose(SE3& T, const Vec3& x, const Vec3& y, const Vec3& z, const 
   d[12] = p.x(), d[13] = p.y(), d[14] = p.z(), d[15] = 1;
 }
 
-}  // namespace
-
-namespace {
 
 // Out-of-plane offset of each front origin (pin rotations and slides keep it).
 std::array<double, kNumJoints> front_y_offsets(const Model& model) {
@@ -66,6 +63,17 @@ void set_front_world_pose(const Workspace& ws, int i, double y, SE3& X) {
   const Vec2& o = ws.origin[i];
   set_pose(X, Vec3(c0 * ca, s0 * ca, sa), Vec3(-s0, c0, 0), Vec3(-c0 * sa, -s0 * sa, ca),
            X0.topRightCorner<3, 1>() + Vec3(c0 * o.x() - s0 * y, s0 * o.x() + c0 * y, o.y()));
+}
+
+// Ad_{f^-1} X into link i from its parent, and Ad*_{f^-1} F from link i to its parent: by the pin
+// transforms when they are current, else by the general f_parent.
+inline Twist to_child(const Workspace& ws, int i, const Twist& X) {
+  return ws.pin_valid ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), X)
+                      : Ad_inv_apply(ws.f_parent[i], X);
+}
+inline Wrench to_parent(const Workspace& ws, int i, const Wrench& F) {
+  return ws.pin_valid ? Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), F)
+                      : Ad_inv_dual_apply(ws.f_parent[i], F);
 }
 
 }  // namespace
@@ -87,11 +95,12 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
     // Relative motion: a pin rotation about -y by q_i (cos, sin from the front pass) or a slide.
     SE3& f = ws.f_parent[i];
     const double c = ws.joint_cos[i], s = ws.joint_sin[i];
+    const Vec3 offset = home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0);
     if (model.prismatic[i])
-      set_pose(f, Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), home + Vec3(ws.q[i], 0, 0));
+      set_pose(f, Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), offset);
     else
-      set_pose(f, Vec3(c, 0, s), Vec3::UnitY(), Vec3(-s, 0, c), home);
-    ws.V[i] = Ad_inv_apply_pin(c, s, home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0), ws.V[p]);
+      set_pose(f, Vec3(c, 0, s), Vec3::UnitY(), Vec3(-s, 0, c), offset);
+    ws.V[i] = Ad_inv_apply_pin(c, s, offset, ws.V[p]);
     ws.V[i][model.prismatic[i] ? 3 : 1] += model.prismatic[i] ? qd[i] : -qd[i];  // + S_i qd_i
   }
   ws.pin_valid = true;
@@ -161,17 +170,9 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
   // Backward: children have higher indices than their parents (Table 1 order).
   for (int i = kNumJoints - 1; i >= 0; --i) {
     const int p = model.parent[i];
-    if (p < 0) {
-      tau[i] = model.screw[i].dot(ws.F[i]);  // eq. 1: tau_i = S_i^T F_i
-      continue;
-    }
-    if (ws.pin_valid) {
-      tau[i] = model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1];
-      ws.F[p] += Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.F[i]);
-    } else {
-      tau[i] = model.screw[i].dot(ws.F[i]);
-      ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
-    }
+    // eq. 1: tau_i = S_i^T F_i; for the front's known screws one entry of F_i.
+    tau[i] = ws.pin_valid && p >= 0 ? (model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1]) : model.screw[i].dot(ws.F[i]);
+    if (p >= 0) ws.F[p] += to_parent(ws, i, ws.F[i]);
   }
   ws.tau_r = tau;
 }
@@ -187,11 +188,7 @@ void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Ma
     for (int i = 0; i < kNumJoints; ++i) {
       const int p = model.parent[i];
       acc[i] = model.screw[i] * A(i, col);
-      if (p >= 0) {
-        acc[i] += ws.pin_valid ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i],
-                                                  ws.f_parent[i].template topRightCorner<3, 1>(), acc[p])
-                               : Ad_inv_apply(ws.f_parent[i], acc[p]);
-      }
+      if (p >= 0) acc[i] += to_child(ws, i, acc[p]);
       const BodyInertia& b = model.machine.bodies[i];
       force[i] = inertia_apply(b.mass, b.com, b.inertia, acc[i]);
     }
@@ -199,9 +196,7 @@ void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Ma
       out(i, col) = model.screw[i].dot(force[i]);
       const int p = model.parent[i];
       if (p < 0) continue;
-      force[p] += ws.pin_valid ? Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i],
-                                                       ws.f_parent[i].template topRightCorner<3, 1>(), force[i])
-                               : Ad_inv_dual_apply(ws.f_parent[i], force[i]);
+      force[p] += to_parent(ws, i, force[i]);
     }
   }
 }

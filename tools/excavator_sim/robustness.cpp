@@ -24,10 +24,6 @@ bool pid_over_adaptive(const Summary& s, double& arm, double& bucket) {
   return true;
 }
 
-}  // namespace
-
-namespace {
-
 // The single faults; the "all" variant applies every one of them (mass +20 %).
 void heavier_model(SceneBundle&, RunOptions& o) { o.controller_mass_scale = 1.2; }
 void lighter_model(SceneBundle&, RunOptions& o) { o.controller_mass_scale = 0.8; }
