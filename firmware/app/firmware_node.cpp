@@ -59,6 +59,8 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       estimator_(config.controller.filter),
       machine_(config.controller.watchdog_timeout),
       blender_(config.controller.blend_time),
+      lag_compensator_(config.controller.actuator_lag, config.controller.actuator_lag_target,
+                       config.controller.period, control::effort_limits_of(model.machine)),
       control_timing_("control", 100.0),
       cycle_timing_("cycle", 1000.0),
       period_(config.controller.period) {}
@@ -169,6 +171,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   input.soil.terrain_height = config_.terrain_height;
   input.soil.theta_known = config_.theta_known;
   input.soil.theta = config_.theta_true;
+  input.actuator_limited = lag_compensator_.clamped();
   out_ = controller_->update(input);
   if (out_.status != ModelStatus::ok || !finite(out_.tau)) fault_ = true;
 
@@ -176,8 +179,14 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))
     blender_.on_switch(t, last_sent_, out_.tau);
   const Vec4 tau = blender_.apply(t, out_.tau);
+  // After a stop the actuator is taken to deliver what the law asks for first (the plant's
+  // actuators hold their effort); last_sent_ stays the effort asked for, the blend's reference.
+  if (transition.changed && (transition.from == control::Mode::safe_stop ||
+                             transition.from == control::Mode::wait_sensors))
+    lag_compensator_.reset(tau);
+  const Vec4 sent = lag_compensator_.apply(tau);
   command_.mode = hal::CommandMode::effort;
-  for (int j = 0; j < 4; ++j) command_.value[j] = tau[j];
+  for (int j = 0; j < 4; ++j) command_.value[j] = sent[j];
   last_sent_ = tau;
   control_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
 }

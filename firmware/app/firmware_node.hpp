@@ -3,12 +3,14 @@
 // wires bus, state machine, estimator, trajectory, controller and telemetry):
 //   begin_cycle(): send SYNC(k) (+ heartbeat)              -> the plant steps once and answers
 //   end_cycle():   read + validate sensors -> watchdog/state machine -> estimate -> trajectory
-//                  -> control law -> saturate/blend -> write commands -> telemetry
+//                  -> control law -> saturate/blend -> actuator-lag lead -> write commands
+//                  -> telemetry
 // Time is the cycle count times the period, so a run is deterministic and the plant's time is the
 // firmware's. Nothing here allocates, locks or blocks after construction.
 #include <cstdint>
 #include <memory>
 
+#include "control/actuator_lag_compensator.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
 #include "control/perf_counter.hpp"
@@ -96,6 +98,7 @@ class FirmwareNode {
   control::StateEstimator estimator_;
   control::ControlStateMachine machine_;
   control::CommandBlender blender_;
+  control::ActuatorLagCompensator lag_compensator_;
   control::PerfCounter control_timing_;
   control::PerfCounter cycle_timing_;
 

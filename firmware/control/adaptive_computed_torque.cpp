@@ -73,7 +73,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   }
 
   // Update law (eq. 27), explicit Euler at the control period, then the projection.
-  if (out.in_soil && out.saturated == 0) {
+  if (out.in_soil && out.saturated == 0 && in.actuator_limited == 0) {
     const Eigen::LDLT<Mat4> ldlt(M_a);
     const Mat4x6 Phi = ldlt.solve(Y);                       // M_a^-1 Y
     const Vec4 BtPx = P_.bottomRows<4>() * x;               // B^T P x

@@ -72,7 +72,7 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
                  {"type", "period", "kp", "kv", "ki", "integral_limit", "lyapunov_q",
                   "adaptation_rate", "theta_min", "theta_max", "theta_initial",
                   "regressor_acceleration", "slotine_li", "filters", "watchdog_timeout",
-                  "blend_time"});
+                  "blend_time", "actuator_lag", "actuator_lag_target"});
   if (node["type"]) {
     const std::string t = node["type"].as<std::string>();
     if (t == "pid") c.kind = ControllerKind::pid;
@@ -120,6 +120,9 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
   if (node["watchdog_timeout"])
     c.watchdog_timeout = read_number(node["watchdog_timeout"], file, s + ".watchdog_timeout", 1e-4, 10);
   if (node["blend_time"]) c.blend_time = read_number(node["blend_time"], file, s + ".blend_time", 0, 10);
+  if (node["actuator_lag"]) c.actuator_lag = read_number(node["actuator_lag"], file, s + ".actuator_lag", 0, 1);
+  if (node["actuator_lag_target"])
+    c.actuator_lag_target = read_number(node["actuator_lag_target"], file, s + ".actuator_lag_target", 1e-4, 1);
   c.filter.period = c.period;
   validate(c, file);
   return c;
@@ -144,6 +147,12 @@ void validate(const ControllerConfig& c, const std::string& file) {
                         fmt(c.gains.ki[j]) + " makes the PID loop unstable: must be below kv*kp = " +
                             fmt(c.gains.kv[j] * c.gains.kp[j]));
   }
+  // A target slower than the lag would lag more, not less; a lead gain above 20 amplifies the
+  // measurement noise that reaches the command twentyfold.
+  if (c.actuator_lag > 0 && !(c.actuator_lag_target <= c.actuator_lag && c.actuator_lag <= 20 * c.actuator_lag_target))
+    throw ConfigError(file, s + ".actuator_lag_target",
+                      fmt(c.actuator_lag_target) + " s must lie in actuator_lag / 20 .. actuator_lag = " +
+                          fmt(c.actuator_lag / 20) + " .. " + fmt(c.actuator_lag) + " s");
   // The filters must sit below the Nyquist frequency of the control period.
   const double nyquist = 0.5 / c.period;
   if (!(c.filter.velocity_cutoff_hz < nyquist))

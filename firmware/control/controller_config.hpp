@@ -48,6 +48,12 @@ struct ControllerConfig {
   Vec4 sl_kd = Vec4::Constant(8);
   Vec6 sl_adaptation_rate = (Vec6() << 3e3, 3e5, 3e7, 3e3, 3e5, 3e7).finished();
 
+  // Actuator lag the firmware compensates (actuator_lag_compensator.hpp): the time constant of the
+  // machine's effort response (0: ideal force actuators, the paper's; no compensation) and the one
+  // the compensated actuator should show. lag / target is the lead's high-frequency gain.
+  double actuator_lag = 0;            // s
+  double actuator_lag_target = 0.005; // s
+
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop
   double blend_time = 0.2;          // s, bumpless switch fade

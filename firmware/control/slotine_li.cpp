@@ -60,7 +60,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
       if (config_.sl_adaptation_rate[i] > 0)
         out.lyapunov += 0.5 * tilde[i] * tilde[i] / config_.sl_adaptation_rate[i];
   }
-  if (out.in_soil && out.saturated == 0) {
+  if (out.in_soil && out.saturated == 0 && in.actuator_limited == 0) {
     const Vec6 theta_dot = -config_.sl_adaptation_rate.cwiseProduct(Y.transpose() * s);
     theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
   }

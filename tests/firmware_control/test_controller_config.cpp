@@ -48,6 +48,8 @@ controller:
   filters: {velocity_cutoff_hz: 30, acceleration_cutoff_hz: 10}
   watchdog_timeout: 0.05
   blend_time: 0.1
+  actuator_lag: 0.03
+  actuator_lag_target: 0.006
 )")["controller"], "scene.yaml");
   CHECK(c.kind == ControllerKind::slotine_li);
   CHECK(c.period == 0.002);
@@ -60,6 +62,8 @@ controller:
   CHECK(c.sl_kd[0] == 9);
   CHECK(c.filter.acceleration_cutoff_hz == 10);
   CHECK(c.watchdog_timeout == 0.05);
+  CHECK(c.actuator_lag == 0.03);
+  CHECK(c.actuator_lag_target == 0.006);
 }
 
 TEST_CASE("firmware/controller config errors name the field and the allowed range") {
@@ -74,5 +78,9 @@ TEST_CASE("firmware/controller config errors name the field and the allowed rang
   CHECK(error_of("controller: {kp: [100, 100, 100, 100], kv: [10, 10, 10, 10], ki: [2000, 0, 0, 0]}")
             .find("controller.ki[0] | 2000 makes the PID loop unstable") == 0);
   CHECK(error_of("controller: {filters: {velocity_cutoff_hz: 800}}").find("controller.filters.velocity_cutoff_hz | 800 Hz must be below 500 Hz") == 0);
+  CHECK(error_of("controller: {actuator_lag: 0.02, actuator_lag_target: 0.03}")
+            .find("controller.actuator_lag_target | 0.03 s must lie in actuator_lag / 20 .. actuator_lag = 0.001 .. 0.02 s") == 0);
+  CHECK(error_of("controller: {actuator_lag: 0.1, actuator_lag_target: 0.001}").find("controller.actuator_lag_target | ") == 0);
+  CHECK(error_of("controller: {actuator_lag: -0.01}").find("controller.actuator_lag | -0.01 outside the allowed range 0 .. 1") == 0);
   CHECK(error_of("controller: {period: nan}").find("controller.period | ") == 0);
 }
