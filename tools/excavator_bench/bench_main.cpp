@@ -580,6 +580,7 @@ std::vector<ControlStability> control_stability_map(const BenchScene& dig, doubl
         if (kind == control::ControllerKind::pid && std::string(a.name) == "adaptation_scale") continue;
         ClosedLoopVariant v;
         v.controller = kind;
+        v.fidelity = dig.scene.actuators.fidelity;  // the scene's own actuators, which its firmware config expects
         v.duration = duration;
         const std::string n = a.name;
         if (n == "gain_scale") v.gain_scale = value;

@@ -103,13 +103,17 @@ def stability(out):
     data = rows(os.path.join(out, "stability_control.csv"))
     axis_list = sorted({r["axis"] for r in data})
     fig, axes = plt.subplots(1, len(axis_list), figsize=(4.5 * len(axis_list), 4.5), squeeze=False)
+    # One colour per controller in every panel (PID has no adaptation-rate panel).
+    controllers = sorted({r["controller"] for r in data})
+    colour = {c: "C%d" % i for i, c in enumerate(controllers)}
     for ax, axis in zip(axes[0], axis_list):
-        for ctrl in sorted({r["controller"] for r in data}):
+        for ctrl in controllers:
             pts = [(num(r["value"]), num(r["tracking_rms_worst"]), r["ok"] == "1") for r in data
                    if r["controller"] == ctrl and r["axis"] == axis]
             if not pts:
                 continue
-            line, = ax.plot([p[0] for p in pts], [max(p[1], 1e-7) for p in pts], marker="o", ms=4, label=ctrl)
+            line, = ax.plot([p[0] for p in pts], [max(p[1], 1e-7) for p in pts], marker="o", ms=4, label=ctrl,
+                            color=colour[ctrl])
             bad = [p for p in pts if not p[2]]
             if bad:
                 ax.plot([p[0] for p in bad], [max(p[1], 1e-7) for p in bad], "x", color=line.get_color(), ms=12, mew=2)
