@@ -3,53 +3,22 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <set>
-#include <sstream>
+
+#include "control/config_fields.hpp"
 
 namespace exc::control {
 namespace {
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-double read_number(const YAML::Node& n, const std::string& file, const std::string& field, double lo,
-                   double hi) {
-  double v = 0;
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    throw ConfigError(file, field, "not a number (allowed: " + fmt(lo) + " .. " + fmt(hi) + ")");
-  }
-  if (!std::isfinite(v) || v < lo || v > hi)
-    throw ConfigError(file, field, fmt(v) + " outside the allowed range " + fmt(lo) + " .. " + fmt(hi));
-  return v;
-}
 
 template <int N>
 Eigen::Matrix<double, N, 1> read_vector(const YAML::Node& n, const std::string& file,
                                         const std::string& field, double lo, double hi) {
   if (!n.IsSequence() || static_cast<int>(n.size()) != N)
     throw ConfigError(file, field, "must be a list of " + std::to_string(N) + " numbers in " +
-                                       fmt(lo) + " .. " + fmt(hi));
+                                       format_number(lo) + " .. " + format_number(hi));
   Eigen::Matrix<double, N, 1> v;
   for (int i = 0; i < N; ++i)
     v[i] = read_number(n[i], file, field + "[" + std::to_string(i) + "]", lo, hi);
   return v;
-}
-
-void reject_unknown(const YAML::Node& n, const std::string& file, const std::string& section,
-                    const std::set<std::string>& allowed) {
-  for (const auto& kv : n) {
-    const std::string key = kv.first.as<std::string>();
-    if (!allowed.count(key)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw ConfigError(file, section + "." + key, "unknown key (allowed: " + list + ")");
-    }
-  }
 }
 
 }  // namespace
@@ -68,7 +37,7 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
   if (!node.IsDefined() || node.IsNull()) return c;
   const std::string s = "controller";
   if (!node.IsMap()) throw ConfigError(file, s, "must be a mapping of controller settings");
-  reject_unknown(node, file, s,
+  reject_unknown_keys(node, file, s,
                  {"type", "period", "kp", "kv", "ki", "integral_limit", "lyapunov_q",
                   "adaptation_rate", "theta_min", "theta_max", "theta_initial",
                   "regressor_acceleration", "slotine_li", "filters", "watchdog_timeout",
@@ -101,7 +70,7 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
   }
   if (const YAML::Node sl = node["slotine_li"]) {
     if (!sl.IsMap()) throw ConfigError(file, s + ".slotine_li", "must be a mapping with lambda, kd");
-    reject_unknown(sl, file, s + ".slotine_li", {"lambda", "kd", "adaptation_rate"});
+    reject_unknown_keys(sl, file, s + ".slotine_li", {"lambda", "kd", "adaptation_rate"});
     if (sl["lambda"]) c.sl_lambda = read_vector<4>(sl["lambda"], file, s + ".slotine_li.lambda", 1e-3, 1e4);
     if (sl["adaptation_rate"])
       c.sl_adaptation_rate =
@@ -110,7 +79,7 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
   }
   if (const YAML::Node f = node["filters"]) {
     if (!f.IsMap()) throw ConfigError(file, s + ".filters", "must be a mapping");
-    reject_unknown(f, file, s + ".filters", {"velocity_cutoff_hz", "acceleration_cutoff_hz"});
+    reject_unknown_keys(f, file, s + ".filters", {"velocity_cutoff_hz", "acceleration_cutoff_hz"});
     if (f["velocity_cutoff_hz"])
       c.filter.velocity_cutoff_hz = read_number(f["velocity_cutoff_hz"], file, s + ".filters.velocity_cutoff_hz", 0.1, 1e4);
     if (f["acceleration_cutoff_hz"])
@@ -134,33 +103,33 @@ void validate(const ControllerConfig& c, const std::string& file) {
     const std::string idx = "[" + std::to_string(i) + "]";
     if (!(c.theta_min[i] < c.theta_max[i]))
       throw ConfigError(file, s + ".theta_min" + idx,
-                        fmt(c.theta_min[i]) + " must be below theta_max" + idx + " = " + fmt(c.theta_max[i]));
+                        format_number(c.theta_min[i]) + " must be below theta_max" + idx + " = " + format_number(c.theta_max[i]));
     if (c.theta_initial[i] < c.theta_min[i] || c.theta_initial[i] > c.theta_max[i])
       throw ConfigError(file, s + ".theta_initial" + idx,
-                        fmt(c.theta_initial[i]) + " outside the bounds " + fmt(c.theta_min[i]) + " .. " +
-                            fmt(c.theta_max[i]));
+                        format_number(c.theta_initial[i]) + " outside the bounds " + format_number(c.theta_min[i]) + " .. " +
+                            format_number(c.theta_max[i]));
   }
   for (int j = 0; j < kNumActive; ++j) {
     // e''' + kv e'' + kp e' + ki e = 0 is Hurwitz iff kv kp > ki (Routh).
     if (!(c.gains.kv[j] * c.gains.kp[j] > c.gains.ki[j]))
       throw ConfigError(file, s + ".ki[" + std::to_string(j) + "]",
-                        fmt(c.gains.ki[j]) + " makes the PID loop unstable: must be below kv*kp = " +
-                            fmt(c.gains.kv[j] * c.gains.kp[j]));
+                        format_number(c.gains.ki[j]) + " makes the PID loop unstable: must be below kv*kp = " +
+                            format_number(c.gains.kv[j] * c.gains.kp[j]));
   }
   // A target slower than the lag would lag more, not less; a lead gain above 20 amplifies the
   // measurement noise that reaches the command twentyfold.
   if (c.actuator_lag > 0 && !(c.actuator_lag_target <= c.actuator_lag && c.actuator_lag <= 20 * c.actuator_lag_target))
     throw ConfigError(file, s + ".actuator_lag_target",
-                      fmt(c.actuator_lag_target) + " s must lie in actuator_lag / 20 .. actuator_lag = " +
-                          fmt(c.actuator_lag / 20) + " .. " + fmt(c.actuator_lag) + " s");
+                      format_number(c.actuator_lag_target) + " s must lie in actuator_lag / 20 .. actuator_lag = " +
+                          format_number(c.actuator_lag / 20) + " .. " + format_number(c.actuator_lag) + " s");
   // The filters must sit below the Nyquist frequency of the control period.
   const double nyquist = 0.5 / c.period;
   if (!(c.filter.velocity_cutoff_hz < nyquist))
     throw ConfigError(file, s + ".filters.velocity_cutoff_hz",
-                      fmt(c.filter.velocity_cutoff_hz) + " Hz must be below " + fmt(nyquist) + " Hz (Nyquist)");
+                      format_number(c.filter.velocity_cutoff_hz) + " Hz must be below " + format_number(nyquist) + " Hz (Nyquist)");
   if (!(c.filter.acceleration_cutoff_hz < nyquist))
     throw ConfigError(file, s + ".filters.acceleration_cutoff_hz",
-                      fmt(c.filter.acceleration_cutoff_hz) + " Hz must be below " + fmt(nyquist) + " Hz (Nyquist)");
+                      format_number(c.filter.acceleration_cutoff_hz) + " Hz must be below " + format_number(nyquist) + " Hz (Nyquist)");
 }
 
 ControllerConfig load_controller_config(const std::string& path) {

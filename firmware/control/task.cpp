@@ -3,44 +3,11 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <set>
-#include <sstream>
+
+#include "control/config_fields.hpp"
 
 namespace exc::control {
 namespace {
-
-std::string fmt(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-double number(const YAML::Node& n, const std::string& file, const std::string& field, double lo, double hi,
-              const char* unit) {
-  if (!n.IsDefined() || n.IsNull()) throw ConfigError(file, field, std::string("missing (a number in ") + fmt(lo) + " .. " + fmt(hi) + " " + unit + ")");
-  double v = 0;
-  try {
-    v = n.as<double>();
-  } catch (const YAML::Exception&) {
-    throw ConfigError(file, field, std::string("not a number (allowed: ") + fmt(lo) + " .. " + fmt(hi) + " " + unit + ")");
-  }
-  if (!std::isfinite(v) || v < lo || v > hi)
-    throw ConfigError(file, field, fmt(v) + " " + unit + " outside the allowed range " + fmt(lo) + " .. " + fmt(hi));
-  return v;
-}
-
-void only_keys(const YAML::Node& n, const std::string& file, const std::string& field,
-               const std::set<std::string>& allowed) {
-  if (!n.IsMap()) throw ConfigError(file, field, "must be a mapping");
-  for (const auto& kv : n) {
-    const std::string key = kv.first.as<std::string>();
-    if (!allowed.count(key)) {
-      std::string list;
-      for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw ConfigError(file, field + "." + key, "unknown key (allowed: " + list + ")");
-    }
-  }
-}
 
 const YAML::Node& sequence(const YAML::Node& n, const std::string& file, const std::string& field) {
   if (!n.IsDefined() || !n.IsSequence() || n.size() < 2)
@@ -59,25 +26,25 @@ Task parse_task(const YAML::Node& node, const std::string& file, const Machine& 
   Task task;
   constexpr double kTimeMax = 1e5;
   if (type == "joint_waypoints") {
-    only_keys(node, file, s, {"type", "waypoints"});
+    reject_unknown_keys(node, file, s, {"type", "waypoints"});
     task.type = TaskType::joint_waypoints;
     const YAML::Node w = sequence(node["waypoints"], file, s + ".waypoints");
     const Vec4 lo = machine.q_min(), hi = machine.q_max();
     std::vector<Vec4> qs;
     for (std::size_t i = 0; i < w.size(); ++i) {
       const std::string f = s + ".waypoints[" + std::to_string(i) + "]";
-      only_keys(w[i], file, f, {"t", "q"});
-      const double t = number(w[i]["t"], file, f + ".t", 0, kTimeMax, "s");
+      reject_unknown_keys(w[i], file, f, {"t", "q"});
+      const double t = read_number(w[i]["t"], file, f + ".t", 0, kTimeMax, "s");
       if (!task.waypoint_times.empty() && !(t > task.waypoint_times.back()))
-        throw ConfigError(file, f + ".t", fmt(t) + " s must be later than the previous waypoint's " +
-                                              fmt(task.waypoint_times.back()) + " s");
+        throw ConfigError(file, f + ".t", format_number(t) + " s must be later than the previous waypoint's " +
+                                              format_number(task.waypoint_times.back()) + " s");
       const YAML::Node q = w[i]["q"];
       if (!q.IsDefined() || !q.IsSequence() || q.size() != kNumActive)
         throw ConfigError(file, f + ".q", "must be 4 numbers [swing rad, L_boom m, L_arm m, L_bucket m]");
       Vec4 v;
       for (int j = 0; j < kNumActive; ++j) {
         const double l = std::isfinite(lo[j]) ? lo[j] : -1e3, h = std::isfinite(hi[j]) ? hi[j] : 1e3;
-        v[j] = number(q[j], file, f + ".q[" + std::to_string(j) + "]", l, h, j == 0 ? "rad" : "m");
+        v[j] = read_number(q[j], file, f + ".q[" + std::to_string(j) + "]", l, h, j == 0 ? "rad" : "m");
       }
       task.waypoint_times.push_back(t);
       qs.push_back(v);
@@ -85,20 +52,20 @@ Task parse_task(const YAML::Node& node, const std::string& file, const Machine& 
     task.trajectory = JointTrajectory(task.waypoint_times, qs);
     check_joint_trajectory(machine, task.trajectory, task.waypoint_times, options, file, s + ".waypoints");
   } else if (type == "dig") {
-    only_keys(node, file, s, {"type", "swing", "path"});
+    reject_unknown_keys(node, file, s, {"type", "swing", "path"});
     task.type = TaskType::dig;
-    task.swing = node["swing"] ? number(node["swing"], file, s + ".swing", -3.14159265358979323846,
+    task.swing = node["swing"] ? read_number(node["swing"], file, s + ".swing", -3.14159265358979323846,
                                         3.14159265358979323846, "rad")
                                : 0.0;
     const YAML::Node p = sequence(node["path"], file, s + ".path");
     for (std::size_t i = 0; i < p.size(); ++i) {
       const std::string f = s + ".path[" + std::to_string(i) + "]";
-      only_keys(p[i], file, f, {"t", "x", "z", "pitch_deg"});
+      reject_unknown_keys(p[i], file, f, {"t", "x", "z", "pitch_deg"});
       DigWaypoint wp;
-      wp.t = number(p[i]["t"], file, f + ".t", 0, kTimeMax, "s");
-      wp.pose.x = number(p[i]["x"], file, f + ".x", 0, 100, "m");
-      wp.pose.z = number(p[i]["z"], file, f + ".z", -100, 100, "m");
-      wp.pose.pitch = number(p[i]["pitch_deg"], file, f + ".pitch_deg", -360, 360, "deg") * 3.14159265358979323846 / 180;
+      wp.t = read_number(p[i]["t"], file, f + ".t", 0, kTimeMax, "s");
+      wp.pose.x = read_number(p[i]["x"], file, f + ".x", 0, 100, "m");
+      wp.pose.z = read_number(p[i]["z"], file, f + ".z", -100, 100, "m");
+      wp.pose.pitch = read_number(p[i]["pitch_deg"], file, f + ".pitch_deg", -360, 360, "deg") * 3.14159265358979323846 / 180;
       task.path.push_back(wp);
       task.waypoint_times.push_back(wp.t);
     }
