@@ -45,14 +45,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
 
   // Contact and anchor (the controller's own estimate unless the caller knows them).
   out.rho = ws_.rho;
-  if (in.soil.anchor_given) {
-    out.in_soil = in.soil.in_soil;
-    out.rho_env = in.soil.rho_env;
-  } else {
-    anchor_.update(ws_.rho, in.soil.terrain_height);
-    out.in_soil = anchor_.in_soil();
-    out.rho_env = anchor_.anchor();
-  }
+  anchor_.resolve(in.soil, ws_.rho, out.in_soil, out.rho_env);
   const Vec4& qdd_for_y = config_.regressor_acceleration == RegressorAcceleration::desired ? in.qdd_d : in.qdd;
   const Vec2 rhodd = ws_.J_t * qdd_for_y + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, ws_.rhod, rhodd, out.rho_env, out.in_soil);

@@ -41,14 +41,7 @@ ControlOutput ComputedTorquePid::update(const ControlInput& in) {
   x << out.e, out.ed;
   out.lyapunov = out.lyapunov_tracking = x.dot(P_ * x);
   out.rho = ws_.rho;
-  if (in.soil.anchor_given) {
-    out.in_soil = in.soil.in_soil;
-    out.rho_env = in.soil.rho_env;
-  } else {
-    anchor_.update(ws_.rho, in.soil.terrain_height);
-    out.in_soil = anchor_.in_soil();
-    out.rho_env = anchor_.anchor();
-  }
+  anchor_.resolve(in.soil, ws_.rho, out.in_soil, out.rho_env);
   return out;
 }
 

@@ -35,14 +35,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
   bias_forces(model_, ws_, h_r);
 
   out.rho = ws_.rho;  // position level: independent of the velocity passed in
-  if (in.soil.anchor_given) {
-    out.in_soil = in.soil.in_soil;
-    out.rho_env = in.soil.rho_env;
-  } else {
-    anchor_.update(ws_.rho, in.soil.terrain_height);
-    out.in_soil = anchor_.in_soil();
-    out.rho_env = anchor_.anchor();
-  }
+  anchor_.resolve(in.soil, ws_.rho, out.in_soil, out.rho_env);
   const Vec2 rhod_r = ws_.J_t * qd_r;
   const Vec2 rhodd_r = ws_.J_t * qdd_r + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, rhod_r, rhodd_r, out.rho_env, out.in_soil);

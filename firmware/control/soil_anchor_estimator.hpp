@@ -11,6 +11,7 @@
 // the projection keeps Theta_hat physical). No allocation.
 #include <cmath>
 
+#include "control/control_types.hpp"
 #include "model/types.hpp"
 
 namespace exc::control {
@@ -33,6 +34,18 @@ class SoilAnchorEstimator {
     }
     if (!in_soil_ || (anchor_ - rho).norm() > shear_failure_distance(depth)) anchor_ = rho;
     in_soil_ = true;
+  }
+  // What a control law uses: the caller's contact and anchor when it knows them
+  // (SoilContext::anchor_given, simulation truth), else this estimate, advanced with the tip rho.
+  void resolve(const SoilContext& soil, const Vec2& rho, bool& in_soil, Vec2& rho_env) {
+    if (soil.anchor_given) {
+      in_soil = soil.in_soil;
+      rho_env = soil.rho_env;
+      return;
+    }
+    update(rho, soil.terrain_height);
+    in_soil = in_soil_;
+    rho_env = anchor_;
   }
   bool in_soil() const { return in_soil_; }
   const Vec2& anchor() const { return anchor_; }
