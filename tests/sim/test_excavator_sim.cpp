@@ -70,6 +70,9 @@ TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive bea
     INFO(joint << ": PID " << pid << " m, adaptive " << adaptive << " m");
     CHECK(pid >= 5 * adaptive);
   }
+  // The summary says what ran: the scene's actuators and the firmware's compensation of their lag.
+  CHECK(j["setup"].get<std::string>().find("actuators limited (effort lag 20 ms), firmware lag compensation 20 ms -> 5 ms") == 0);
+  CHECK(r.out.find("scene dig: actuators limited") != std::string::npos);
   CHECK(j["heap_allocations_in_loop"].get<long long>() == 0);
   CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.0).epsilon(1e-3));
   const double median = j["control_step_us"]["median"].get<double>();

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 #include <unistd.h>
@@ -170,6 +171,20 @@ SceneBundle load_scene_bundle(const std::string& path) {
 Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
   Summary summary;
   summary.scene = bundle.name;
+  {
+    const plant::Scene& sc = bundle.scene;
+    std::ostringstream o;
+    o << "actuators " << plant::to_string(sc.actuators.fidelity);
+    if (sc.actuators.fidelity == plant::ActuatorFidelity::limited) o << " (effort lag " << sc.actuators.lag * 1e3 << " ms)";
+    o << ", firmware lag compensation ";
+    if (bundle.controller.actuator_lag > 0)
+      o << bundle.controller.actuator_lag * 1e3 << " ms -> " << bundle.controller.actuator_lag_target * 1e3 << " ms";
+    else
+      o << "off";
+    o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
+      << " at " << sc.integrator.step * 1e3 << " ms";
+    summary.setup = o.str();
+  }
   std::shared_ptr<telemetry::LcmOutput> output;
   if (!options.lcm_url.empty()) {
     std::string error;

@@ -64,6 +64,8 @@ struct RunResult {
 
 struct Summary {
   std::string scene;
+  // What ran, as a person reads it: the plant's actuators and integrator, the firmware's lag compensation.
+  std::string setup;
   std::vector<RunResult> runs;
   bool all_ok = true;
 };

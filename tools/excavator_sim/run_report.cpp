@@ -28,7 +28,7 @@ nlohmann::json timing_json(const Timing& t) {
 
 void print_summary(const Summary& summary, std::ostream& out) {
   char line[256];
-  out << "\nscene " << summary.scene << "\n\n";
+  out << "\nscene " << summary.scene << ": " << summary.setup << "\n\n";
   out << "tracking error (while tracking)     ";
   for (const RunResult& r : summary.runs) {
     std::snprintf(line, sizeof line, "| %-10s RMS      max     ", r.controller.c_str());
@@ -71,6 +71,7 @@ void print_summary(const Summary& summary, std::ostream& out) {
 nlohmann::json to_json(const Summary& summary) {
   nlohmann::json j;
   j["scene"] = summary.scene;
+  j["setup"] = summary.setup;
   j["ok"] = summary.all_ok;
   Timing worst;
   std::uint64_t allocations = 0;

@@ -301,7 +301,10 @@ def write_report(runs, summary, title, out_dir, written):
     if summary is not None:
         runs_in_summary = sim_runs(summary)
         table = sim_table(runs_in_summary) if runs_in_summary else summary_table(summary)
-        lines += ["## Summary", ""] + table + [""]
+        lines += ["## Summary", ""]
+        if isinstance(summary, dict) and isinstance(summary.get("setup"), str):
+            lines += ["Scene `%s`: %s." % (summary.get("scene", "?"), summary["setup"]), ""]
+        lines += table + [""]
     # From the log: the controller's own error e (estimated state against q_d) over every logged
     # cycle, hold included; the summary's figures are the plant's true state while tracking.
     lines += ["## RMS of the controller's error e over the whole log (telemetry)", ""]
