@@ -7,19 +7,16 @@
 #include <sstream>
 
 #include "model/machine.hpp"
+#include "text_file.hpp"
 
 using namespace exc;
 
+using exc::test::read_text_file;
+
 namespace {
-std::string read_text(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 // The reference text with one substring replaced (the edit must apply exactly once).
 std::string edited(const std::string& from, const std::string& to) {
-  std::string text = read_text(EXC_MACHINE_FILE);
+  std::string text = read_text_file(EXC_MACHINE_FILE);
   const auto pos = text.find(from);
   REQUIRE(pos != std::string::npos);
   REQUIRE(text.find(from, pos + 1) == std::string::npos);

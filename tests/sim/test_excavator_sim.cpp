@@ -12,7 +12,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "text_file.hpp"
+
 namespace fs = std::filesystem;
+
+using exc::test::read_text_file;
 
 namespace {
 
@@ -22,12 +26,6 @@ struct Run {
   fs::path dir;
 };
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel).
 Run run_sim(const std::string& args) {
@@ -39,8 +37,8 @@ Run run_sim(const std::string& args) {
   const std::string cmd = "cd '" + r.dir.string() + "' && " + EXC_SIM_TOOL + " " + args + " > out.txt 2> err.txt";
   const int raw = std::system(cmd.c_str());
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = slurp(r.dir / "out.txt");
-  r.err = slurp(r.dir / "err.txt");
+  r.out = read_text_file(r.dir / "out.txt");
+  r.err = read_text_file(r.dir / "err.txt");
   return r;
 }
 
@@ -53,7 +51,7 @@ TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive bea
   const Run r = run_sim("run " + kDig + " --no-report --quiet --json summary.json --out out");
   INFO(r.err);
   REQUIRE(r.status == 0);
-  const nlohmann::json j = nlohmann::json::parse(slurp(r.dir / "summary.json"));
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
   for (const char* c : {"pid", "adaptive"}) {
     REQUIRE(j.contains(c));
     for (const char* joint : kJoints) {
@@ -89,7 +87,7 @@ TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better tha
                         (have_matplotlib ? "" : " --no-plots"));
   INFO(r.err);
   REQUIRE(r.status == 0);
-  const nlohmann::json j = nlohmann::json::parse(slurp(r.dir / "robust.json"));
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "robust.json"));
   const nlohmann::json& rows = j["robustness"];
   REQUIRE(rows.size() == 7);
   CHECK(rows[0]["variant"] == "nominal");
@@ -111,7 +109,7 @@ TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better tha
   for (std::size_t i = 1; i < rows.size(); ++i) CHECK(rows[i]["adaptive"]["rms_error"]["bucket"].get<double>() != nominal_bucket);
   CHECK(r.out.find("PID/adapt.") != std::string::npos);
   // The same table next to its chart (1200 x 700 PNG; skipped only without matplotlib).
-  CHECK(slurp(r.dir / "rob" / "robustness.json") == slurp(r.dir / "robust.json"));
+  CHECK(read_text_file(r.dir / "rob" / "robustness.json") == read_text_file(r.dir / "robust.json"));
   if (have_matplotlib) {
     CHECK(fs::file_size(r.dir / "rob" / "robustness.png") > 20000);
   } else {
@@ -121,7 +119,7 @@ TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better tha
 
 TEST_CASE("tools/excavator-sim: on the dig scene's lagging actuators the firmware's lag compensation keeps the adaptive law's lead") {
   // The shipped scene with the compensation switched off: same plant, same laws.
-  const std::string text = slurp(kDig);
+  const std::string text = read_text_file(kDig);
   const std::string from = "actuator_lag: 0.02";
   REQUIRE(text.find("fidelity: limited") != std::string::npos);
   REQUIRE(text.find(from) != std::string::npos);
@@ -133,8 +131,8 @@ TEST_CASE("tools/excavator-sim: on the dig scene's lagging actuators the firmwar
   const Run without = run_sim("run " + scene.string() + " --no-report --quiet --json s.json --out out");
   REQUIRE(with.status == 0);
   REQUIRE(without.status == 0);
-  const nlohmann::json a = nlohmann::json::parse(slurp(with.dir / "s.json"));
-  const nlohmann::json b = nlohmann::json::parse(slurp(without.dir / "s.json"));
+  const nlohmann::json a = nlohmann::json::parse(read_text_file(with.dir / "s.json"));
+  const nlohmann::json b = nlohmann::json::parse(read_text_file(without.dir / "s.json"));
   for (const char* joint : {"arm", "bucket"}) {
     const double on = a["adaptive"]["rms_error"][joint].get<double>();
     const double uncompensated = b["adaptive"]["rms_error"][joint].get<double>();
@@ -149,7 +147,7 @@ TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits
   const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
   fs::create_directories(dir);
   const fs::path bad = dir / ("bad_scene_" + std::to_string(getpid()) + ".yaml");
-  std::string text = slurp(kDig);
+  std::string text = read_text_file(kDig);
   const std::string from = "duration: 10.0";
   REQUIRE(text.find(from) != std::string::npos);
   text.replace(text.find(from), from.size(), "duration: -3");

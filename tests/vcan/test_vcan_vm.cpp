@@ -16,8 +16,11 @@
 #include <vector>
 
 #include "hal/candump_log.hpp"
+#include "text_file.hpp"
 
 namespace fs = std::filesystem;
+
+using exc::test::read_text_file;
 
 namespace {
 
@@ -28,12 +31,6 @@ struct RunResult {
   std::string out, err;
 };
 
-std::string read_file(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::string quote(const std::string& s) {
   std::string q = "'";
@@ -56,8 +53,8 @@ RunResult run(const std::string& command, const fs::path& dir) {
   const int raw = std::system(line.c_str());
   RunResult r;
   r.status = (raw != -1 && WIFEXITED(raw)) ? WEXITSTATUS(raw) : -1;
-  r.out = read_file(out);
-  r.err = read_file(err);
+  r.out = read_text_file(out);
+  r.err = read_text_file(err);
   return r;
 }
 
@@ -131,21 +128,21 @@ TEST_CASE("vcan/vcan-vm passes output and status and directory and environment a
   CHECK(r.status == 3);
   CHECK(r.out == "out 1\nout 2\n");
   CHECK(r.err == "err\n");
-  CHECK(read_file(dir / "where.txt") == dir.string() + "\n");
-  CHECK(read_file(dir / "env.txt") == "a b'c");
-  const std::string link = read_file(dir / "link.txt");
+  CHECK(read_text_file(dir / "where.txt") == dir.string() + "\n");
+  CHECK(read_text_file(dir / "env.txt") == "a b'c");
+  const std::string link = read_text_file(dir / "link.txt");
   CHECK(link.find("vcan0") != std::string::npos);
   CHECK(link.find("UP") != std::string::npos);
   CHECK(link.find("link/can") != std::string::npos);
 
   // What the probe's second raw socket received, in order.
-  INFO("probe stderr: ", read_file(dir / "probe.err"));
-  CHECK(read_file(dir / "probe.status") == "0\n");
-  CHECK(lines_of(read_file(dir / "probe.out")) == sent);
+  INFO("probe stderr: ", read_text_file(dir / "probe.err"));
+  CHECK(read_text_file(dir / "probe.status") == "0\n");
+  CHECK(lines_of(read_text_file(dir / "probe.out")) == sent);
 
   // What candump recorded: same frames, same order, on vcan0, with time stamps that do not go back.
-  CHECK(read_file(dir / "candump.status") == "0\n");
-  const std::vector<std::string> captured = lines_of(read_file(dir / "capture.log"));
+  CHECK(read_text_file(dir / "candump.status") == "0\n");
+  const std::vector<std::string> captured = lines_of(read_text_file(dir / "capture.log"));
   REQUIRE(captured.size() == sent.size());
   std::int64_t last_ns = 0;
   for (std::size_t i = 0; i < sent.size(); ++i) {
@@ -170,9 +167,9 @@ TEST_CASE("vcan/vcan-vm passes output and status and directory and environment a
 
 #ifdef EXC_HAL_TESTS
   // The HAL's SocketCAN test, which skips on this kernel, runs for real on the VM's vcan0.
-  const std::string hal = read_file(dir / "hal.out");
+  const std::string hal = read_text_file(dir / "hal.out");
   INFO("hal test output: ", hal);
-  CHECK(read_file(dir / "hal.status") == "0\n");
+  CHECK(read_text_file(dir / "hal.status") == "0\n");
   CHECK(hal.find("SKIPPED") == std::string::npos);
   CHECK(std::regex_search(hal, std::regex("test cases: +1 \\| +1 passed \\| +0 failed")));
 #endif
