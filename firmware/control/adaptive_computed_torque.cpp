@@ -9,16 +9,30 @@ namespace exc::control {
 AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const ControllerConfig& config,
                                                const EffortLimits& limits)
     : model_(model), ws_(model), config_(config), limits_(limits) {
-  const Mat8 A = error_dynamics_matrix(config.gains.kp, config.gains.kv);
-  const Mat8 Q = config.lyapunov_q.asDiagonal();
-  if (!solve_lyapunov(A, Q, P_))
-    throw ConfigError("<controller>", "controller.kp/kv", "A^T P + P A + Q = 0 has no SPD solution");
+  PidGains gains = config.gains;
+  if (config.integral_action) {
+    const Mat12 A = integral_error_dynamics_matrix(gains.kp, gains.kv, gains.ki);
+    Vec12 q;
+    q << config.lyapunov_q_integral, config.lyapunov_q;
+    if (!solve_lyapunov(A, Mat12(q.asDiagonal()), P_))
+      throw ConfigError("<controller>", "controller.kp/kv/ki", "A^T P + P A + Q = 0 has no SPD solution");
+  } else {
+    gains.ki.setZero();  // the paper's law: no integral state, zero rows and columns of P for it
+    const Mat8 A = error_dynamics_matrix(gains.kp, gains.kv);
+    Mat8 P8;
+    if (!solve_lyapunov(A, Mat8(config.lyapunov_q.asDiagonal()), P8))
+      throw ConfigError("<controller>", "controller.kp/kv", "A^T P + P A + Q = 0 has no SPD solution");
+    P_.bottomRightCorner<8, 8>() = P8;
+  }
+  feedback_.set_gains(gains);
   reset();
 }
 
 void AdaptiveComputedTorque::reset() {
   theta_hat_ = config_.theta_initial;
   anchor_.reset();
+  feedback_.reset();
+  saturated_ = 0;
 }
 
 Vec6 AdaptiveComputedTorque::gamma() const {
@@ -50,14 +64,14 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   const Vec2 rhodd = ws_.J_t * qdd_for_y + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, ws_.rhod, rhodd, out.rho_env, out.in_soil);
 
-  const Vec4 v = in.qdd_d - config_.gains.kv.cwiseProduct(out.ed) - config_.gains.kp.cwiseProduct(out.e);
+  const Vec4 v = in.qdd_d - feedback_.update(out.e, out.ed, config_.period, saturated_);
   out.tau_unsaturated = M_a * v + h_a + Y * theta_hat_;  // eq. 12
-  out.saturated = limits_.saturate(out.tau_unsaturated, out.tau);
+  out.saturated = saturated_ = limits_.saturate(out.tau_unsaturated, out.tau);
   last_tau_ = out.tau;
 
-  Vec8 x;
-  x << out.e, out.ed;
-  out.lyapunov_tracking = x.dot(P_ * x);
+  Vec12 z;
+  z << feedback_.integral(), out.e, out.ed;
+  out.lyapunov_tracking = z.dot(P_ * z);
   out.lyapunov = out.lyapunov_tracking;
   if (in.soil.theta_known) {
     const Vec6 g = gamma();
@@ -69,7 +83,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   if (out.in_soil && out.saturated == 0 && in.actuator_limited == 0) {
     const Eigen::LDLT<Mat4> ldlt(M_a);
     const Mat4x6 Phi = ldlt.solve(Y);                       // M_a^-1 Y
-    const Vec4 BtPx = P_.bottomRows<4>() * x;               // B^T P x
+    const Vec4 BtPx = P_.bottomRows<4>() * z;               // B^T P x (or z)
     const Vec6 theta_dot = -config_.adaptation_rate.cwiseProduct(Phi.transpose() * BtPx);
     theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
   }

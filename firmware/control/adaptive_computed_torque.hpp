@@ -8,6 +8,9 @@
 //   V = x^T P x + Theta~^T Gamma Theta~, Theta~ = Theta_hat - Theta, Vdot = -x^T Q x   (eqs. 26, 28)
 // Sign check: with the plant M_a qdd + h_a + J_t^T F_soil = tau_a the error obeys
 // edd + K_v ed + K_p e = Phi Theta~, so Vdot = -x^T Q x + 2 Theta~^T (Phi^T B^T P x + Gamma Theta_hat_dot).
+// Beyond the paper, optional (controller.integral_action): integral action, qdd_d - K_v ed - K_p e
+// - K_i int e, with z = [int e; e; ed], A = [0 I 0; 0 0 I; -K_i -K_p -K_v], B = [0; 0; I] in place of
+// x, A, B above; the same proof (the error obeys edd + K_v ed + K_p e + K_i int e = Phi Theta~).
 // Decisions the paper leaves open (docs/control.md):
 // - Update law integrated by explicit Euler at the control period, then projected onto
 //   [theta_min, theta_max] per parameter. Gamma is diagonal, so the clamp is the projection in the
@@ -18,6 +21,7 @@
 //   (state_estimator.hpp) or qdd_d, by config (regressor_acceleration).
 #include "control/controller_config.hpp"
 #include "control/effort_limits.hpp"
+#include "control/pid.hpp"
 #include "control/regressor.hpp"
 #include "control/soil_anchor_estimator.hpp"
 #include "model/closed_chain.hpp"
@@ -33,9 +37,12 @@ class AdaptiveComputedTorque final : public Controller {
   ControlOutput update(const ControlInput& in) override;
   ControllerKind kind() const override { return ControllerKind::adaptive; }
 
-  const Mat8& lyapunov_p() const { return P_; }
+  // P of V over z = [int e; e; ed] (without integral action the int e rows and columns are zero).
+  const Mat12& lyapunov_p() const { return P_; }
   const Vec6& theta_hat() const { return theta_hat_; }
   void set_theta_hat(const Vec6& th) { theta_hat_ = th.cwiseMax(config_.theta_min).cwiseMin(config_.theta_max); }
+  // The integral of e (with integral action; tests start from a given one).
+  void set_error_integral(const Vec4& i) { feedback_.set_integral(i); }
   // Gamma of V (the inverse of the adaptation rates; a zero rate gives an infinite weight, so V is
   // reported with that parameter's term left out).
   Vec6 gamma() const;
@@ -45,7 +52,9 @@ class AdaptiveComputedTorque final : public Controller {
   Workspace ws_;
   ControllerConfig config_;
   EffortLimits limits_;
-  Mat8 P_ = Mat8::Identity();
+  Mat12 P_ = Mat12::Zero();
+  Pid feedback_;                      // K_p e + K_v ed (+ K_i int e), the integral frozen on saturation
+  std::uint8_t saturated_ = 0;
   Vec6 theta_hat_ = Vec6::Zero();
   SoilAnchorEstimator anchor_;
   Vec4 last_tau_ = Vec4::Zero();

@@ -41,7 +41,8 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
                  {"type", "period", "kp", "kv", "ki", "integral_limit", "lyapunov_q",
                   "adaptation_rate", "theta_min", "theta_max", "theta_initial",
                   "regressor_acceleration", "slotine_li", "filters", "watchdog_timeout",
-                  "blend_time", "actuator_lag", "actuator_lag_target"});
+                  "blend_time", "actuator_lag", "actuator_lag_target", "integral_action",
+                  "lyapunov_q_integral"});
   if (node["type"]) {
     const std::string t = node["type"].as<std::string>();
     if (t == "pid") c.kind = ControllerKind::pid;
@@ -89,6 +90,16 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
   if (node["watchdog_timeout"])
     c.watchdog_timeout = read_number(node["watchdog_timeout"], file, s + ".watchdog_timeout", 1e-4, 10);
   if (node["blend_time"]) c.blend_time = read_number(node["blend_time"], file, s + ".blend_time", 0, 10);
+  if (node["integral_action"]) {
+    const YAML::Node n = node["integral_action"];
+    try {
+      c.integral_action = n.as<bool>();
+    } catch (const YAML::Exception&) {
+      throw ConfigError(file, s + ".integral_action", "'" + n.as<std::string>() + "' (allowed: true, false)");
+    }
+  }
+  if (node["lyapunov_q_integral"])
+    c.lyapunov_q_integral = read_vector<4>(node["lyapunov_q_integral"], file, s + ".lyapunov_q_integral", 1e-9, 1e9);
   if (node["actuator_lag"]) c.actuator_lag = read_number(node["actuator_lag"], file, s + ".actuator_lag", 0, 1);
   if (node["actuator_lag_target"])
     c.actuator_lag_target = read_number(node["actuator_lag_target"], file, s + ".actuator_lag_target", 1e-4, 1);

@@ -41,6 +41,10 @@ struct ControllerConfig {
   Vec6 theta_max = (Vec6() << 500, 3e4, 1e6, 500, 3e4, 1e6).finished();
   Vec6 theta_initial = (Vec6() << 100, 2e3, 3e4, 100, 2e3, 3e4).finished();
   RegressorAcceleration regressor_acceleration = RegressorAcceleration::filtered;
+  // Beyond the paper: integral action in the adaptive law (K_i and integral_limit as the PID's), with
+  // Q of the integral states (z = [int e; e; ed] order: these first, then lyapunov_q).
+  bool integral_action = false;
+  Vec4 lyapunov_q_integral = (Vec4() << 0.64, 0.64, 6.4, 0.064).finished();  // lyapunov_q e weights / 100 (docs/control.md)
 
   // Slotine-Li: s = ed + lambda e; tau = ... - kd s (kd in 1/s, scaled by M_a: see slotine_li.hpp).
   // Same error bandwidth as the computed-torque laws: kv = lambda + kd, kp = lambda kd.

@@ -33,7 +33,7 @@ struct LyapunovRun {
 // Step 25 us: at 50 us the explicit Euler steps show one-step rises of ~1e-6 V0 that vanish at
 // 25 us (so they are integration error, not the law). Noise-free, exact model, constant soil parameters, fixed anchor, the controller given the true
 // qdd (the algebraic loop through the soil's added mass solved by fixed-point iteration).
-LyapunovRun run_lyapunov(const Vec2& anchor_error, double dt = 2.5e-5) {
+LyapunovRun run_lyapunov(const Vec2& anchor_error, bool integral_action = false, double dt = 2.5e-5) {
   const Model model = build_model(reference_machine());
   ControllerConfig cfg;
   cfg.period = dt;
@@ -42,6 +42,8 @@ LyapunovRun run_lyapunov(const Vec2& anchor_error, double dt = 2.5e-5) {
   // Vdot = -x^T Q x holds for any SPD Q; Q = I keeps the O(dt^2) residual of the explicit Euler
   // update below round-off at this step (the defaults' larger Q needs a smaller step for that).
   cfg.lyapunov_q = Vec8::Ones();
+  cfg.integral_action = integral_action;  // z = [int e; e; ed] with K_i = 100 (the defaults)
+  cfg.lyapunov_q_integral = Vec4::Ones();
   EffortLimits unlimited;
   AdaptiveComputedTorque ctrl(model, cfg, unlimited);
 
@@ -61,6 +63,8 @@ LyapunovRun run_lyapunov(const Vec2& anchor_error, double dt = 2.5e-5) {
 
   LyapunovRun run;
   double v_prev = -1;
+  // With integral action the integral starts away from zero, so that its terms in V carry weight.
+  if (integral_action) ctrl.set_error_integral(Vec4(0.0, 2e-3, -3e-3, 3e-3));
   Vec4 qdd_true = Vec4::Zero();
   const int steps = static_cast<int>(std::lround(2.0 / dt));
   for (int k = 0; k < steps; ++k) {  // 2 s
@@ -101,6 +105,13 @@ TEST_CASE("firmware/adaptive: V = x'Px + Theta~'Gamma Theta~ never increases (no
   MESSAGE("V0 = " << run.v0 << ", V(2 s) = " << run.v_end << ", worst one-step rise = " << run.worst_rise);
   CHECK(run.v_end < 0.9 * run.v0);                 // it does decrease
   CHECK(run.worst_rise <= 1e-9 * run.v0);          // and never rises beyond integration round-off
+}
+
+TEST_CASE("firmware/adaptive with integral action: V = z'Pz + Theta~'Gamma Theta~ never increases (noise-free, exact model)") {
+  const LyapunovRun run = run_lyapunov(Vec2::Zero(), true);
+  MESSAGE("V0 = " << run.v0 << ", V(2 s) = " << run.v_end << ", worst one-step rise = " << run.worst_rise);
+  CHECK(run.v_end < 0.9 * run.v0);
+  CHECK(run.worst_rise <= 1e-9 * run.v0);
 }
 
 TEST_CASE("firmware/adaptive: the Lyapunov check can fail (a wrong anchor breaks the error dynamics)") {
@@ -182,5 +193,50 @@ TEST_CASE("firmware/adaptive and Slotine-Li freeze the soil estimate while the a
     const Vec6 after_free = free_law->update(in).theta_hat, after_held = held_law->update(limited).theta_hat;
     CHECK((after_free - cfg.theta_initial).norm() > 0);
     CHECK(after_held == cfg.theta_initial);
+  }
+}
+
+TEST_CASE("firmware/adaptive with integral action removes the steady error of a wrong mass model; without it the error stays") {
+  // Holding a pose in the air with a controller whose links are 20 % too light: the gravity it does
+  // not cancel is a constant disturbance. Without integral action the error settles where K_p e
+  // balances it; with K_i the integral takes it over and e goes to zero (s^3 + K_v s^2 + K_p s + K_i
+  // is Hurwitz, slowest pole ~ -2 1/s, so 8 s is ~16 time constants).
+  const Model truth = build_model(reference_machine());
+  Machine light_machine = reference_machine();
+  for (BodyInertia& b : light_machine.bodies) {
+    b.mass *= 0.8;
+    b.inertia *= 0.8;
+  }
+  const Model light = build_model(light_machine);
+  Vec4 q0;
+  REQUIRE(inverse_kinematics(truth.machine, 0.0, TipPose{7.0, 1.0, 0.0}, q0) == IkStatus::ok);
+  sim::SoilTruth air;
+  air.terrain_height = -50;  // never touched
+  Vec4 final_error[2];
+  for (int with_integral = 0; with_integral < 2; ++with_integral) {
+    ControllerConfig cfg;
+    cfg.integral_action = with_integral == 1;
+    AdaptiveComputedTorque ctrl(light, cfg, effort_limits_of(truth.machine));
+    sim::ModelPlant plant(truth, air);
+    plant.reset(q0, Vec4::Zero());
+    ControlOutput out;
+    for (int k = 0; k < 8000; ++k) {
+      ControlInput in;
+      in.t = k * cfg.period;
+      in.q = plant.q();
+      in.qd = plant.qd();
+      in.q_d = q0;
+      in.soil.terrain_height = air.terrain_height;
+      out = ctrl.update(in);
+      REQUIRE(out.status == ModelStatus::ok);
+      REQUIRE(plant.step(out.tau, plant.soil_load(), cfg.period));
+    }
+    final_error[with_integral] = out.e.cwiseAbs();
+  }
+  MESSAGE("|e| after 8 s (m): without integral " << final_error[0].transpose() << ", with " << final_error[1].transpose());
+  for (int j = 1; j < 4; ++j) {
+    CAPTURE(j);
+    CHECK(final_error[0][j] > 1e-4);                       // the disturbance is really there
+    CHECK(final_error[1][j] < 1e-3 * final_error[0][j]);  // and integral action removes it
   }
 }

@@ -50,6 +50,8 @@ controller:
   blend_time: 0.1
   actuator_lag: 0.03
   actuator_lag_target: 0.006
+  integral_action: true
+  lyapunov_q_integral: [1, 2, 3, 4]
 )")["controller"], "scene.yaml");
   CHECK(c.kind == ControllerKind::slotine_li);
   CHECK(c.period == 0.002);
@@ -64,6 +66,8 @@ controller:
   CHECK(c.watchdog_timeout == 0.05);
   CHECK(c.actuator_lag == 0.03);
   CHECK(c.actuator_lag_target == 0.006);
+  CHECK(c.integral_action);
+  CHECK(c.lyapunov_q_integral[3] == 4);
 }
 
 TEST_CASE("firmware/controller config errors name the field and the allowed range") {
@@ -82,5 +86,7 @@ TEST_CASE("firmware/controller config errors name the field and the allowed rang
             .find("controller.actuator_lag_target | 0.03 s must lie in actuator_lag / 20 .. actuator_lag = 0.001 .. 0.02 s") == 0);
   CHECK(error_of("controller: {actuator_lag: 0.1, actuator_lag_target: 0.001}").find("controller.actuator_lag_target | ") == 0);
   CHECK(error_of("controller: {actuator_lag: -0.01}").find("controller.actuator_lag | -0.01 outside the allowed range 0 .. 1") == 0);
+  CHECK(error_of("controller: {integral_action: maybe}") == "controller.integral_action | 'maybe' (allowed: true, false)");
+  CHECK(error_of("controller: {lyapunov_q_integral: [1, 0, 1, 1]}").find("controller.lyapunov_q_integral[1] | 0 outside the allowed range") == 0);
   CHECK(error_of("controller: {period: nan}").find("controller.period | ") == 0);
 }
