@@ -144,8 +144,10 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   const double t = time();
   const Vec4 q = to_vec(sensors_.position);
   const Vec4 qd = to_vec(sensors_.velocity);
-  if (transition.changed && (transition.from == control::Mode::safe_stop ||
-                             transition.from == control::Mode::wait_sensors)) {
+  // Entering hold/track after a stop or at start: the estimator, the law and the lag model restart.
+  const bool restarted = transition.changed && (transition.from == control::Mode::safe_stop ||
+                                                transition.from == control::Mode::wait_sensors);
+  if (restarted) {
     estimator_.reset(q, qd);
     controller_->reset();
   } else {
@@ -179,11 +181,9 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))
     blender_.on_switch(t, last_sent_, out_.tau);
   const Vec4 tau = blender_.apply(t, out_.tau);
-  // After a stop the actuator is taken to deliver what the law asks for first (the plant's
+  // After a restart the actuator is taken to deliver what the law asks for first (the plant's
   // actuators hold their effort); last_sent_ stays the effort asked for, the blend's reference.
-  if (transition.changed && (transition.from == control::Mode::safe_stop ||
-                             transition.from == control::Mode::wait_sensors))
-    lag_compensator_.reset(tau);
+  if (restarted) lag_compensator_.reset(tau);
   const Vec4 sent = lag_compensator_.apply(tau);
   command_.mode = hal::CommandMode::effort;
   for (int j = 0; j < 4; ++j) command_.value[j] = sent[j];

@@ -9,6 +9,7 @@
 // advanced with the clamped u, so a saturated actuator is modelled as such (no wind-up).
 // T_a = 0 (the paper's ideal force actuators) passes r through unchanged. Allocation-free.
 #include <cmath>
+#include <cstdint>
 
 #include "control/effort_limits.hpp"
 #include "model/types.hpp"
