@@ -4,7 +4,6 @@
 
 #include <fstream>
 #include <regex>
-#include <sstream>
 
 #include "model/machine.hpp"
 #include "text_file.hpp"

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 #include <string>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -26,7 +25,6 @@ struct Run {
   fs::path dir;
 };
 
-
 // Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel).
 Run run_sim(const std::string& args) {
   static int call = 0;
@@ -43,6 +41,21 @@ Run run_sim(const std::string& args) {
 }
 
 const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+
+// The shipped dig scene with one edit (which must apply exactly once), written next to the test's
+// runs under a name of this process; returns its path.
+fs::path edited_dig(const std::string& from, const std::string& to, const std::string& stem) {
+  std::string text = read_text_file(kDig);
+  const auto pos = text.find(from);
+  REQUIRE(pos != std::string::npos);
+  REQUIRE(text.find(from, pos + 1) == std::string::npos);
+  text.replace(pos, from.size(), to);
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
+  fs::create_directories(dir);
+  const fs::path path = dir / (stem + "_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(path) << text;
+  return path;
+}
 const char* const kJoints[4] = {"swing", "boom", "arm", "bucket"};
 
 }  // namespace
@@ -119,14 +132,8 @@ TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better tha
 
 TEST_CASE("tools/excavator-sim: on the dig scene's lagging actuators the firmware's lag compensation keeps the adaptive law's lead") {
   // The shipped scene with the compensation switched off: same plant, same laws.
-  const std::string text = read_text_file(kDig);
-  const std::string from = "actuator_lag: 0.02";
-  REQUIRE(text.find("fidelity: limited") != std::string::npos);
-  REQUIRE(text.find(from) != std::string::npos);
-  std::string off = text;
-  off.replace(off.find(from), from.size(), "actuator_lag: 0");
-  const fs::path scene = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("dig_no_compensation_" + std::to_string(getpid()) + ".yaml");
-  std::ofstream(scene) << off;
+  REQUIRE(read_text_file(kDig).find("fidelity: limited") != std::string::npos);
+  const fs::path scene = edited_dig("actuator_lag: 0.02", "actuator_lag: 0", "dig_no_compensation");
   const Run with = run_sim("run " + kDig + " --no-report --quiet --json s.json --out out");
   const Run without = run_sim("run " + scene.string() + " --no-report --quiet --json s.json --out out");
   REQUIRE(with.status == 0);
@@ -141,17 +148,11 @@ TEST_CASE("tools/excavator-sim: on the dig scene's lagging actuators the firmwar
     CHECK(uncompensated >= 1.3 * on);
   }
   CHECK(a["heap_allocations_in_loop"].get<long long>() == 0);
+  fs::remove(scene);
 }
 
 TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits 2") {
-  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
-  fs::create_directories(dir);
-  const fs::path bad = dir / ("bad_scene_" + std::to_string(getpid()) + ".yaml");
-  std::string text = read_text_file(kDig);
-  const std::string from = "duration: 10.0";
-  REQUIRE(text.find(from) != std::string::npos);
-  text.replace(text.find(from), from.size(), "duration: -3");
-  std::ofstream(bad) << text;
+  const fs::path bad = edited_dig("duration: 10.0", "duration: -3", "bad_scene");
   for (const char* sub : {"run", "robustness"}) {
     const Run r = run_sim(std::string(sub) + " " + bad.string() + " --quiet");
     INFO(sub << ": " << r.err);
