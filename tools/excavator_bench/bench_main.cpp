@@ -348,8 +348,8 @@ std::vector<PeerResult> peer_comparison(const std::vector<BenchScene>& scenes,
     // Step times are the best of kTimingPasses medians, for both engines: a burst of load from
     // elsewhere on this shared machine can cover a whole pass and would otherwise decide the ratio.
     p.plant_step_us = ours.step_median_us;
-    const OpenLoopSettings timing = st;
-    auto plant_pass = [&] { return run_open_loop(s, profile, timing, true).step_median_us; };
+    // A copy of st: it is switched to the augmented form below.
+    auto plant_pass = [&, st] { return run_open_loop(s, profile, st, true).step_median_us; };
     p.constraint_error = ours.max_constraint_residual;
     p.tip_rms = ours.ok ? rms_distance(ours.tip, references[i].tip) : NAN;
     p.reference_tip = references[i].tip;

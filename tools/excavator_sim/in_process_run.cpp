@@ -156,6 +156,23 @@ RunResult run_one(const SceneBundle& bundle, control::ControllerKind kind, const
   return result;
 }
 
+// The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of it,
+// the integrator.
+std::string describe_setup(const SceneBundle& bundle) {
+  const plant::Scene& sc = bundle.scene;
+  std::ostringstream o;
+  o << "actuators " << plant::to_string(sc.actuators.fidelity);
+  if (sc.actuators.fidelity == plant::ActuatorFidelity::limited) o << " (effort lag " << sc.actuators.lag * 1e3 << " ms)";
+  o << ", firmware lag compensation ";
+  if (bundle.controller.actuator_lag > 0)
+    o << bundle.controller.actuator_lag * 1e3 << " ms -> " << bundle.controller.actuator_lag_target * 1e3 << " ms";
+  else
+    o << "off";
+  o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
+    << " at " << sc.integrator.step * 1e3 << " ms";
+  return o.str();
+}
+
 }  // namespace
 
 SceneBundle load_scene_bundle(const std::string& path) {
@@ -171,20 +188,7 @@ SceneBundle load_scene_bundle(const std::string& path) {
 Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
   Summary summary;
   summary.scene = bundle.name;
-  {
-    const plant::Scene& sc = bundle.scene;
-    std::ostringstream o;
-    o << "actuators " << plant::to_string(sc.actuators.fidelity);
-    if (sc.actuators.fidelity == plant::ActuatorFidelity::limited) o << " (effort lag " << sc.actuators.lag * 1e3 << " ms)";
-    o << ", firmware lag compensation ";
-    if (bundle.controller.actuator_lag > 0)
-      o << bundle.controller.actuator_lag * 1e3 << " ms -> " << bundle.controller.actuator_lag_target * 1e3 << " ms";
-    else
-      o << "off";
-    o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
-      << " at " << sc.integrator.step * 1e3 << " ms";
-    summary.setup = o.str();
-  }
+  summary.setup = describe_setup(bundle);
   std::shared_ptr<telemetry::LcmOutput> output;
   if (!options.lcm_url.empty()) {
     std::string error;
