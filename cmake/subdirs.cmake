@@ -1,9 +1,14 @@
-# add_present_subdirectories(): adds every immediate subdirectory that has a CMakeLists.txt, in name
-# order, so each component (and each tool or test suite) owns its own build file.
+# add_present_subdirectories([PLANT_SIDE dir...]): adds every immediate subdirectory that has a
+# CMakeLists.txt, in name order, so each component (and each tool or test suite) owns its own build
+# file. The PLANT_SIDE ones need the simulated machine and are left out when EXC_FIRMWARE_ONLY is on.
 function(add_present_subdirectories)
+  cmake_parse_arguments(ARG "" "" "PLANT_SIDE" ${ARGN})
   file(GLOB children LIST_DIRECTORIES true RELATIVE ${CMAKE_CURRENT_SOURCE_DIR} ${CMAKE_CURRENT_SOURCE_DIR}/*)
   list(SORT children)
   foreach(child ${children})
+    if(EXC_FIRMWARE_ONLY AND child IN_LIST ARG_PLANT_SIDE)
+      continue()
+    endif()
     if(IS_DIRECTORY ${CMAKE_CURRENT_SOURCE_DIR}/${child} AND EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${child}/CMakeLists.txt)
       add_subdirectory(${child})
     endif()

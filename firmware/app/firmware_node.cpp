@@ -92,21 +92,32 @@ void FirmwareNode::end_cycle() {
   in.have_valid_frame = have_valid_;
   in.last_valid_frame_time = last_valid_time_;
   in.track_requested = t >= config_.track_delay;
-  in.trajectory_finished = machine_.mode() == control::Mode::track &&
-                           t - track_start_ + task_.start_time() >= task_.end_time();
+  in.stop_requested = stop_requested_;
+  // Once the task has ended it stays ended: hold must not re-enter track and restart the path.
+  in.trajectory_finished =
+      finished_ || (machine_.mode() == control::Mode::track && t - track_start_ + task_.start_time() >= task_.end_time());
   in.fault = fault_;
   const control::Transition transition = machine_.step(in);
   transition_ = transition;
   if (transition.changed) {
     if (transition.to == control::Mode::hold) {
-      held_q_ = to_vec(sensors_.position);
+      // From track, hold where the path was (its last point when it ended): the desired pose never
+      // steps. From start-up or a safe stop, hold where the machine is.
+      held_q_ = transition.from == control::Mode::track ? q_d_ : to_vec(sensors_.position);
+      if (transition.from == control::Mode::track && !finished_ && in.trajectory_finished) {
+        Vec4 qd_end, qdd_end;
+        task_.trajectory.evaluate(task_.end_time(), held_q_, qd_end, qdd_end);
+        finished_ = true;
+        finish_time_ = t;
+      }
       fault_ = false;
+      fault_code_ = FirmwareFault::none;
     }
     if (transition.to == control::Mode::track) track_start_ = t;
-    if (transition.from == control::Mode::track && in.trajectory_finished) finished_ = true;
     if (transition.to == control::Mode::safe_stop) {
       ++safe_stops_;
-      port_.send_fault(false, static_cast<std::uint16_t>(fault_ ? FirmwareFault::model : FirmwareFault::sensor_timeout));
+      fault_code_ = fault_ ? FirmwareFault::model : FirmwareFault::sensor_timeout;
+      port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
     }
   }
 
@@ -118,7 +129,7 @@ void FirmwareNode::end_cycle() {
   if (telemetry_ != nullptr && transition.changed) {
     exlcm::fault_t f{};
     f.utime = static_cast<std::int64_t>(t * 1e6);
-    f.code = static_cast<std::int32_t>(transition.to == control::Mode::safe_stop ? 1 : 0);
+    f.code = static_cast<std::int32_t>(transition.to == control::Mode::safe_stop ? fault_code_ : FirmwareFault::none);
     f.severity = transition.to == control::Mode::safe_stop ? 2 : 0;
     f.active = transition.to == control::Mode::safe_stop;
     std::snprintf(reinterpret_cast<char*>(f.text), sizeof(f.text), "%s -> %s: %s", control::to_string(transition.from),

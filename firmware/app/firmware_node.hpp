@@ -59,6 +59,10 @@ class FirmwareNode {
   bool receive();
   // Completes the cycle once the plant had its chance to answer.
   void end_cycle();
+  // A stop from outside (operator, supervisor, signal): the next cycle leaves track for hold at the
+  // desired pose of that moment, and the node stays in hold. Real-time safe (sets a flag).
+  void request_stop() { stop_requested_ = true; }
+  bool stop_requested() const { return stop_requested_; }
   // The last mode transition (changed == false when the last cycle kept its mode).
   const control::Transition& last_transition() const { return transition_; }
   // Tracking figures as the firmware measures them (sensed q_a against q_d, while tracking).
@@ -68,8 +72,10 @@ class FirmwareNode {
   double time() const { return static_cast<double>(cycle_) * period_; }
   control::Mode mode() const { return machine_.mode(); }
   bool tracking() const { return machine_.mode() == control::Mode::track; }
-  // The trajectory ran to its end (the node then holds the last point).
+  // The trajectory ran to its end (the node then holds its last point until the run ends or a
+  // stop arrives; it never restarts the task by itself), and the loop time when it did (s).
   bool trajectory_finished() const { return finished_; }
+  double finish_time() const { return finish_time_; }
   // Desired and measured q_a of the last cycle (valid while tracking or holding).
   const Vec4& q_desired() const { return q_d_; }
   const hal::SensorState& sensors() const { return sensors_; }
@@ -114,7 +120,10 @@ class FirmwareNode {
   Vec4 q_d_ = Vec4::Zero(), qd_d_ = Vec4::Zero(), qdd_d_ = Vec4::Zero();
   Vec4 last_sent_ = Vec4::Zero();
   bool fault_ = false;
+  FirmwareFault fault_code_ = FirmwareFault::none;
   bool finished_ = false;
+  double finish_time_ = 0;
+  bool stop_requested_ = false;
   std::uint64_t safe_stops_ = 0;
   hal::SensorState sensors_;
   hal::CommandState command_;

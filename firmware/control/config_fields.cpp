@@ -37,7 +37,7 @@ void reject_unknown_keys(const YAML::Node& n, const std::string& file, const std
     if (!allowed.count(key)) {
       std::string list;
       for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
-      throw ConfigError(file, field + "." + key, "unknown key (allowed: " + list + ")");
+      throw ConfigError(file, field.empty() ? key : field + "." + key, "unknown key (allowed: " + list + ")");
     }
   }
 }

@@ -41,7 +41,9 @@ class ControlStateMachine {
   double watchdog_timeout() const { return timeout_; }
 
   Transition step(const StateMachineInputs& in) {
-    const bool fresh = in.have_valid_frame && (in.t - in.last_valid_frame_time) <= timeout_;
+    // 1 ns of slack: times are cycle counts times the period, and (k + n) T - k T may round above
+    // n T; the watchdog must trip on the same cycle whatever k is.
+    const bool fresh = in.have_valid_frame && (in.t - in.last_valid_frame_time) <= timeout_ + 1e-9;
     switch (mode_) {
       case Mode::init: return go(Mode::wait_sensors, "started");
       case Mode::wait_sensors:

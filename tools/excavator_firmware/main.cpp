@@ -16,9 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/firmware_node.hpp"
+#include "app/firmware_settings.hpp"
 #include "hal/clock.hpp"
 #include "hal/socketcan_bus.hpp"
-#include "in_process_run.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
 namespace {
@@ -67,8 +67,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   try {
-    const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(scene_path);
-    const exc::Model model = exc::build_model(bundle.scene.machine);
+    const exc::app::FirmwareSettings settings = exc::app::load_firmware_settings(scene_path);
+    const exc::Model model = exc::build_model(settings.machine);
     std::uint32_t ids[32];
     const std::size_t n = exc::hal::receive_ids(exc::hal::Node::firmware, ids, 32);
     std::string error;
@@ -92,15 +92,15 @@ int main(int argc, char** argv) {
     fc.kind = controller == "pid" ? exc::control::ControllerKind::pid
               : controller == "slotine_li" ? exc::control::ControllerKind::slotine_li
                                            : exc::control::ControllerKind::adaptive;
-    fc.controller = bundle.controller;
-    fc.terrain_height = bundle.scene.terrain.height;
-    exc::app::FirmwareNode node(model, bundle.task, fc, port, publisher.get());
+    fc.controller = settings.controller;
+    fc.terrain_height = settings.terrain_height;
+    exc::app::FirmwareNode node(model, settings.task, fc, port, publisher.get());
 
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     if (realtime) try_realtime();
-    const double cycle_s = bundle.controller.period;
-    const auto cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : bundle.scene.duration) / cycle_s));
+    const double cycle_s = settings.controller.period;
+    const auto cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / cycle_s));
     const auto wait_ns = static_cast<std::int64_t>(realtime ? 0.8 * cycle_s * 1e9 : sensor_timeout_ms * 1e6);
     const auto startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
     exc::hal::DeadlineSleeper sleeper(static_cast<std::int64_t>(std::llround(cycle_s * 1e9)));

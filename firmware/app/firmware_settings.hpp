@@ -1,0 +1,37 @@
+#pragma once
+// The firmware's own reading of a scene file: the sections a controller on a real machine is given
+// (its nominal machine, `controller:`, `task:`, the site's terrain height and the run's duration).
+// The simulated machine's sections (soil, actuators, integrator, sensors, initial state, checks)
+// belong to the plant, which reads them with its own loader; the firmware only checks that every
+// top-level key is a known section, so a typo is an error on both sides. Nothing here links plant
+// code. Start-up code: allocates, throws control::ConfigError naming file, field and range.
+#include <string>
+
+#include "control/controller_config.hpp"
+#include "control/task.hpp"
+#include "model/machine.hpp"
+
+namespace YAML {
+class Node;
+}
+
+namespace exc::app {
+
+struct FirmwareSettings {
+  std::string file;          // the scene file
+  std::string name;          // scene name
+  std::string machine_file;  // resolved path of the nominal machine, empty for the built-in one
+  Machine machine;           // the controller's model of the machine (nominal parameters)
+  control::ControllerConfig controller;
+  control::Task task;
+  double terrain_height = 0;  // m, world z of the flat ground the soil estimator anchors to
+  double duration = 10;       // s, how long the run lasts
+};
+
+// Opens and parses the file once.
+FirmwareSettings load_firmware_settings(const std::string& path);
+// From an already parsed document; relative machine paths resolve against base_directory.
+FirmwareSettings parse_firmware_settings(const YAML::Node& root, const std::string& file,
+                                         const std::string& base_directory);
+
+}  // namespace exc::app

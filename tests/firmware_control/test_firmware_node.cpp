@@ -1,0 +1,201 @@
+// FirmwareNode's own cycle, closed over the in-memory CAN bus with the model plant on the other end
+// (firmware side only: no sim_plant code). What a user sees of the node: the task ends in hold at
+// its final pose, a stop from outside brings it to hold, faults carry their codes, and the real
+// cycle allocates nothing.
+#include <doctest/doctest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <vector>
+
+#include "allocation_counter.hpp"
+#include "app/firmware_node.hpp"
+#include "closed_loop.hpp"
+#include "hal/memory_bus.hpp"
+#include "model/closed_chain.hpp"
+#include "scenes.hpp"
+
+using namespace exc;
+using namespace exc::control;
+
+namespace {
+
+struct SimClock {
+  std::int64_t now_ns = 0;
+  static std::int64_t read(void* self) { return static_cast<SimClock*>(self)->now_ns; }
+};
+
+// Firmware node and model plant on one memory bus; the plant answers each SYNC with its state and
+// applies the latest effort command, as the simulated machine does.
+struct Loop {
+  const Model& model;
+  Task task;
+  SimClock clock;
+  hal::MemoryBusHub hub{&SimClock::read, &clock};
+  hal::MemoryBusNode* fw_bus = hub.attach();
+  hal::MemoryBusNode* plant_bus = hub.attach();
+  hal::FirmwareCanPort fw_port{*fw_bus};
+  hal::PlantCanPort plant_port{*plant_bus};
+  sim::ModelPlant plant;
+  app::FirmwareNode node;
+  hal::CommandState command;
+  bool answer = true;  // false: the plant goes silent (sensor loss)
+
+  Loop(const Model& m, const char* task_yaml, app::FirmwareNodeConfig cfg)
+      : model(m),
+        task(parse_task(YAML::Load(task_yaml)["task"], "test", m.machine)),
+        plant(m, sim::SoilTruth{}),
+        node(m, task, cfg, fw_port, nullptr) {
+    Vec4 q0, qd0, qdd0;
+    task.trajectory.evaluate(task.start_time(), q0, qd0, qdd0);
+    plant.reset(q0, Vec4::Zero());
+  }
+
+  void cycle() {
+    clock.now_ns += 1'000'000;
+    node.begin_cycle();
+    std::uint64_t k = 0;
+    if (plant_port.poll_sync(k)) {
+      plant_port.read(command);
+      const TipLoad load = plant.soil_load();
+      Vec4 tau = Vec4::Zero();
+      // Valve commands (the firmware's safe state) leave this effort-driven plant unforced.
+      if (command.valid && command.mode == hal::CommandMode::effort)
+        for (int j = 0; j < 4; ++j) tau[j] = command.value[j];
+      plant.step(tau, load, 1e-3);
+      if (answer) {
+        hal::SensorState s;
+        s.cycle = k;
+        s.motion_valid = true;
+        for (int j = 0; j < 4; ++j) {
+          s.position[j] = plant.q()[j];
+          s.velocity[j] = plant.qd()[j];
+        }
+        plant_port.write(s);
+      }
+    }
+    node.end_cycle();
+  }
+};
+
+Vec2 tip_of(const Model& model, const Vec4& q) {
+  Workspace ws(model);
+  update_closed_chain(model, ws, q, Vec4::Zero());
+  return ws.rho;
+}
+
+}  // namespace
+
+TEST_CASE("firmware/node: after its task the machine holds the final pose; the path never restarts and the command never jumps") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::adaptive;
+  Loop loop(model, sim::kDigTask, cfg);
+  const double end = loop.task.end_time();  // 10 s
+  Vec4 q_final, qd_end, qdd_end;
+  loop.task.trajectory.evaluate(end, q_final, qd_end, qdd_end);
+
+  const int cycles = static_cast<int>(4 * end / 1e-3);  // four times the task's length
+  double largest_step_tracking = 0, largest_step_after = 0, worst_tip_after = 0;
+  int track_entries = 0;
+  const Vec4 limits = model.machine.effort_max().cwiseMax(-model.machine.effort_min());
+  Vec4 last_cmd = Vec4::Zero();
+  bool have_last = false;
+  for (int k = 0; k < cycles; ++k) {
+    loop.cycle();
+    const auto& tr = loop.node.last_transition();
+    if (tr.changed && tr.to == Mode::track) ++track_entries;
+    Vec4 cmd;
+    for (int j = 0; j < 4; ++j) cmd[j] = loop.node.last_command().value[j];
+    // Command change per cycle, per joint, as a fraction of the joint's effort limit.
+    if (have_last) {
+      const double step = ((cmd - last_cmd).cwiseAbs().array() / limits.array()).maxCoeff();
+      if (loop.node.mode() == Mode::track && loop.node.time() > 1.0) largest_step_tracking = std::max(largest_step_tracking, step);
+      if (loop.node.trajectory_finished()) largest_step_after = std::max(largest_step_after, step);
+    }
+    last_cmd = cmd;
+    have_last = true;
+    if (loop.node.trajectory_finished()) {
+      REQUIRE(loop.node.mode() == Mode::hold);
+      // The desired pose is the path's final point, exactly, every cycle after the end.
+      CHECK((loop.node.q_desired() - q_final).cwiseAbs().maxCoeff() == 0.0);
+      if (loop.node.time() > loop.node.finish_time() + 2.0)
+        worst_tip_after = std::max(worst_tip_after, (loop.plant.rho() - tip_of(model, q_final)).norm());
+    }
+  }
+  MESSAGE("finished at " << loop.node.finish_time() << " s; largest command step (fraction of the effort limit) while tracking "
+                         << largest_step_tracking << ", after the end " << largest_step_after
+                         << "; worst tip distance from the final pose (2 s after the end on) " << worst_tip_after * 1e3 << " mm");
+  CHECK(loop.node.trajectory_finished());
+  CHECK(track_entries == 1);
+  // The task ends when its path ends (plus the start delay), to the cycle.
+  CHECK(std::abs(loop.node.finish_time() - (end + cfg.track_delay)) <= 1.5e-3);
+  CHECK(worst_tip_after < 1e-3);
+  // Ending the task is no bigger a change of command than a cycle of tracking.
+  CHECK(largest_step_after <= largest_step_tracking);
+}
+
+TEST_CASE("firmware/node: a stop request from outside brings a tracking machine to hold at the desired pose of that moment") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  while (loop.node.time() < 3.0) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::track);
+  const Vec4 q_at_stop = loop.node.q_desired();
+  loop.node.request_stop();
+  loop.cycle();
+  CHECK(loop.node.mode() == Mode::hold);
+  CHECK(loop.node.last_transition().changed);
+  CHECK(std::string(loop.node.last_transition().reason) == "stop requested");
+  for (int k = 0; k < 3000; ++k) {
+    loop.cycle();
+    REQUIRE(loop.node.mode() == Mode::hold);
+    CHECK((loop.node.q_desired() - q_at_stop).cwiseAbs().maxCoeff() == 0.0);
+  }
+  CHECK_FALSE(loop.node.trajectory_finished());
+  // Held, the machine settles where it was told to stop (within 1 mm / 1 mrad).
+  CHECK((loop.plant.q() - q_at_stop).cwiseAbs().maxCoeff() < 1e-3);
+}
+
+TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fault and sends it on the bus") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  while (loop.node.time() < 1.0) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::track);
+  loop.answer = false;
+  int cycles_to_stop = 0;
+  while (loop.node.mode() != Mode::safe_stop && cycles_to_stop < 1000) {
+    loop.cycle();
+    ++cycles_to_stop;
+  }
+  CHECK(loop.node.mode() == Mode::safe_stop);
+  // The watchdog's timeout is 20 ms: the safe state comes on the first cycle past it.
+  CHECK(cycles_to_stop == static_cast<int>(std::lround(cfg.controller.watchdog_timeout / 1e-3)) + 1);
+  // The plant's end reads the fault frame with its code (on its next SYNC).
+  loop.cycle();
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::sensor_timeout));
+}
+
+TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over 20000 cycles of the dig task") {
+  REQUIRE(exc::test::allocation_counting_works());
+  const Model model = build_model(reference_machine());
+  for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {
+    app::FirmwareNodeConfig cfg;
+    cfg.kind = kind;
+    cfg.controller.actuator_lag = 0.02;
+    Loop loop(model, sim::kDigTask, cfg);
+    loop.cycle();  // start-up cycle outside the count (first touch)
+    std::size_t allocations = 0;
+    {
+      exc::test::AllocationCounter counter;
+      exc::test::EigenNoMallocScope no_eigen_malloc;
+      for (int k = 0; k < 20000; ++k) loop.cycle();
+      allocations = counter.count();
+    }
+    INFO(to_string(kind));
+    CHECK(allocations == 0);
+    CHECK(loop.node.trajectory_finished());  // the run crossed track -> hold too
+  }
+}

@@ -1,0 +1,18 @@
+# cmake -DBINARY=path -P check_no_plant_symbols.cmake: fails when the binary defines or uses any
+# symbol of namespace exc::plant or exc::sim (counted with nm -C, as a reviewer would).
+execute_process(COMMAND nm -C ${BINARY} OUTPUT_VARIABLE symbols RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "nm -C ${BINARY} failed (${rc})")
+endif()
+string(REGEX MATCHALL "[^\n]*exc::(plant|sim)::[^\n]*" offending "${symbols}")
+list(LENGTH offending count)
+string(REGEX MATCHALL "[^\n]*exc::control::[^\n]*" firmware "${symbols}")
+list(LENGTH firmware firmware_count)
+if(firmware_count EQUAL 0)
+  message(FATAL_ERROR "${BINARY}: no exc::control symbol found; the check reads the wrong binary")
+endif()
+if(count GREATER 0)
+  string(REGEX MATCH "[^\n]*exc::(plant|sim)::[^\n]*" first "${symbols}")
+  message(FATAL_ERROR "${BINARY} holds ${count} plant/simulator symbols, e.g.\n  ${first}")
+endif()
+message(STATUS "${BINARY}: ${firmware_count} firmware symbols, no exc::plant or exc::sim symbol")
