@@ -10,13 +10,14 @@
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/fault_t.hpp"
 #include "exlcm/timing_t.hpp"
+#include "hal/can_protocol.hpp"
 #include "hal/clock.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
 namespace exc::app {
 namespace {
 
-constexpr int kHeartbeatPeriod = 100;  // cycles (hal/can_protocol.hpp kHeartbeatPeriodCycles)
+constexpr int kHeartbeatPeriod = hal::kHeartbeatPeriodCycles;
 constexpr int kCounterPeriod = 100;    // cycles between timing / CAN counter messages
 
 Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]); }
@@ -72,6 +73,11 @@ void FirmwareNode::begin_cycle() {
   complete_ = false;
   port_.send_sync(cycle_);
   if (cycle_ % kHeartbeatPeriod == 0) port_.send_heartbeat(static_cast<std::uint8_t>(machine_.mode()));
+  // FW_EMERGENCY is IfActive in the DBC: sent on entry to the safe state (end_cycle) and repeated
+  // every 10 ms while it lasts, so a node that missed the first frame still learns of the stop.
+  if (machine_.mode() == control::Mode::safe_stop && cycle_ > safe_stop_cycle_ &&
+      (cycle_ - safe_stop_cycle_) % hal::kEmergencyRepeatCycles == 0)
+    port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
 }
 
 bool FirmwareNode::receive() {
@@ -116,6 +122,7 @@ void FirmwareNode::end_cycle() {
     if (transition.to == control::Mode::track) track_start_ = t;
     if (transition.to == control::Mode::safe_stop) {
       ++safe_stops_;
+      safe_stop_cycle_ = cycle_;
       fault_code_ = fault_ ? FirmwareFault::model : FirmwareFault::sensor_timeout;
       port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
     }

@@ -125,6 +125,7 @@ class FirmwareNode {
   double finish_time_ = 0;
   bool stop_requested_ = false;
   std::uint64_t safe_stops_ = 0;
+  std::uint64_t safe_stop_cycle_ = 0;  // cycle the last safe state began
   hal::SensorState sensors_;
   hal::CommandState command_;
   control::ControlOutput out_;

@@ -6,11 +6,14 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <map>
 #include <vector>
 
 #include "allocation_counter.hpp"
 #include "app/firmware_node.hpp"
 #include "closed_loop.hpp"
+#include "dbc_reader.hpp"
+#include "hal/can_protocol.hpp"
 #include "hal/memory_bus.hpp"
 #include "model/closed_chain.hpp"
 #include "scenes.hpp"
@@ -198,4 +201,52 @@ TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over
     CHECK(allocations == 0);
     CHECK(loop.node.trajectory_finished());  // the run crossed track -> hold too
   }
+}
+
+TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle time in a capture, FW_EMERGENCY repeating while the safe state lasts") {
+  // The schedule comes from the DBC file (read by the tests' own reader), the frames from a listener
+  // on the bus, as candump would see them.
+  const std::vector<exc::test::DbcMessage> dbc = exc::test::read_dbc(EXC_CAN_DBC_FILE);
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  hal::MemoryBusNode* listener = loop.hub.attach(4096);
+  std::map<std::uint32_t, std::vector<int>> seen;  // id -> cycles it was sent in
+  const int silent_from = 2000, silent_to = 2500, cycles = 4000;
+  for (int k = 1; k <= cycles; ++k) {
+    loop.answer = k < silent_from || k >= silent_to;
+    loop.cycle();
+    hal::CanFrame f;
+    while (listener->receive(f)) seen[f.id].push_back(k);
+  }
+  int checked = 0;
+  for (const auto& m : dbc) {
+    if (m.sender != "Firmware") continue;
+    const std::vector<int>& at = seen[m.id];
+    INFO(m.name);
+    if (m.if_active) {
+      // Active from the watchdog's trip (21 cycles into the silence) to the first answered cycle.
+      REQUIRE(m.cycle_fast_ms == hal::kEmergencyRepeatCycles);
+      REQUIRE(at.size() >= 2);
+      const int first = silent_from + static_cast<int>(std::lround(cfg.controller.watchdog_timeout / 1e-3));
+      CHECK(at.front() == first);
+      for (std::size_t i = 1; i < at.size(); ++i) CHECK(at[i] - at[i - 1] == m.cycle_fast_ms);
+      CHECK(at.back() < silent_to + 1);
+      // The last repeat can fall on the first answered cycle: its SYNC goes out before the answer.
+      CHECK(at.size() == static_cast<std::size_t>((silent_to - first) / m.cycle_fast_ms + 1));
+      ++checked;
+    } else if (m.cycle_ms > 0 && m.command_set != 2) {  // the effort set is sent; valves only in the safe state
+      REQUIRE(at.size() >= 2);
+      int largest_gap = 0;
+      for (std::size_t i = 1; i < at.size(); ++i) largest_gap = std::max(largest_gap, at[i] - at[i - 1]);
+      const bool commands = m.command_set == 1;
+      // Commands pause while the safe state sends valves instead; everything else keeps its period.
+      if (commands)
+        CHECK(at.size() + (silent_to - silent_from) >= static_cast<std::size_t>(cycles / m.cycle_ms) - 30);
+      else
+        CHECK(largest_gap == m.cycle_ms);
+      ++checked;
+    }
+  }
+  CHECK(checked >= 4);  // SYNC, the effort pair, FW_HEARTBEAT, FW_EMERGENCY
 }

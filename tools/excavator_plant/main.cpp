@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "hal/socketcan_bus.hpp"
+#include "hal/can_protocol.hpp"
 #include "plant_node.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/telemetry_publisher.hpp"
@@ -62,7 +63,9 @@ int main(int argc, char** argv) {
 
     const double total = duration > 0 ? duration : plant.scene().duration;
     const auto cycles = static_cast<std::uint64_t>(std::llround(total / plant.scene().cycle));
-    const std::int64_t slice_ns = 50'000'000;  // wake at least every 50 ms to watch for silence
+    // Wake every 10 ms to watch for silence: while holding, PLANT_EMERGENCY repeats at that period
+    // (IfActive in the DBC).
+    const std::int64_t slice_ns = exc::hal::kEmergencyRepeatCycles * exc::hal::kCyclePeriodNs;
     double silent_ms = 0;
     bool announced = false;
     std::printf("excavator-plant: %s on %s, %llu cycles, waiting for SYNC\n", plant.scene().name.c_str(),
@@ -88,8 +91,8 @@ int main(int argc, char** argv) {
                      iface.c_str(), startup_s);
         return 5;
       }
+      if (node.steps() > 0 && silent_ms >= silence_ms) node.hold_for_silence();  // entry, then every slice
       if (node.steps() > 0 && silent_ms >= silence_ms && !announced) {
-        node.hold_for_silence();
         std::printf("excavator-plant: no SYNC for %.0f ms after step %llu: hold (valves centred, machine braked)\n",
                     silent_ms, static_cast<unsigned long long>(node.steps()));
         std::fflush(stdout);

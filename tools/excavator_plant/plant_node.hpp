@@ -33,7 +33,8 @@ class PlantNode {
 
   bool failed() const { return !plant_.status().ok(); }
   // The firmware fell silent (no SYNC): latch the hold until a fresh command set arrives, and say
-  // so on the bus with PLANT_EMERGENCY.
+  // so on the bus with PLANT_EMERGENCY. Called again every 10 ms while the silence lasts, each call
+  // repeats the frame (IfActive in the DBC).
   void hold_for_silence();
   bool holding() const { return holding_; }
   std::uint64_t holds() const { return holds_; }     // transitions into hold

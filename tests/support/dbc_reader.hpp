@@ -32,6 +32,8 @@ struct DbcMessage {
   std::string sender;
   std::vector<DbcSignal> signals;
   int cycle_ms = 0;
+  bool if_active = false;  // GenMsgSendType IfActive: sent on entry, then every cycle_fast_ms while active
+  int cycle_fast_ms = 0;
   int command_set = 0;  // index into ExcCommandSet's enum: 0 none, 1 effort, 2 valve
 };
 
@@ -75,6 +77,8 @@ inline std::vector<DbcMessage> read_dbc(const std::string& path) {
       const auto it = by_id.find(static_cast<std::uint32_t>(std::stoul(m[2])));
       if (it == by_id.end()) throw std::runtime_error(path + ":" + std::to_string(line_number) + ": BA_ for unknown BO_");
       if (m[1] == "GenMsgCycleTime") messages[it->second].cycle_ms = std::stoi(m[3]);
+      if (m[1] == "GenMsgCycleTimeFast") messages[it->second].cycle_fast_ms = std::stoi(m[3]);
+      if (m[1] == "GenMsgSendType") messages[it->second].if_active = std::stoi(m[3]) == 1;
       if (m[1] == "ExcCommandSet") messages[it->second].command_set = std::stoi(m[3]);
     }
   }
