@@ -73,11 +73,15 @@ TEST_CASE("hal/bus budget of the DBC schedule at 1 Mbit/s classical CAN, and the
   const int with_emergency = std::max(effort.cyclic_bits + effort.emergency_bits, valve.cyclic_bits + valve.emergency_bits);
   MESSAGE("classical CAN, worst cycle: effort ", effort.cyclic_bits, " bits, valve ", valve.cyclic_bits,
           " bits; with both emergency frames ", with_emergency, " bits; budget 500 bits (50% of 1 ms at 1 Mbit/s)");
-  // The schedule must at least fit in one cycle, or the SYNC-driven loop could not run on a real bus.
+  // The figures docs/can-protocol.md and the README state (counted from the DBC with the published
+  // worst-case frame length): 985 bits in the worst effort cycle, 98.5 % of the bus. It fits the
+  // 1 ms cycle, so the SYNC-driven loop runs on a real bus, but not the 50 % budget: issue 14 moves
+  // the interface to CAN FD for that.
+  CHECK(effort.cyclic_bits == 985);
+  CHECK(valve.cyclic_bits == 890);
+  CHECK(with_emergency == 1175);
   CHECK(cyclic <= 1000);
-  if (cyclic > 500) {
-    MESSAGE("classical CAN does NOT meet the 50% budget: ", cyclic / 10.0, "% of the bus");
-  }
+  if (cyclic > 500) MESSAGE("classical CAN does NOT meet the 50% budget: ", cyclic / 10.0, "% of the bus");
 
   // CAN FD with bit-rate switch: every frame becomes an FD frame; the command frames merge into one
   // (both effort halves), the sensor frames into one carrying all pressures every cycle.

@@ -103,7 +103,7 @@ TEST_CASE("plant/end stop: ideal actuators report a cylinder driven through it, 
   CHECK(std::abs(limited.state().qd_a[1]) <= m.boom.max_speed + 1e-12);
 }
 
-TEST_CASE("plant/step time per integrator (printed, generous budget)") {
+TEST_CASE("plant/step time per integrator: the median keeps pace with the 1 kHz cycle four times over (printed)") {
   for (const char* m : exc::plant::test::kMethods) {
     for (const char* f : exc::plant::test::kFormulations) {
       exc::plant::test::SceneText t;
@@ -121,7 +121,10 @@ TEST_CASE("plant/step time per integrator (printed, generous budget)") {
       std::nth_element(us.begin(), us.begin() + us.size() / 2, us.end());
       const double median = us[us.size() / 2];
       MESSAGE(std::string(m) << " / " << std::string(f) << ": median step " << median << " us (test build)");
-      CHECK(median < 2000.0);
+      // A quarter of the 1 ms cycle: the plant must outrun the firmware's cycle with room for the
+      // firmware, the bus and telemetry in the same lockstep process. Medians hold on a loaded machine;
+      // the steps take 2-60 us (excavator-plant-bench has the real figures).
+      CHECK(median < 250.0);
     }
   }
 }
