@@ -131,7 +131,6 @@ void FirmwareNode::end_cycle() {
   compute_command(transition);
   port_.write(command_);
   if (machine_.mode() == control::Mode::track) measured_.add(to_vec(sensors_.position), q_d_);
-  cycle_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
   if (telemetry_ != nullptr) publish_cycle();
   if (telemetry_ != nullptr && transition.changed) {
     exlcm::fault_t f{};
@@ -143,7 +142,10 @@ void FirmwareNode::end_cycle() {
                   control::to_string(transition.to), transition.reason);
     telemetry_->publish(telemetry::Channel::fault, f);
   }
+  // The cycle's scope (stated once, in firmware_node.hpp): read to telemetry encoded, the periodic
+  // counter messages included.
   if (telemetry_ != nullptr && cycle_ % kCounterPeriod == 0) publish_counters();
+  cycle_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
 }
 
 void FirmwareNode::compute_command(const control::Transition& transition) {

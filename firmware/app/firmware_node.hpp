@@ -84,7 +84,8 @@ class FirmwareNode {
   const control::ControlOutput& last_output() const { return out_; }
   const hal::CommandState& last_command() const { return command_; }
   // Time of the control computation (estimate + trajectory + control law), and of the whole
-  // end_cycle (read + compute + write + telemetry encode).
+  // end_cycle: from its start (the plant has answered) through read, compute and write to the end of
+  // the cycle's telemetry encoding (the counter messages every 100 cycles included).
   const control::PerfCounter& control_timing() const { return control_timing_; }
   const control::PerfCounter& cycle_timing() const { return cycle_timing_; }
   std::uint64_t safe_stops() const { return safe_stops_; }
