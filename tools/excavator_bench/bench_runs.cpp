@@ -10,9 +10,8 @@
 #include <stdexcept>
 
 #include "app/firmware_node.hpp"
-#include "hal/memory_bus.hpp"
+#include "harness/lockstep_run.hpp"
 #include "model/closed_chain.hpp"
-#include "plant_node.hpp"
 #include "sim_plant/plant.hpp"
 
 namespace exc::bench {
@@ -149,12 +148,6 @@ double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
 
 namespace {
 
-// The bus is stamped with simulated time (as in excavator-sim), so runs are deterministic.
-struct SimClock {
-  std::int64_t now_ns = 0;
-  static std::int64_t read(void* self) { return static_cast<SimClock*>(self)->now_ns; }
-};
-
 constexpr std::array<int, 6> kCylinderBodies = {kBoomBarrel, kBoomRod, kArmBarrel, kArmRod, kBucketBarrel, kBucketRod};
 
 }  // namespace
@@ -178,7 +171,6 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
   s.task.trajectory.evaluate(s.task.start_time(), q0, qd0, qdd0);
   scene.q_a0 = q0;
   scene.qd_a0 = qd0;
-  plant::Plant plant(scene);
 
   // The firmware's model: the full machine, with its masses off by the given error.
   Machine fw_machine = s.scene.machine;
@@ -186,9 +178,14 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
     b.mass *= 1 + v.model_mass_error;
     b.inertia *= 1 + v.model_mass_error;
   }
-  const Model fw_model = build_model(fw_machine);
-
-  control::ControllerConfig cc = s.controller;
+  app::FirmwareSettings fw;
+  fw.name = s.name;
+  fw.machine = fw_machine;
+  fw.task = s.task;
+  fw.terrain_height = scene.terrain.height;
+  fw.duration = scene.duration;
+  control::ControllerConfig& cc = fw.controller;
+  cc = s.controller;
   const double g = v.gain_scale;
   cc.gains.kp *= g * g;
   cc.gains.kv *= g;
@@ -198,61 +195,29 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
   cc.adaptation_rate *= v.adaptation_scale;
   cc.sl_adaptation_rate *= v.adaptation_scale;
 
-  SimClock clock;
-  hal::MemoryBusHub hub(&SimClock::read, &clock);
-  hal::MemoryBusNode* firmware_bus = hub.attach();
-  hal::MemoryBusNode* plant_bus = hub.attach();
-  hal::FirmwareCanPort firmware_port(*firmware_bus);
-  hal::PlantCanPort plant_port(*plant_bus);
-  app::FirmwareNodeConfig fc;
-  fc.kind = v.controller;
-  fc.controller = cc;
-  fc.terrain_height = scene.terrain.height;
-  app::FirmwareNode firmware(fw_model, s.task, fc, firmware_port, nullptr);
-  app::PlantNode plant_node(plant, plant_port, nullptr);
-
   ClosedLoopResult r;
-  const double duration = v.duration > 0 ? v.duration : scene.duration;
-  const auto cycles = static_cast<std::int64_t>(std::llround(duration / scene.cycle));
-  const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
   const int per_hold = cycles_per_hold(scene.cycle);
-  double sum_sq[4] = {0, 0, 0, 0};
-  std::int64_t samples = 0;
-  const double cpu0 = thread_cpu_seconds();
-  for (std::int64_t k = 0; k < cycles; ++k) {
-    clock.now_ns = k * period_ns;
-    firmware.begin_cycle();
-    plant_node.poll();
-    firmware.end_cycle();
-    if (plant_node.failed()) {
-      r.ok = false;
-      r.failure = std::string("plant stopped: ") + plant.status().text();
-      break;
-    }
-    if (firmware.safe_stops() > 0) {
-      r.ok = false;
-      r.failure = "the firmware went to its safe state (" + std::string(control::to_string(firmware.mode())) + ")";
-      break;
-    }
-    if (firmware.tracking()) {
-      const Vec4 e = plant.state().q_a - firmware.q_desired();
-      for (int j = 0; j < 4; ++j) {
-        sum_sq[j] += e[j] * e[j];
-        r.tracking_max = std::max(r.tracking_max, std::abs(e[j]));
-      }
-      ++samples;
-    }
+  sim::LockstepOptions o;
+  o.controller = v.controller;
+  o.duration = v.duration;
+  o.stop_at_safe_state = true;
+  const double duration = v.duration > 0 ? v.duration : scene.duration;
+  r.tip.reserve(static_cast<std::size_t>(std::llround(duration / kProfileHold)) + 1);
+  r.effort.reserve(r.tip.capacity());
+  o.observer = [&r, per_hold](std::int64_t k, const plant::Plant& plant, const app::FirmwareNode&) {
     if ((k + 1) % per_hold == 0) {
       r.tip.push_back(plant.state().tip_world);
       r.effort.push_back(plant.state().effort);
     }
-  }
-  r.cpu_seconds = thread_cpu_seconds() - cpu0;
-  r.simulated = plant.state().time;
-  for (int j = 0; j < 4; ++j) r.tracking_rms[j] = samples ? std::sqrt(sum_sq[j] / static_cast<double>(samples)) : 0;
-  if (r.ok && samples == 0) {
-    r.ok = false;
-    r.failure = "the firmware never tracked";
+  };
+  const sim::RunRecord run = sim::run_lockstep(scene, fw, o);
+  r.ok = run.ok;
+  r.failure = run.failure;
+  r.cpu_seconds = run.cpu_seconds;
+  r.simulated = run.simulated_seconds;
+  for (int j = 0; j < 4; ++j) {
+    r.tracking_rms[j] = run.rms_error[j];
+    r.tracking_max = std::max(r.tracking_max, run.max_error[j]);
   }
   return r;
 }

@@ -12,7 +12,7 @@
 
 #include "hal/socketcan_bus.hpp"
 #include "hal/can_protocol.hpp"
-#include "plant_node.hpp"
+#include "sim_plant/plant_node.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 

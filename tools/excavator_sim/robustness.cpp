@@ -25,8 +25,15 @@ bool pid_over_adaptive(const Summary& s, double& arm, double& bucket) {
 }
 
 // The single faults; the "all" variant applies every one of them (mass +20 %).
-void heavier_model(SceneBundle&, RunOptions& o) { o.controller_mass_scale = 1.2; }
-void lighter_model(SceneBundle&, RunOptions& o) { o.controller_mass_scale = 0.8; }
+// The firmware's model has every link's mass and inertia scaled while the plant keeps the true machine.
+void scale_model_masses(SceneBundle& b, double scale) {
+  for (BodyInertia& body : b.firmware.machine.bodies) {
+    body.mass *= scale;
+    body.inertia *= scale;
+  }
+}
+void heavier_model(SceneBundle& b, RunOptions&) { scale_model_masses(b, 1.2); }
+void lighter_model(SceneBundle& b, RunOptions&) { scale_model_masses(b, 0.8); }
 // Noise of the order of a good encoder chain: 0.1 mm on a stroke, 0.2 mrad on the swing, and a
 // velocity signal (differentiated in the drive) ten times noisier than a clean one.
 void sensor_noise(SceneBundle& b, RunOptions&) {

@@ -1,4 +1,4 @@
-#include "plant_node.hpp"
+#include "sim_plant/plant_node.hpp"
 
 #include "app/can_stats_message.hpp"
 #include "exlcm/machine_state_t.hpp"

@@ -1,0 +1,161 @@
+#include "harness/lockstep_run.hpp"
+
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "allocation_counter.hpp"
+#include "app/firmware_node.hpp"
+#include "app/tracking_metrics.hpp"
+#include "hal/memory_bus.hpp"
+#include "sim_plant/plant.hpp"
+#include "sim_plant/plant_node.hpp"
+#include "telemetry/lcm_output.hpp"
+#include "telemetry/telemetry_publisher.hpp"
+
+namespace exc::sim {
+namespace {
+
+// The bus is stamped with simulated time, so the codec's timing rules never see wall-clock jitter.
+struct SimClock {
+  std::int64_t now_ns = 0;
+  static std::int64_t read(void* self) { return static_cast<SimClock*>(self)->now_ns; }
+};
+
+Timing timing_of(const control::PerfCounter& c) { return Timing{c.median_us(), c.p99_us(), c.max_us(), c.count()}; }
+
+Vec6 theta_of(const plant::SoilParameters& s) {
+  Vec6 t;
+  t << s.mass[0], s.damping[0], s.stiffness[0], s.mass[1], s.damping[1], s.stiffness[1];
+  return t;
+}
+
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+}  // namespace
+
+SceneBundle load_scene_bundle(const std::string& path) {
+  SceneBundle b;
+  b.scene = plant::load_scene(path);
+  b.firmware = app::load_firmware_settings(path);
+  b.name = b.scene.name;
+  return b;
+}
+
+RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
+  RunRecord result;
+  result.controller = control::to_string(options.controller);
+
+  plant::Plant plant(scene);
+  SimClock clock;
+  hal::MemoryBusHub hub(&SimClock::read, &clock);
+  hal::MemoryBusNode* firmware_bus = hub.attach();
+  hal::MemoryBusNode* plant_bus = hub.attach();
+  hal::FirmwareCanPort firmware_port(*firmware_bus);
+  hal::PlantCanPort plant_port(*plant_bus);
+
+  std::unique_ptr<telemetry::TelemetryPublisher> publisher;
+  if (options.telemetry) {
+    telemetry::TelemetryConfig tc;
+    tc.shared_output = options.telemetry;
+    tc.channel_suffix = "/" + result.controller;
+    publisher = std::make_unique<telemetry::TelemetryPublisher>(tc);
+    std::string error;
+    if (!publisher->start(&error)) throw std::runtime_error("telemetry: " + error);
+  }
+
+  app::FirmwareNodeConfig fc;
+  fc.kind = options.controller;
+  fc.controller = firmware.controller;
+  fc.terrain_height = firmware.terrain_height;
+  fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
+  fc.theta_true = theta_of(scene.soil);
+  const Model firmware_model = build_model(firmware.machine);
+  app::FirmwareNode node(firmware_model, firmware.task, fc, firmware_port, publisher.get());
+  app::PlantNode plant_node(plant, plant_port, publisher.get());
+
+  const double duration = options.duration > 0 ? options.duration : scene.duration;
+  const auto cycles = static_cast<std::int64_t>(std::llround(duration / scene.cycle));
+  const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
+  TrackingMetrics metrics;
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::int64_t progress_every = std::max<std::int64_t>(1, cycles / 10);
+  const bool interactive = isatty(STDERR_FILENO) != 0;
+  std::uint64_t allocations = 0;
+  const double cpu_start = thread_cpu_seconds();
+  {
+    // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
+    // allocations (LCM) are on another thread and not counted.
+    test::AllocationCounter counter;
+    for (std::int64_t k = 0; k < cycles; ++k) {
+      clock.now_ns = k * period_ns;
+      node.begin_cycle();
+      plant_node.poll();
+      node.end_cycle();
+      if (node.tracking()) metrics.add(plant.state().q_a, node.q_desired());
+      const plant::PlantState& s = plant.state();
+      result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
+      if (options.observer) options.observer(k, plant, node);
+      if (plant_node.failed()) break;
+      if (options.stop_at_safe_state && node.safe_stops() > 0) break;
+      if (options.progress && (k + 1) % progress_every == 0) {
+        // On a terminal the line is redrawn in place; in a log, one line per tenth of the run.
+        std::fprintf(stderr, interactive ? "\r  %-10s %5.1f / %.1f s simulated" : "  %-10s %5.1f / %.1f s simulated\n",
+                     result.controller.c_str(), s.time, duration);
+        std::fflush(stderr);
+      }
+    }
+    allocations = counter.count();
+  }
+  result.cpu_seconds = thread_cpu_seconds() - cpu_start;
+  if (options.progress && interactive) std::fprintf(stderr, "\n");
+  node.publish_counters();
+  plant_node.publish_counters();
+  if (publisher) publisher->stop();
+
+  result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  result.simulated_seconds = plant.state().time;
+  result.tracking_samples = metrics.samples();
+  for (int j = 0; j < 4; ++j) {
+    result.rms_error[j] = metrics.rms(j);
+    result.max_error[j] = metrics.max_abs(j);
+    result.measured_rms_error[j] = node.measured_tracking().rms(j);
+    result.measured_max_error[j] = node.measured_tracking().max_abs(j);
+  }
+  const Vec6 truth = theta_of(scene.soil);
+  for (int i = 0; i < 6; ++i) {
+    result.theta_hat[i] = node.last_output().theta_hat[i];
+    result.theta_true[i] = truth[i];
+  }
+  result.reanchor_count = plant.state().reanchor_count;
+  result.control_step = timing_of(node.control_timing());
+  result.firmware_cycle = timing_of(node.cycle_timing());
+  result.heap_allocations_in_loop = allocations;
+  result.safe_stops = node.safe_stops();
+  result.rx_rejected = firmware_port.rx_stats().rejected() + plant_port.rx_stats().rejected();
+  result.task_finished = node.trajectory_finished();
+  result.task_finish_time = node.finish_time();
+  if (plant_node.failed()) {
+    result.ok = false;
+    result.failure = std::string("plant stopped: ") + plant.status().text();
+  } else if (node.safe_stops() > 0) {
+    result.ok = false;
+    result.failure = "the firmware went to its safe state " + std::to_string(node.safe_stops()) + " time(s) (" +
+                     control::to_string(node.mode()) + " at the end)";
+  } else if (metrics.samples() == 0) {
+    result.ok = false;
+    result.failure = std::string("the firmware never tracked (mode ") + control::to_string(node.mode()) + ")";
+  }
+  return result;
+}
+
+}  // namespace exc::sim
