@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "control/law_stages.hpp"
 #include "control/lyapunov.hpp"
 
 namespace exc::control {
@@ -43,19 +44,11 @@ Vec6 AdaptiveComputedTorque::gamma() const {
 
 ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   ControlOutput out;
-  out.e = in.q - in.q_d;
-  out.ed = in.qd - in.qd_d;
+  tracking_errors(in, out);
   out.theta_hat = theta_hat_;
-  const ModelReport report = update_closed_chain(model_, ws_, in.q, in.qd);
-  out.status = report.status;
-  if (!report.ok()) {
-    out.tau = out.tau_unsaturated = last_tau_;
-    return out;
-  }
   Mat4 M_a;
   Vec4 h_a;
-  mass_matrix(model_, ws_, M_a);
-  bias_forces(model_, ws_, h_a);
+  if (!model_at(model_, ws_, in.q, in.qd, last_tau_, out, M_a, h_a)) return out;
 
   // Contact and anchor (the controller's own estimate unless the caller knows them).
   out.rho = ws_.rho;
@@ -66,8 +59,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
 
   const Vec4 v = in.qdd_d - feedback_.update(out.e, out.ed, config_.period, saturated_);
   out.tau_unsaturated = M_a * v + h_a + Y * theta_hat_;  // eq. 12
-  out.saturated = saturated_ = limits_.saturate(out.tau_unsaturated, out.tau);
-  last_tau_ = out.tau;
+  saturated_ = saturate_output(limits_, out, last_tau_);
 
   Vec12 z;
   z << feedback_.integral(), out.e, out.ed;

@@ -1,5 +1,6 @@
 #include "control/computed_torque_pid.hpp"
 
+#include "control/law_stages.hpp"
 #include "control/lyapunov.hpp"
 
 namespace exc::control {
@@ -20,22 +21,13 @@ void ComputedTorquePid::reset() {
 
 ControlOutput ComputedTorquePid::update(const ControlInput& in) {
   ControlOutput out;
-  out.e = in.q - in.q_d;
-  out.ed = in.qd - in.qd_d;
-  const ModelReport report = update_closed_chain(model_, ws_, in.q, in.qd);
-  out.status = report.status;
-  if (!report.ok()) {  // hold the last good command; the loop decides (safe_stop)
-    out.tau = out.tau_unsaturated = last_tau_;
-    return out;
-  }
+  tracking_errors(in, out);
   Mat4 M_a;
   Vec4 h_a;
-  mass_matrix(model_, ws_, M_a);
-  bias_forces(model_, ws_, h_a);
+  if (!model_at(model_, ws_, in.q, in.qd, last_tau_, out, M_a, h_a)) return out;
   const Vec4 feedback = pid_.update(out.e, out.ed, config_.period, saturated_);
   out.tau_unsaturated = M_a * (in.qdd_d - feedback) + h_a;  // eq. 12 without the soil term
-  out.saturated = saturated_ = limits_.saturate(out.tau_unsaturated, out.tau);
-  last_tau_ = out.tau;
+  saturated_ = saturate_output(limits_, out, last_tau_);
 
   Vec8 x;
   x << out.e, out.ed;

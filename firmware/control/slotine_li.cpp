@@ -1,5 +1,7 @@
 #include "control/slotine_li.hpp"
 
+#include "control/law_stages.hpp"
+
 namespace exc::control {
 
 SlotineLi::SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits)
@@ -14,8 +16,7 @@ void SlotineLi::reset() {
 
 ControlOutput SlotineLi::update(const ControlInput& in) {
   ControlOutput out;
-  out.e = in.q - in.q_d;
-  out.ed = in.qd - in.qd_d;
+  tracking_errors(in, out);
   out.theta_hat = theta_hat_;
   const Vec4& lambda = config_.sl_lambda;
   const Vec4 qd_r = in.qd_d - lambda.cwiseProduct(out.e);
@@ -23,16 +24,9 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
   const Vec4 s = out.ed + lambda.cwiseProduct(out.e);
 
   // Kinematics at (q, qd_r): M_a(q), C_a(q, qd_r) qd_r + g_a, J_t(q), Jd_t(q, qd_r) qd_r.
-  const ModelReport report = update_closed_chain(model_, ws_, in.q, qd_r);
-  out.status = report.status;
-  if (!report.ok()) {
-    out.tau = out.tau_unsaturated = last_tau_;
-    return out;
-  }
   Mat4 M_a;
   Vec4 h_r;
-  mass_matrix(model_, ws_, M_a);
-  bias_forces(model_, ws_, h_r);
+  if (!model_at(model_, ws_, in.q, qd_r, last_tau_, out, M_a, h_r)) return out;
 
   out.rho = ws_.rho;  // position level: independent of the velocity passed in
   anchor_.resolve(in.soil, ws_.rho, out.in_soil, out.rho_env);
@@ -42,8 +36,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
 
   const Vec4 kd = config_.sl_kd.cwiseProduct(M_a.diagonal());
   out.tau_unsaturated = M_a * qdd_r + h_r + Y * theta_hat_ - kd.cwiseProduct(s);
-  out.saturated = limits_.saturate(out.tau_unsaturated, out.tau);
-  last_tau_ = out.tau;
+  saturate_output(limits_, out, last_tau_);
 
   out.lyapunov_tracking = 0.5 * s.dot(M_a * s) + out.e.dot(lambda.cwiseProduct(kd).cwiseProduct(out.e));
   out.lyapunov = out.lyapunov_tracking;
