@@ -149,8 +149,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     result.failure = std::string("plant stopped: ") + plant.status().text();
   } else if (node.safe_stops() > 0) {
     result.ok = false;
-    result.failure = "the firmware went to its safe state " + std::to_string(node.safe_stops()) + " time(s) (" +
-                     control::to_string(node.mode()) + " at the end)";
+    result.failure = "the firmware went to its safe state " + std::to_string(node.safe_stops()) + " time(s), the last for " +
+                     node.last_fault_text() + " (mode " + control::to_string(node.mode()) + " at the end)";
   } else if (metrics.samples() == 0) {
     result.ok = false;
     result.failure = std::string("the firmware never tracked (mode ") + control::to_string(node.mode()) + ")";

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 
 #include "app/can_stats_message.hpp"
@@ -48,6 +49,16 @@ void fill_timing(const control::PerfCounter& c, std::int8_t stage, std::int64_t 
 }
 
 }  // namespace
+
+const char* to_string(FirmwareFault fault) {
+  switch (fault) {
+    case FirmwareFault::none: return "none";
+    case FirmwareFault::sensor_timeout: return "sensor timeout";
+    case FirmwareFault::model: return "model";
+    case FirmwareFault::tracking_error: return "tracking error";
+  }
+  return "unknown";
+}
 
 FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
                            hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry)
@@ -97,7 +108,9 @@ void FirmwareNode::end_cycle() {
   in.t = t;
   in.have_valid_frame = have_valid_;
   in.last_valid_frame_time = last_valid_time_;
-  in.track_requested = t >= config_.track_delay;
+  // The task starts once. After a safe stop the machine holds where it is when the sensors are back:
+  // resuming would restart the path from its first point, a step command nobody asked for.
+  in.track_requested = t >= config_.track_delay && safe_stops_ == 0;
   in.stop_requested = stop_requested_;
   // Once the task has ended it stays ended: hold must not re-enter track and restart the path.
   in.trajectory_finished =
@@ -117,13 +130,18 @@ void FirmwareNode::end_cycle() {
         finish_time_ = t;
       }
       fault_ = false;
-      fault_code_ = FirmwareFault::none;
+      pending_fault_ = FirmwareFault::none;
     }
     if (transition.to == control::Mode::track) track_start_ = t;
     if (transition.to == control::Mode::safe_stop) {
       ++safe_stops_;
       safe_stop_cycle_ = cycle_;
-      fault_code_ = fault_ ? FirmwareFault::model : FirmwareFault::sensor_timeout;
+      fault_code_ = fault_ ? pending_fault_ : FirmwareFault::sensor_timeout;
+      if (fault_code_ == FirmwareFault::sensor_timeout)
+        std::snprintf(fault_text_, sizeof fault_text_, "sensor timeout: no valid sensor set for %.0f ms at t = %.3f s",
+                      (t - last_valid_time_) * 1e3, t);
+      else
+        std::memcpy(fault_text_, pending_text_, sizeof fault_text_);
       port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
     }
   }
@@ -138,8 +156,10 @@ void FirmwareNode::end_cycle() {
     f.code = static_cast<std::int32_t>(transition.to == control::Mode::safe_stop ? fault_code_ : FirmwareFault::none);
     f.severity = transition.to == control::Mode::safe_stop ? 2 : 0;
     f.active = transition.to == control::Mode::safe_stop;
-    std::snprintf(reinterpret_cast<char*>(f.text), sizeof(f.text), "%s -> %s: %s", control::to_string(transition.from),
-                  control::to_string(transition.to), transition.reason);
+    std::snprintf(reinterpret_cast<char*>(f.text), sizeof(f.text), "%s -> %s: %s%s%s", control::to_string(transition.from),
+                  control::to_string(transition.to), transition.reason,
+                  transition.to == control::Mode::safe_stop ? ": " : "",
+                  transition.to == control::Mode::safe_stop ? fault_text_ : "");
     telemetry_->publish(telemetry::Channel::fault, f);
   }
   // The cycle's scope (stated once, in firmware_node.hpp): read to telemetry encoded, the periodic
@@ -195,7 +215,21 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   input.soil.theta = config_.theta_true;
   input.actuator_limited = lag_compensator_.clamped();
   out_ = controller_->update(input);
-  if (out_.status != ModelStatus::ok || !finite(out_.tau)) fault_ = true;
+  if (!fault_ && (out_.status != ModelStatus::ok || !finite(out_.tau))) {
+    fault_ = true;
+    pending_fault_ = FirmwareFault::model;
+    std::snprintf(pending_text_, sizeof pending_text_, "model: the closed-chain model refused the state at t = %.3f s", t);
+  }
+  // Far from where it was told to go: stop (the state machine takes the safe state next cycle).
+  for (int j = 0; j < 4 && !fault_; ++j) {
+    const double limit = config_.controller.tracking_error_limit[j];
+    if (std::abs(out_.e[j]) > limit) {
+      fault_ = true;
+      pending_fault_ = FirmwareFault::tracking_error;
+      std::snprintf(pending_text_, sizeof pending_text_, "tracking error: %s %.4f %s > limit %.4f at t = %.3f s",
+                    kActiveNames[static_cast<std::size_t>(j)], std::abs(out_.e[j]), j == 0 ? "rad" : "m", limit, t);
+    }
+  }
 
   // Bumpless: entering hold/track from another effort-commanding mode starts from the last command.
   if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))

@@ -42,7 +42,9 @@ enum class FirmwareFault : std::uint16_t {
   none = 0,
   sensor_timeout = 1,  // watchdog: no valid sensor set within the timeout
   model = 2,           // the closed-chain model refused the state (no assembly, toggle)
+  tracking_error = 3,  // a joint's |q_a - q_d| exceeded controller.tracking_error_limit
 };
+const char* to_string(FirmwareFault fault);
 
 class FirmwareNode {
  public:
@@ -89,6 +91,10 @@ class FirmwareNode {
   const control::PerfCounter& control_timing() const { return control_timing_; }
   const control::PerfCounter& cycle_timing() const { return cycle_timing_; }
   std::uint64_t safe_stops() const { return safe_stops_; }
+  // The fault of the last safe stop (none before any), and its description ("tracking error: swing
+  // 0.1013 rad > limit 0.1 rad at t = 1.234 s").
+  FirmwareFault last_fault() const { return fault_code_; }
+  const char* last_fault_text() const { return fault_text_; }
   // Publishes the timing and CAN counters now (also done every 100 cycles).
   void publish_counters();
 
@@ -121,7 +127,10 @@ class FirmwareNode {
   Vec4 q_d_ = Vec4::Zero(), qd_d_ = Vec4::Zero(), qdd_d_ = Vec4::Zero();
   Vec4 last_sent_ = Vec4::Zero();
   bool fault_ = false;
-  FirmwareFault fault_code_ = FirmwareFault::none;
+  FirmwareFault pending_fault_ = FirmwareFault::none;  // raised by this cycle's computation
+  FirmwareFault fault_code_ = FirmwareFault::none;     // of the last safe stop
+  char pending_text_[96] = "";
+  char fault_text_[96] = "";
   bool finished_ = false;
   double finish_time_ = 0;
   bool stop_requested_ = false;

@@ -40,7 +40,7 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
   reject_unknown_keys(node, file, s,
                  {"type", "period", "kp", "kv", "ki", "integral_limit", "lyapunov_q",
                   "adaptation_rate", "theta_min", "theta_max", "theta_initial",
-                  "regressor_acceleration", "slotine_li", "filters", "watchdog_timeout",
+                  "regressor_acceleration", "slotine_li", "filters", "watchdog_timeout", "tracking_error_limit",
                   "blend_time", "actuator_lag", "actuator_lag_target", "integral_action",
                   "lyapunov_q_integral"});
   if (node["type"]) {
@@ -87,6 +87,8 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
       c.filter.acceleration_cutoff_hz =
           read_number(f["acceleration_cutoff_hz"], file, s + ".filters.acceleration_cutoff_hz", 0.1, 1e4);
   }
+  if (node["tracking_error_limit"])
+    c.tracking_error_limit = read_vector<4>(node["tracking_error_limit"], file, s + ".tracking_error_limit", 1e-4, 10);
   if (node["watchdog_timeout"])
     c.watchdog_timeout = read_number(node["watchdog_timeout"], file, s + ".watchdog_timeout", 1e-4, 10);
   if (node["blend_time"]) c.blend_time = read_number(node["blend_time"], file, s + ".blend_time", 0, 10);

@@ -60,6 +60,10 @@ struct ControllerConfig {
 
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop
+  // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
+  // machine far from where it was told to go must stop. About twice the worst error of the PID
+  // baseline in the dig scene (bucket 0.12 m), 0.5-1 m at the tip: rad (swing), m (cylinders).
+  Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();
   double blend_time = 0.2;          // s, bumpless switch fade
 
   static PidGains default_gains() {

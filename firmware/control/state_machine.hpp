@@ -7,6 +7,7 @@
 //   hold/track -> safe_stop       watchdog: no valid sensor frame for longer than the timeout, or a
 //                                 fault (model, non-finite command); command: zero flow / brake
 //   safe_stop -> hold             frames are back (fresh) and no fault: hold where the machine is
+//                                 (FirmwareNode does not request tracking again after a safe stop)
 // Each transition carries a reason. Pure logic on the inputs; no allocation, no clock of its own.
 #include <cstdint>
 

@@ -62,10 +62,16 @@ struct Loop {
       plant_port.read(command);
       const TipLoad load = plant.soil_load();
       Vec4 tau = Vec4::Zero();
-      // Valve commands (the firmware's safe state) leave this effort-driven plant unforced.
-      if (command.valid && command.mode == hal::CommandMode::effort)
+      // Valve commands (the firmware's safe state: valves centred) hold the machine where it is, as
+      // the simulated machine's hold does.
+      if (command.valid && command.mode == hal::CommandMode::effort) {
         for (int j = 0; j < 4; ++j) tau[j] = command.value[j];
-      plant.step(tau, load, 1e-3);
+        plant.step(tau, load, 1e-3);
+      } else if (command.valid) {
+        plant.reset(plant.q(), Vec4::Zero());
+      } else {
+        plant.step(tau, load, 1e-3);
+      }
       if (answer) {
         hal::SensorState s;
         s.cycle = k;
@@ -249,4 +255,57 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
     }
   }
   CHECK(checked >= 4);  // SYNC, the effort pair, FW_HEARTBEAT, FW_EMERGENCY
+}
+
+TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated) trips the tracking-error fault within one cycle's motion past the limit") {
+  const char* fast_swing = R"(
+task:
+  type: joint_waypoints
+  waypoints:
+    - {t: 0.0, q: [0.0, 2.45, 2.40, 2.10]}
+    - {t: 2.5, q: [2.0, 2.45, 2.40, 2.10]}
+)";
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, fast_swing, cfg);
+  const double limit = cfg.controller.tracking_error_limit[0];
+  double error_before = 0, desired_step = 0;
+  Vec4 last_qd = loop.node.q_desired();
+  int cycles = 0;
+  while (loop.node.mode() != Mode::safe_stop && cycles < 5000) {
+    loop.cycle();
+    ++cycles;
+    if (loop.node.mode() == Mode::track) {
+      error_before = std::abs(loop.plant.q()[0] - loop.node.q_desired()[0]);
+      desired_step = std::max(desired_step, std::abs(loop.node.q_desired()[0] - last_qd[0]));
+    }
+    last_qd = loop.node.q_desired();
+  }
+  REQUIRE(loop.node.mode() == Mode::safe_stop);
+  CHECK(loop.node.last_fault() == app::FirmwareFault::tracking_error);
+  const std::string text = loop.node.last_fault_text();
+  MESSAGE(text << "; error at the last tracking cycle " << error_before << " rad");
+  CHECK(text.rfind("tracking error: swing ", 0) == 0);
+  // Stopped before the error passed the limit by more than one cycle of the path's motion.
+  CHECK(error_before <= limit + desired_step + 1e-9);
+  CHECK(loop.node.time() < 2.5 + cfg.track_delay);  // long before the path's end
+  // The plant hears it: FW_EMERGENCY carries the code.
+  loop.cycle();
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::tracking_error));
+}
+
+TEST_CASE("firmware/node: the shipped tasks never trip the tracking-error fault with any controller") {
+  const Model model = build_model(reference_machine());
+  for (const char* task : {sim::kDigTask, sim::kFreeMotionTask}) {
+    for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {
+      app::FirmwareNodeConfig cfg;
+      cfg.kind = kind;
+      Loop loop(model, task, cfg);
+      for (int k = 0; k < 11000; ++k) loop.cycle();
+      INFO(to_string(kind) << ": " << loop.node.last_fault_text());
+      CHECK(loop.node.safe_stops() == 0);
+      CHECK(loop.node.trajectory_finished());
+    }
+  }
 }

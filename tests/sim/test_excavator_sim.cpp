@@ -94,7 +94,7 @@ TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive bea
   CHECK(fs::file_size(r.dir / "out" / "run.lcm") > 1000000);
 }
 
-TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better than PID on arm and bucket in every variant") {
+TEST_CASE("tools/excavator-sim robustness: adaptive completes every variant, at least 2x better than PID on arm and bucket wherever PID completes; PID stops only by the tracking-error fault") {
   const bool have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' 2>/dev/null") == 0;
   const Run r = run_sim("robustness " + kDig + " --quiet --json robust.json --out rob" +
                         (have_matplotlib ? "" : " --no-plots"));
@@ -107,6 +107,15 @@ TEST_CASE("tools/excavator-sim robustness: adaptive stays at least 2x better tha
   for (const nlohmann::json& row : rows) {
     const std::string name = row["variant"].get<std::string>();
     INFO("variant " << name);
+    // The adaptive law completes every variant. PID either completes or is stopped by the firmware's
+    // tracking-error fault (it drifts 0.2 m on the bucket in 3x stiffer soil), and the row says so.
+    CHECK(row["adaptive"]["ok"].get<bool>());
+    const bool pid_completed = row["pid"]["ok"].get<bool>();
+    if (!pid_completed) {
+      CHECK(row["pid"]["failure"].get<std::string>().find("tracking error: bucket") != std::string::npos);
+      CHECK_FALSE(row["ok"].get<bool>());
+      continue;
+    }
     CHECK(row["ok"].get<bool>());
     for (const char* joint : {"arm", "bucket"}) {
       const double pid = row["pid"]["rms_error"][joint].get<double>();

@@ -97,7 +97,7 @@ void visit_fields(const exlcm::fault_t& m, Visitor& v) {
   v.number("code", &m.code, 1);
   v.number("severity", &m.severity, 1);
   v.boolean("active", &m.active, 1);
-  v.text("text", m.text, 64);
+  v.text("text", m.text, sizeof m.text);
 }
 
 template <class Visitor>
