@@ -2,7 +2,11 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
+
 #include "control/config_fields.hpp"
+#include "control/effort_feasibility.hpp"
+#include "model/model.hpp"
 
 namespace exc::app {
 namespace {
@@ -15,6 +19,28 @@ std::string directory_of(const std::string& path) {
 std::string resolve(const std::string& base, const std::string& path) {
   if (path.empty() || path[0] == '/') return path;
   return base + "/" + path;
+}
+
+// The task against the actuators' limits before the run: refused with the place, the joint and the
+// effort, or (task.efforts.fit_timing) slowed down until it fits, 2 % beyond the exact fit.
+void check_task_efforts(FirmwareSettings& s) {
+  control::Task& task = s.task;
+  if (!task.efforts.check) return;
+  control::FeasibilityOptions o;
+  o.soil_margin = task.efforts.soil_margin;
+  o.terrain_height = s.terrain_height;
+  const Model model = build_model(s.machine);
+  const control::FeasibilityReport r = control::check_effort_feasibility(model, task.trajectory, o);
+  if (r.ok) return;
+  const std::string field = task.type == control::TaskType::dig ? "task.path" : "task.waypoints";
+  if (!task.efforts.fit_timing || std::isinf(r.time_scale))
+    throw control::ConfigError(s.file, field, r.message(task.waypoint_times, field) +
+                                                  (std::isinf(r.time_scale) ? "" : "; or set task.efforts.fit_timing: true"));
+  task.timing_scale = r.time_scale * 1.02;
+  task.trajectory = control::scale_timing(task.trajectory, task.timing_scale);
+  const double t0 = task.waypoint_times.front();
+  for (double& t : task.waypoint_times) t = t0 + (t - t0) * task.timing_scale;
+  for (control::DigWaypoint& w : task.path) w.t = t0 + (w.t - t0) * task.timing_scale;
 }
 
 }  // namespace
@@ -50,6 +76,7 @@ FirmwareSettings parse_firmware_settings(const YAML::Node& root, const std::stri
   s.controller = control::parse_controller_config(root["controller"], file);
   if (!root["task"]) throw ConfigError(file, "task", "missing: the firmware needs a task");
   s.task = control::parse_task(root["task"], file, s.machine);
+  check_task_efforts(s);
   return s;
 }
 

@@ -9,6 +9,22 @@
 namespace exc::control {
 namespace {
 
+bool read_flag(const YAML::Node& n, const std::string& file, const std::string& field) {
+  bool v = false;
+  if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) throw ConfigError(file, field, "must be true or false");
+  return v;
+}
+
+TaskEffortCheck parse_effort_check(const YAML::Node& n, const std::string& file, const std::string& field) {
+  TaskEffortCheck c;
+  if (!n.IsDefined() || n.IsNull()) return c;
+  reject_unknown_keys(n, file, field, {"check", "soil_margin", "fit_timing"});
+  if (n["check"]) c.check = read_flag(n["check"], file, field + ".check");
+  if (n["soil_margin"]) c.soil_margin = read_number(n["soil_margin"], file, field + ".soil_margin", 0, 0.9);
+  if (n["fit_timing"]) c.fit_timing = read_flag(n["fit_timing"], file, field + ".fit_timing");
+  return c;
+}
+
 const YAML::Node& sequence(const YAML::Node& n, const std::string& file, const std::string& field) {
   if (!n.IsDefined() || !n.IsSequence() || n.size() < 2)
     throw ConfigError(file, field, "must be a list of at least 2 waypoints");
@@ -26,7 +42,7 @@ Task parse_task(const YAML::Node& node, const std::string& file, const Machine& 
   Task task;
   constexpr double kTimeMax = 1e5;
   if (type == "joint_waypoints") {
-    reject_unknown_keys(node, file, s, {"type", "waypoints"});
+    reject_unknown_keys(node, file, s, {"type", "waypoints", "efforts"});
     task.type = TaskType::joint_waypoints;
     const YAML::Node w = sequence(node["waypoints"], file, s + ".waypoints");
     const Vec4 lo = machine.q_min(), hi = machine.q_max();
@@ -52,7 +68,7 @@ Task parse_task(const YAML::Node& node, const std::string& file, const Machine& 
     task.trajectory = JointTrajectory(task.waypoint_times, qs);
     check_joint_trajectory(machine, task.trajectory, task.waypoint_times, options, file, s + ".waypoints");
   } else if (type == "dig") {
-    reject_unknown_keys(node, file, s, {"type", "swing", "path"});
+    reject_unknown_keys(node, file, s, {"type", "swing", "path", "efforts"});
     task.type = TaskType::dig;
     task.swing = node["swing"] ? read_number(node["swing"], file, s + ".swing", -3.14159265358979323846,
                                         3.14159265358979323846, "rad")
@@ -73,6 +89,7 @@ Task parse_task(const YAML::Node& node, const std::string& file, const Machine& 
   } else {
     throw ConfigError(file, s + ".type", "'" + type + "' (allowed: joint_waypoints, dig)");
   }
+  task.efforts = parse_effort_check(node["efforts"], file, s + ".efforts");
   return task;
 }
 

@@ -24,6 +24,13 @@ namespace exc::control {
 
 enum class TaskType { joint_waypoints, dig };
 
+// The effort check before the run (effort_feasibility.hpp), from the task's `efforts:` mapping.
+struct TaskEffortCheck {
+  bool check = true;        // refuse a path the actuators cannot drive
+  double soil_margin = 0.3; // fraction of each limit kept for the soil where the tip is below ground
+  bool fit_timing = false;  // instead of refusing, slow the whole path down until it fits
+};
+
 struct Task {
   TaskType type = TaskType::joint_waypoints;
   JointTrajectory trajectory;
@@ -32,6 +39,8 @@ struct Task {
   std::vector<DigWaypoint> path;       // dig: the tip poses as given
   double start_time() const { return trajectory.start_time(); }
   double end_time() const { return trajectory.end_time(); }
+  TaskEffortCheck efforts;
+  double timing_scale = 1;             // > 1 when fit_timing slowed the path down (times multiplied)
 };
 
 Task parse_task(const YAML::Node& task, const std::string& file, const Machine& machine,

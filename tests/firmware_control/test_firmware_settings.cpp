@@ -5,6 +5,7 @@
 #include <string>
 
 #include "app/firmware_settings.hpp"
+#include "control/effort_feasibility.hpp"
 
 using namespace exc;
 
@@ -66,4 +67,44 @@ TEST_CASE("firmware/settings name the file when it is missing or not YAML") {
     CHECK(e.file() == "/nonexistent/scene.yaml");
     CHECK(e.reason() == "cannot open the file");
   }
+}
+
+namespace {
+
+// Issue 16's scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
+std::string fast_swing_scene(const std::string& efforts) {
+  return "name: fast_swing\nduration: 3\n"
+         "task:\n  type: joint_waypoints\n" + efforts +
+         "  waypoints:\n    - {t: 0.0, q: [0.0, 2.45, 2.40, 2.10]}\n    - {t: 2.5, q: [2.0, 2.45, 2.40, 2.10]}\n";
+}
+
+}  // namespace
+
+TEST_CASE("firmware/settings refuse a task the actuators cannot drive, naming the place, the joint, the torque and the timing that fits") {
+  const std::string e = error_of(fast_swing_scene(""));
+  MESSAGE(e);
+  CHECK(e.rfind("task.waypoints | task.waypoints[0] -> task.waypoints[1] at t = ", 0) == 0);
+  CHECK(e.find("the swing needs ") != std::string::npos);
+  CHECK(e.find("65.0 kN m") != std::string::npos);
+  CHECK(e.find("it fits with the timing scaled by 2.2") != std::string::npos);
+  CHECK(e.find("or set task.efforts.fit_timing: true") != std::string::npos);
+}
+
+TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much; check: false forces it as written") {
+  const app::FirmwareSettings fit =
+      app::parse_firmware_settings(YAML::Load(fast_swing_scene("  efforts: {fit_timing: true}\n")), "scene.yaml", ".");
+  MESSAGE("timing scaled by " << fit.task.timing_scale);
+  CHECK(fit.task.timing_scale > 2.0);
+  CHECK(fit.task.timing_scale < 2.5);
+  CHECK(fit.task.end_time() == doctest::Approx(2.5 * fit.task.timing_scale));
+  CHECK(fit.task.waypoint_times.back() == doctest::Approx(2.5 * fit.task.timing_scale));
+  const Model model = build_model(fit.machine);
+  CHECK(control::check_effort_feasibility(model, fit.task.trajectory).ok);
+
+  const app::FirmwareSettings forced =
+      app::parse_firmware_settings(YAML::Load(fast_swing_scene("  efforts: {check: false}\n")), "scene.yaml", ".");
+  CHECK(forced.task.timing_scale == 1.0);
+  CHECK(forced.task.end_time() == doctest::Approx(2.5));
+  CHECK(error_of(fast_swing_scene("  efforts: {check: maybe}\n")) == "task.efforts.check | must be true or false");
+  CHECK(error_of(fast_swing_scene("  efforts: {soil_margin: 2}\n")).rfind("task.efforts.soil_margin | ", 0) == 0);
 }

@@ -178,3 +178,41 @@ TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits
   CHECK(help.status == 0);
   CHECK(help.out.find("--json") != std::string::npos);
 }
+
+TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run, and forced, stops it safely with the reason and exit 1") {
+  const std::string free_motion = std::string(EXC_SOURCE_DIR) + "/scenes/free_motion.yaml";
+  std::string text = read_text_file(free_motion);
+  const std::string from = "    - {t: 2.0, q: [0.4, 2.70, 2.60, 1.90]}";
+  const auto pos = text.find(from);
+  REQUIRE(pos != std::string::npos);
+  text.replace(pos, from.size(), "    - {t: 2.5, q: [2.0, 2.70, 2.60, 1.90]}");
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
+  fs::create_directories(dir);
+  const fs::path refused = dir / ("fast_swing_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(refused) << text;
+  const Run r = run_sim("run " + refused.string() + " --quiet --no-report");
+  INFO(r.err);
+  CHECK(r.status == 2);
+  CHECK(r.err.find("the swing needs") != std::string::npos);
+  CHECK(r.err.find("kN m") != std::string::npos);
+
+  std::string forced_text = text;
+  const std::string type = "  type: joint_waypoints";
+  const auto at = forced_text.find(type);
+  REQUIRE(at != std::string::npos);
+  forced_text.insert(at + type.size(), "\n  efforts: {check: false}");
+  const fs::path forced = dir / ("fast_swing_forced_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(forced) << forced_text;
+  const Run f = run_sim("run " + forced.string() + " --quiet --no-report --json summary.json");
+  INFO(f.err);
+  CHECK(f.status == 1);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(f.dir / "summary.json"));
+  CHECK_FALSE(j["ok"].get<bool>());
+  for (const char* c : {"pid", "adaptive"}) {
+    INFO(c);
+    CHECK_FALSE(j[c]["ok"].get<bool>());
+    CHECK(j[c]["failure"].get<std::string>().find("tracking error: swing") != std::string::npos);
+  }
+  fs::remove(refused);
+  fs::remove(forced);
+}

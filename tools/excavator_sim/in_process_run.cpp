@@ -31,6 +31,8 @@ std::string describe_setup(const SceneBundle& bundle) {
     o << c.actuator_lag * 1e3 << " ms -> " << c.actuator_lag_target * 1e3 << " ms";
   else
     o << "off";
+  if (bundle.firmware.task.timing_scale != 1)
+    o << "; task timing scaled by " << bundle.firmware.task.timing_scale << " to fit the actuators' limits";
   o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
     << " at " << sc.integrator.step * 1e3 << " ms";
   return o.str();
