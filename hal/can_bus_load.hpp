@@ -12,7 +12,19 @@
 // at the nominal rate; ESI, DLC (5 bits) and the data with their dynamic stuff bits, then the stuff
 // count and CRC with their fixed stuff bits (27 bits for CRC-17 up to 16 bytes, 32 bits for CRC-21
 // above) run at the data rate.
+#include <cstdint>
+
 namespace exc::hal {
+
+inline constexpr double kClassicalBitRate = 1e6;  // bit/s, the bus the DBC schedule is budgeted for
+
+// CRC-15 of CAN (polynomial 0x4599, initial 0) over `count` bits given MSB first.
+std::uint16_t can_crc15(const std::uint8_t* bits, int count);
+
+// The exact length in bits of one classical standard data frame as it goes on the wire: SOF to EOF
+// plus the 3-bit intermission, with the stuff bits its content really needs (a stuff bit after five
+// equal bits, from SOF to the end of the CRC sequence, stuff bits counting towards the next run).
+int classical_frame_bits(std::uint32_t id, std::uint8_t dlc, const std::uint8_t* data);
 
 constexpr int classical_frame_bits_worst(int data_bytes) {
   return 47 + 8 * data_bytes + (34 + 8 * data_bytes - 1) / 4;

@@ -1,5 +1,6 @@
 #include "hal/can_ports.hpp"
 
+#include "hal/can_bus_load.hpp"
 #include "hal/clock.hpp"
 
 namespace exc::hal {
@@ -28,6 +29,7 @@ bool encode_and_send(CanBus& bus, TxStats& tx, const MessageSpec& message, std::
     return false;
   }
   ++tx.frames_sent;
+  tx.bits += static_cast<std::uint64_t>(classical_frame_bits(frame.id, frame.dlc, frame.data));
   return true;
 }
 
@@ -115,6 +117,7 @@ void FirmwareCanPort::apply(const MessageSpec& message, const CanFrame& frame, S
 bool FirmwareCanPort::read(SensorState& state) {
   CanFrame frame;
   while (bus_.receive(frame)) {
+    rx_bits_ += static_cast<std::uint64_t>(classical_frame_bits(frame.id, frame.dlc, frame.data));
     const MessageSpec* message = nullptr;
     if (codec_.accept(frame, message) != RxVerdict::ok) continue;
     last_valid_rx_ns_ = frame.timestamp_ns != 0 ? frame.timestamp_ns : monotonic_now_ns();

@@ -19,6 +19,7 @@ struct TxStats {
   std::uint64_t send_failed = 0;
   std::uint64_t saturated = 0;   // signals clamped to their DBC range
   std::uint64_t non_finite = 0;  // NaN/inf values replaced before sending
+  std::uint64_t bits = 0;        // exact on-wire bits of the frames sent (stuffing included)
 };
 
 // The identifiers `receiver` listens to (for SocketCAN kernel filters). Returns the count written.
@@ -43,6 +44,9 @@ class FirmwareCanPort {
 
   const RxStats& rx_stats() const { return codec_.stats(); }
   const TxStats& tx_stats() const { return tx_; }
+  // Exact on-wire bits of every frame received, valid or not (with tx_stats().bits: the whole bus of
+  // a two-node network, the figure bus load is computed from).
+  std::uint64_t rx_bits() const { return rx_bits_; }
 
  private:
   bool transmit(const MessageSpec& message, std::uint8_t counter, const double* values);
@@ -54,6 +58,7 @@ class FirmwareCanPort {
   std::uint64_t cycle_ = 0;
   std::uint8_t motion_mask_ = 0;  // bit i: axis i's frame of cycle_ arrived
   std::int64_t last_valid_rx_ns_ = 0;
+  std::uint64_t rx_bits_ = 0;
   std::uint8_t heartbeat_counter_ = 0;
   std::uint8_t emergency_counter_ = 0;
 };

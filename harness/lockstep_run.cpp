@@ -68,6 +68,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     telemetry::TelemetryConfig tc;
     tc.shared_output = options.telemetry;
     tc.channel_suffix = "/" + result.controller;
+    tc.overflow = telemetry::OverflowPolicy::block;  // no deadline here: every message is recorded
     publisher = std::make_unique<telemetry::TelemetryPublisher>(tc);
     std::string error;
     if (!publisher->start(&error)) throw std::runtime_error("telemetry: " + error);
@@ -120,7 +121,14 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   if (options.progress && interactive) std::fprintf(stderr, "\n");
   node.publish_counters();
   plant_node.publish_counters();
-  if (publisher) publisher->stop();
+  if (publisher) {
+    publisher->stop();
+    const telemetry::TelemetryCounters c = publisher->counters();
+    result.telemetry_enqueued = c.enqueued;
+    result.telemetry_published = c.published;
+    result.telemetry_dropped = c.dropped_full_total + c.dropped_overflow + c.dropped_too_large;
+    result.telemetry_ring_high_water = c.ring_high_water;
+  }
 
   result.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   result.simulated_seconds = plant.state().time;

@@ -65,6 +65,10 @@ struct RunRecord {
   std::uint64_t heap_allocations_in_loop = 0;
   std::uint64_t safe_stops = 0;
   std::uint64_t rx_rejected = 0;      // CAN frames rejected by either end
+  // The telemetry path (zero everywhere without telemetry): messages the loop enqueued, handed to LCM,
+  // refused because the ring was full (never with the blocking publisher the harness uses).
+  std::uint64_t telemetry_enqueued = 0, telemetry_published = 0, telemetry_dropped = 0;
+  std::size_t telemetry_ring_high_water = 0;
   bool task_finished = false;         // the task ran to its end (then the machine held its final pose)
   double task_finish_time = 0;        // s
 };

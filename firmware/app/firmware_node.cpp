@@ -286,7 +286,9 @@ void FirmwareNode::publish_counters() {
   fill_timing(control_timing_, 2, utime, m);
   telemetry_->publish(telemetry::Channel::timing, m);
 
-  const exlcm::can_stats_t cs = can_stats_message(port_.rx_stats(), port_.tx_stats(), 0, utime);
+  // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
+  const double load = bus_load_.update(port_.tx_stats().bits + port_.rx_bits(), time());
+  const exlcm::can_stats_t cs = can_stats_message(port_.rx_stats(), port_.tx_stats(), 0, utime, load);
   telemetry_->publish(telemetry::Channel::can_stats, cs);
 }
 

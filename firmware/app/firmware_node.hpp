@@ -18,6 +18,7 @@
 #include "control/state_machine.hpp"
 #include "control/task.hpp"
 #include "hal/can_ports.hpp"
+#include "app/can_stats_message.hpp"
 #include "app/tracking_metrics.hpp"
 #include "model/model.hpp"
 
@@ -114,6 +115,7 @@ class FirmwareNode {
   control::ActuatorLagCompensator lag_compensator_;
   control::PerfCounter control_timing_;
   control::PerfCounter cycle_timing_;
+  BusLoadWindow bus_load_;
 
   double period_;
   std::uint64_t cycle_ = 0;

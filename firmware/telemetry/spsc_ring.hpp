@@ -1,6 +1,7 @@
 #pragma once
-// A lock-free single-producer single-consumer ring of fixed-size byte slots that never blocks the
-// producer: when the ring is full the producer overwrites the oldest message and counts it.
+// A lock-free single-producer single-consumer ring of fixed-size byte slots. push() never blocks: when
+// the ring is full it overwrites the oldest message and counts it. Producers that must not lose
+// messages (or must drop the newest instead) check full() first (TelemetryPublisher does).
 //
 // Why not a plain head/tail ring: with "drop the oldest" the producer must reuse a slot the consumer
 // may be copying at that very moment. Each slot therefore carries a sequence word that says which
@@ -83,6 +84,8 @@ class SpscRing {
     slot.sequence.store(encode_sequence(position, State::complete), std::memory_order_release);
     head_.store(position + 1, std::memory_order_release);
     pushed_.fetch_add(1, std::memory_order_relaxed);
+    const std::size_t waiting = occupancy();
+    if (waiting > high_water_.load(std::memory_order_relaxed)) high_water_.store(waiting, std::memory_order_relaxed);
     return true;
   }
 
@@ -121,6 +124,7 @@ class SpscRing {
           std::memory_order_relaxed);
       const std::uint64_t position = next_;
       ++next_;
+      consumed_.store(next_, std::memory_order_release);
       if (!claimed) continue;  // overwritten while we copied: the producer counted it as dropped
       out.tag = static_cast<std::uint16_t>(header >> 32);
       out.size = size;
@@ -128,6 +132,15 @@ class SpscRing {
       return true;
     }
   }
+
+  // Producer only: messages written and not yet taken by the consumer (0 .. SlotCount). A producer
+  // that must not lose messages waits while full(); one with a deadline refuses the new message.
+  std::size_t occupancy() const {
+    return static_cast<std::size_t>(head_.load(std::memory_order_relaxed) - consumed_.load(std::memory_order_acquire));
+  }
+  bool full() const { return occupancy() >= SlotCount; }
+  // The most messages that were waiting at once (producer-side, after each push).
+  std::size_t high_water() const { return high_water_.load(std::memory_order_relaxed); }
 
   // Producer only: counts a message refused before push (e.g. its encoding did not fit a slot).
   void note_too_large() { too_large_.fetch_add(1, std::memory_order_relaxed); }
@@ -159,6 +172,8 @@ class SpscRing {
   std::array<Slot, SlotCount> slots_{};
   alignas(64) std::atomic<std::uint64_t> head_{0};  // next position the producer writes
   alignas(64) std::uint64_t next_ = 0;               // consumer-private: next position to read
+  std::atomic<std::uint64_t> consumed_{0};           // next_, published for the producer's occupancy
+  alignas(64) std::atomic<std::size_t> high_water_{0};
   alignas(64) std::atomic<std::uint64_t> pushed_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<std::uint64_t> too_large_{0};

@@ -19,6 +19,16 @@
 
 namespace exc::telemetry {
 
+// What publish() does when the ring is full.
+enum class OverflowPolicy : std::uint8_t {
+  // Wait for the telemetry thread to make room: every message of every cycle is recorded. For runs
+  // that are not paced by the wall clock (lockstep, in-process, benchmarks), where no deadline exists.
+  block,
+  // Refuse the new message and count it per channel: the loop never waits. For --realtime runs.
+  drop_newest,
+};
+const char* to_string(OverflowPolicy policy);
+
 struct TelemetryConfig {
   // LCM provider, opened by start() unless `shared_output` is given.
   std::string lcm_url = "file://run.lcm?mode=w";
@@ -28,20 +38,26 @@ struct TelemetryConfig {
   std::string channel_suffix;
   // How often the telemetry thread publishes telemetry_stats_t.
   std::chrono::milliseconds stats_period{1000};
-  // The telemetry thread wakes this often and hands at most `max_burst` messages to LCM per wake.
-  // Why a burst limit: an LCM subscriber (lcm-logger, lcm-spy) queues at most 30 messages per
-  // subscription by default and drops the rest, so a backlog sent in one go (the thread was
-  // descheduled for a few ms) would be lost at the receiver. The ring absorbs the backlog instead;
-  // 16 per ms is still 16000 messages/s, four times the loop's ~4000; waking once per ms rather
+  OverflowPolicy overflow = OverflowPolicy::block;
+  // The telemetry thread wakes this often and drains the ring. To a file:// provider it hands
+  // everything (no receiver to outrun). To a udpm:// provider at most `udpm_burst` messages per wake:
+  // an LCM subscriber (lcm-logger, lcm-spy) queues at most 30 messages per subscription by default
+  // and drops the rest, so a backlog sent in one go would be lost at the receiver. The ring holds the
+  // backlog instead (and, blocking, slows the loop to the receivers' pace); waking once per ms rather
   // than per message also spares the receivers a wake-up per message.
   std::chrono::microseconds wake_period{1000};
-  std::size_t max_burst = 16;
+  std::size_t udpm_burst = 4;
 };
 
 struct TelemetryCounters {
   std::uint64_t enqueued = 0;           // messages pushed into the ring by the loop
   std::uint64_t published = 0;          // messages handed to LCM successfully
-  std::uint64_t dropped_overflow = 0;   // oldest messages overwritten because the ring was full
+  std::uint64_t dropped_overflow = 0;   // oldest messages overwritten (never with the publisher's policies)
+  std::array<std::uint64_t, channel_count> dropped_full{};  // per channel: refused, ring full (drop_newest)
+  std::uint64_t dropped_full_total = 0;
+  std::uint64_t blocked = 0;            // publish() calls that waited for room (block)
+  std::size_t ring_high_water = 0;      // most messages waiting at once
+  std::size_t ring_capacity = 0;
   std::uint64_t dropped_too_large = 0;  // messages whose encoding did not fit a ring slot
   std::uint64_t publish_errors = 0;     // lcm_publish calls that failed
 };
@@ -64,8 +80,9 @@ class TelemetryPublisher {
   // the provider (a log file not shared with another publisher is closed).
   void stop();
 
-  // Real-time safe. Sets msg.seq to this channel's next sequence number (0, 1, 2, ...) and
-  // enqueues its encoding. Returns false if it was refused (encoding larger than a slot).
+  // Allocation-free. Sets msg.seq to this channel's next sequence number (0, 1, 2, ...) and enqueues
+  // its encoding. A full ring waits (block: not for real-time loops) or refuses the message and
+  // counts it (drop_newest). Returns false if it was refused.
   template <class Msg>
   bool publish(Channel channel, Msg msg) {
     const auto index = static_cast<std::size_t>(channel);
@@ -74,6 +91,10 @@ class TelemetryPublisher {
     const int size = msg.encode(encode_buffer_.data(), 0, static_cast<int>(Ring::slot_bytes));
     if (size < 0) {
       ring_.note_too_large();
+      return false;
+    }
+    if (ring_.full() && !make_room()) {
+      dropped_full_[index].fetch_add(1, std::memory_order_relaxed);
       return false;
     }
     return ring_.push(static_cast<std::uint16_t>(index), encode_buffer_.data(),
@@ -88,6 +109,8 @@ class TelemetryPublisher {
 
  private:
   void run();
+  // Ring full: with `block` and a running thread, waits until there is room (true); else false.
+  bool make_room();
   // Publishes up to `limit` messages; returns how many it took from the ring.
   std::size_t drain(std::size_t limit);
   void publish_stats();
@@ -104,6 +127,9 @@ class TelemetryPublisher {
   std::unique_ptr<Ring::Message> message_;
   std::thread thread_;
   std::atomic<bool> stop_requested_{false};
+  std::atomic<bool> running_{false};
+  std::array<std::atomic<std::uint64_t>, channel_count> dropped_full_{};
+  std::atomic<std::uint64_t> blocked_{0};
   std::atomic<std::uint64_t> published_{0};
   std::atomic<std::uint64_t> publish_errors_{0};
   std::int64_t last_utime_ = 0;

@@ -13,6 +13,7 @@
 #include "app/firmware_node.hpp"
 #include "closed_loop.hpp"
 #include "dbc_reader.hpp"
+#include "hal/can_bus_load.hpp"
 #include "hal/can_protocol.hpp"
 #include "hal/memory_bus.hpp"
 #include "model/closed_chain.hpp"
@@ -308,4 +309,31 @@ TEST_CASE("firmware/node: the shipped tasks never trip the tracking-error fault 
       CHECK(loop.node.trajectory_finished());
     }
   }
+}
+
+TEST_CASE("firmware/node: the port counts every frame on the bus once, at its exact length, between the unstuffed and the worst-case length") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  hal::MemoryBusNode* listener = loop.hub.attach(4096);
+  std::uint64_t frames = 0, unstuffed = 0, worst = 0;
+  constexpr int cycles = 2000;
+  for (int k = 0; k < cycles; ++k) {
+    loop.cycle();
+    hal::CanFrame f;
+    while (listener->receive(f)) {
+      ++frames;
+      unstuffed += 47 + 8 * f.dlc;
+      worst += static_cast<std::uint64_t>(hal::classical_frame_bits_worst(f.dlc));
+    }
+  }
+  const std::uint64_t counted = loop.fw_port.tx_stats().bits + loop.fw_port.rx_bits();
+  const double load = static_cast<double>(counted) / (hal::kClassicalBitRate * cycles * 1e-3);
+  MESSAGE(frames << " frames, " << counted << " bits counted (unstuffed " << unstuffed << ", worst case " << worst
+                 << "): bus load " << load * 100 << " %");
+  CHECK(loop.fw_port.tx_stats().frames_sent + loop.fw_port.rx_stats().ok == frames);
+  CHECK(counted > unstuffed);
+  CHECK(counted < worst);
+  app::BusLoadWindow window;
+  CHECK(window.update(counted, cycles * 1e-3) == doctest::Approx(load));
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <map>
+#include <string>
 #include <vector>
 
 #include "dbc_reader.hpp"
@@ -123,4 +124,34 @@ TEST_CASE("hal/bus budget of the DBC schedule at 1 Mbit/s classical CAN, and the
             " us (", ns / 1e4, "% of 1 ms)");
     if (data_rate == 5e6) CHECK(ns <= 500'000.0);
   }
+}
+
+TEST_CASE("hal/exact frame length: CRC-15 check value, no-stuff and worst-case frames, bounded by the worst-case formula") {
+  // CRC-15/CAN of the ASCII string "123456789" is 0x059E (the CRC catalogue's check value).
+  std::vector<std::uint8_t> bits;
+  for (char c : std::string("123456789"))
+    for (int b = 7; b >= 0; --b) bits.push_back(static_cast<std::uint8_t>((c >> b) & 1));
+  CHECK(exc::hal::can_crc15(bits.data(), static_cast<int>(bits.size())) == 0x059E);
+
+  // Every frame lies between the unstuffed length (47 + 8 n) and the worst case, whatever its content.
+  std::uint32_t state = 12345;
+  const auto next = [&state] { return state = state * 1664525u + 1013904223u; };
+  int longest[9] = {};
+  for (int trial = 0; trial < 20000; ++trial) {
+    const std::uint8_t dlc = static_cast<std::uint8_t>(next() % 9);
+    std::uint8_t data[8] = {};
+    for (int i = 0; i < dlc; ++i) data[i] = static_cast<std::uint8_t>(next() >> 24);
+    const int n = exc::hal::classical_frame_bits(next() & 0x7FF, dlc, data);
+    CHECK(n >= 47 + 8 * dlc);
+    CHECK(n <= classical_frame_bits_worst(dlc));
+    longest[dlc] = std::max(longest[dlc], n);
+  }
+  // All-zero content stuffs every fifth bit from SOF on: far more than random data, and never more
+  // than the worst case.
+  const std::uint8_t zeros[8] = {};
+  const int zero_frame = exc::hal::classical_frame_bits(0, 8, zeros);
+  MESSAGE("8-byte frame: all zeros " << zero_frame << " bits, longest of random content " << longest[8]
+                                     << ", worst case " << classical_frame_bits_worst(8));
+  CHECK(zero_frame > 47 + 64 + 15);
+  CHECK(zero_frame <= classical_frame_bits_worst(8));
 }

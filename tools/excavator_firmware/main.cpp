@@ -81,6 +81,9 @@ int main(int argc, char** argv) {
     if (!lcm_url.empty()) {
       exc::telemetry::TelemetryConfig tc;
       tc.lcm_url = lcm_url;
+      // Real time: a full ring must not stall the loop, so it refuses and counts (reported below);
+      // lockstep has no deadline, so it waits and records every message.
+      tc.overflow = realtime ? exc::telemetry::OverflowPolicy::drop_newest : exc::telemetry::OverflowPolicy::block;
       publisher = std::make_unique<exc::telemetry::TelemetryPublisher>(tc);
       if (!publisher->start(&error)) {
         std::cerr << "excavator-firmware: --lcm: " << error << "\n";
@@ -146,6 +149,16 @@ int main(int argc, char** argv) {
       j["control_step_us"] = {{"median", c.median_us()}, {"p99", c.p99_us()}, {"max", c.max_us()}};
       j["safe_stops"] = node.safe_stops();
       j["can_frames_rejected"] = port.rx_stats().rejected();
+      if (publisher) {
+        const exc::telemetry::TelemetryCounters tcn = publisher->counters();
+        nlohmann::json dropped;
+        for (std::size_t i = 0; i < exc::telemetry::channel_count; ++i)
+          dropped[publisher->channel_name(static_cast<exc::telemetry::Channel>(i))] = tcn.dropped_full[i];
+        j["telemetry"] = {{"enqueued", tcn.enqueued}, {"published", tcn.published},
+                          {"dropped", tcn.dropped_full_total}, {"dropped_by_channel", dropped},
+                          {"ring_high_water", tcn.ring_high_water}, {"ring_capacity", tcn.ring_capacity},
+                          {"overflow_policy", exc::telemetry::to_string(tcn.dropped_full_total ? exc::telemetry::OverflowPolicy::drop_newest : (realtime ? exc::telemetry::OverflowPolicy::drop_newest : exc::telemetry::OverflowPolicy::block))}};
+      }
       std::ofstream(json_path) << j.dump(2) << "\n";
     }
     return 0;

@@ -109,6 +109,11 @@ void visit_fields(const exlcm::telemetry_stats_t& m, Visitor& v) {
   v.number("dropped_overflow", &m.dropped_overflow, 1);
   v.number("dropped_too_large", &m.dropped_too_large, 1);
   v.number("publish_errors", &m.publish_errors, 1);
+  v.number("dropped_full", m.dropped_full, 7);
+  v.number("blocked", &m.blocked, 1);
+  v.number("ring_high_water", &m.ring_high_water, 1);
+  v.number("ring_capacity", &m.ring_capacity, 1);
+  v.number("overflow_policy", &m.overflow_policy, 1);
 }
 
 // Calls f(prototype) with a value-initialised message of the exlcm type whose LCM fingerprint is

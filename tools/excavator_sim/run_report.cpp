@@ -58,10 +58,13 @@ void print_summary(const Summary& summary, std::ostream& out) {
   for (const RunResult& r : summary.runs) {
     std::snprintf(line, sizeof line,
                   "%-10s peak soil force %8.1f kN, %d shear re-anchorings; control step median %.1f us, p99 %.1f us, "
-                  "max %.1f us; heap allocations in loop %llu; %.1f s simulated in %.2f s (%.0fx real time)%s%s\n",
+                  "max %.1f us; heap allocations in loop %llu; telemetry %llu messages, %llu dropped; "
+                  "%.1f s simulated in %.2f s (%.0fx real time)%s%s\n",
                   r.controller.c_str(), r.peak_soil_force * 1e-3, r.reanchor_count, r.control_step.median_us,
                   r.control_step.p99_us, r.control_step.max_us,
-                  static_cast<unsigned long long>(r.heap_allocations_in_loop), r.simulated_seconds, r.wall_seconds,
+                  static_cast<unsigned long long>(r.heap_allocations_in_loop),
+                  static_cast<unsigned long long>(r.telemetry_published), static_cast<unsigned long long>(r.telemetry_dropped),
+                  r.simulated_seconds, r.wall_seconds,
                   r.wall_seconds > 0 ? r.simulated_seconds / r.wall_seconds : 0.0, r.ok ? "" : "\n  FAILED: ",
                   r.ok ? "" : r.failure.c_str());
     out << line;
@@ -99,6 +102,9 @@ nlohmann::json to_json(const Summary& summary) {
     run["wall_seconds"] = r.wall_seconds;
     run["safe_stops"] = r.safe_stops;
     run["can_frames_rejected"] = r.rx_rejected;
+    run["telemetry"] = {{"enqueued", r.telemetry_enqueued}, {"published", r.telemetry_published},
+                        {"dropped", r.telemetry_dropped}, {"ring_high_water", r.telemetry_ring_high_water},
+                        {"overflow_policy", "block"}};
     j[r.controller] = run;
     // Headline figures over all runs: the worst timing, the total allocations.
     worst.median_us = std::max(worst.median_us, r.control_step.median_us);
