@@ -1,6 +1,8 @@
 #include "sim_plant/plant_node.hpp"
 
 #include "app/can_stats_message.hpp"
+#include "app/timing_message.hpp"
+#include "hal/clock.hpp"
 #include "exlcm/machine_state_t.hpp"
 #include "model/closed_chain.hpp"
 #include "telemetry/telemetry_publisher.hpp"
@@ -75,7 +77,9 @@ void PlantNode::step(std::uint64_t cycle) {
       for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
     }
   }
+  const std::int64_t step_start = hal::monotonic_now_ns();
   plant_.step(actuator);
+  step_timing_.record_ns(hal::monotonic_now_ns() - step_start);
   ++steps_;
 
   const plant::SensorReading& r = plant_.sensors();
@@ -124,6 +128,9 @@ void PlantNode::publish_counters() {
   const exlcm::can_stats_t cs =
       can_stats_message(port_.rx_stats(), port_.tx_stats(), 1, static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5));
   telemetry_->publish(telemetry::Channel::can_stats, cs);
+  exlcm::timing_t m{};
+  fill_timing(step_timing_, 4, cs.utime, m);  // stage 4: the plant step
+  telemetry_->publish(telemetry::Channel::timing, m);
 }
 
 }  // namespace exc::app

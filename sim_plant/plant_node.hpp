@@ -6,6 +6,7 @@
 // stop. Nothing allocates after construction.
 #include <cstdint>
 
+#include "control/perf_counter.hpp"
 #include "hal/can_ports.hpp"
 #include "model/workspace.hpp"
 #include "sim_plant/plant.hpp"
@@ -61,6 +62,7 @@ class PlantNode {
   bool silence_hold_ = false;
   std::uint64_t holds_ = 0;
   std::uint64_t steps_ = 0;
+  control::PerfCounter step_timing_{"plant_step", 1000.0};
 };
 
 }  // namespace exc::app

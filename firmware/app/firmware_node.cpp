@@ -1,11 +1,13 @@
 #include "app/firmware_node.hpp"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 
 #include "app/can_stats_message.hpp"
+#include "app/timing_message.hpp"
 #include "control/make_controller.hpp"
 #include "exlcm/command_t.hpp"
 #include "exlcm/controller_state_t.hpp"
@@ -24,29 +26,6 @@ constexpr int kCounterPeriod = 100;    // cycles between timing / CAN counter me
 Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]); }
 
 bool finite(const Vec4& v) { return v.allFinite(); }
-
-void fill_timing(const control::PerfCounter& c, std::int8_t stage, std::int64_t utime,
-                 exlcm::timing_t& m) {
-  m.utime = utime;
-  m.stage = stage;
-  m.count = static_cast<std::int64_t>(c.count());
-  m.min_us = c.min_us();
-  m.median_us = c.median_us();
-  m.p99_us = c.p99_us();
-  m.max_us = c.max_us();
-  m.overruns = static_cast<std::int64_t>(c.overruns());
-  // Re-bin the counter's log histogram onto 64 linear bins covering twice the p99.
-  const double span = std::max(1.0, 2 * c.p99_us());
-  m.bin_width_us = span / 64;
-  std::fill(std::begin(m.bins), std::end(m.bins), 0);
-  const auto& h = c.histogram();
-  for (int b = 0; b < control::PerfCounter::kBuckets; ++b) {
-    if (h[b] == 0) continue;
-    const double centre = control::PerfCounter::upper_edge_us(b) / std::sqrt(control::PerfCounter::kRatio);
-    const int bin = std::min(63, static_cast<int>(centre / m.bin_width_us));
-    m.bins[bin] += h[b];
-  }
-}
 
 }  // namespace
 
@@ -74,7 +53,11 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       lag_compensator_(config.controller.actuator_lag, config.controller.actuator_lag_target,
                        config.controller.period, control::effort_limits_of(model.machine)),
       control_timing_("control", 100.0),
-      cycle_timing_("cycle", 1000.0),
+      cycle_timing_("cycle", config.controller.period * 1e6),
+      read_timing_("read", 100.0),
+      write_timing_("write", 100.0),
+      telemetry_timing_("telemetry", 100.0),
+      interval_timing_("interval", config.controller.period * 1.5e6),
       period_(config.controller.period) {}
 
 FirmwareNode::~FirmwareNode() = default;
@@ -103,6 +86,8 @@ void FirmwareNode::end_cycle() {
     have_valid_ = true;
     last_valid_time_ = t;
   }
+  const std::int64_t read_ns = hal::monotonic_now_ns();
+  read_timing_.record_ns(read_ns - start_ns);
 
   control::StateMachineInputs in;
   in.t = t;
@@ -147,7 +132,10 @@ void FirmwareNode::end_cycle() {
   }
 
   compute_command(transition);
+  const std::int64_t write_start_ns = hal::monotonic_now_ns();
   port_.write(command_);
+  const std::int64_t write_end_ns = hal::monotonic_now_ns();
+  write_timing_.record_ns(write_end_ns - write_start_ns);
   if (machine_.mode() == control::Mode::track) measured_.add(to_vec(sensors_.position), q_d_);
   if (telemetry_ != nullptr) publish_cycle();
   if (telemetry_ != nullptr && transition.changed) {
@@ -165,7 +153,15 @@ void FirmwareNode::end_cycle() {
   // The cycle's scope (stated once, in firmware_node.hpp): read to telemetry encoded, the periodic
   // counter messages included.
   if (telemetry_ != nullptr && cycle_ % kCounterPeriod == 0) publish_counters();
-  cycle_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
+  const std::int64_t end_ns = hal::monotonic_now_ns();
+  if (telemetry_ != nullptr) telemetry_timing_.record_ns(end_ns - write_end_ns);
+  cycle_timing_.record_ns(end_ns - start_ns);
+}
+
+void FirmwareNode::record_wakeup(std::int64_t interval_ns, std::uint64_t overruns, std::uint64_t skipped) {
+  interval_timing_.record_ns(interval_ns);
+  deadline_overruns_ = overruns;
+  skipped_deadlines_ = skipped;
 }
 
 void FirmwareNode::compute_command(const control::Transition& transition) {
@@ -280,11 +276,22 @@ void FirmwareNode::publish_cycle() {
 void FirmwareNode::publish_counters() {
   if (telemetry_ == nullptr) return;
   const auto utime = static_cast<std::int64_t>(time() * 1e6);
+  // Every stage of the loop (timing_t.stage): 0 the whole end_cycle, 1 read, 2 update (estimate,
+  // trajectory, law), 3 write, 6 telemetry encode; 5 the wake-up interval of a real-time loop, whose
+  // overruns field carries the deadlines missed (the plant publishes 4, its step).
   exlcm::timing_t m{};
-  fill_timing(cycle_timing_, 0, utime, m);
-  telemetry_->publish(telemetry::Channel::timing, m);
-  fill_timing(control_timing_, 2, utime, m);
-  telemetry_->publish(telemetry::Channel::timing, m);
+  const std::pair<const control::PerfCounter*, std::int8_t> stages[] = {
+      {&cycle_timing_, 0}, {&read_timing_, 1}, {&control_timing_, 2}, {&write_timing_, 3}, {&telemetry_timing_, 6}};
+  for (const auto& [counter, stage] : stages) {
+    fill_timing(*counter, stage, utime, m);
+    telemetry_->publish(telemetry::Channel::timing, m);
+  }
+  if (interval_timing_.count() > 0) {
+    fill_timing(interval_timing_, 5, utime, m);
+    m.overruns = static_cast<std::int64_t>(deadline_overruns_);
+    m.skipped = static_cast<std::int64_t>(skipped_deadlines_);
+    telemetry_->publish(telemetry::Channel::timing, m);
+  }
 
   // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
   const double load = bus_load_.update(port_.tx_stats().bits + port_.rx_bits(), time());

@@ -91,6 +91,10 @@ class FirmwareNode {
   // the cycle's telemetry encoding (the counter messages every 100 cycles included).
   const control::PerfCounter& control_timing() const { return control_timing_; }
   const control::PerfCounter& cycle_timing() const { return cycle_timing_; }
+  const control::PerfCounter& interval_timing() const { return interval_timing_; }
+  // A real-time loop reports each wake-up: the interval since the previous one, and its sleeper's
+  // deadline counters (published on EXC_TIMING, stage 5).
+  void record_wakeup(std::int64_t interval_ns, std::uint64_t overruns, std::uint64_t skipped);
   std::uint64_t safe_stops() const { return safe_stops_; }
   // The fault of the last safe stop (none before any), and its description ("tracking error: swing
   // 0.1013 rad > limit 0.1 rad at t = 1.234 s").
@@ -115,6 +119,8 @@ class FirmwareNode {
   control::ActuatorLagCompensator lag_compensator_;
   control::PerfCounter control_timing_;
   control::PerfCounter cycle_timing_;
+  control::PerfCounter read_timing_, write_timing_, telemetry_timing_, interval_timing_;
+  std::uint64_t deadline_overruns_ = 0, skipped_deadlines_ = 0;
   BusLoadWindow bus_load_;
 
   double period_;

@@ -10,12 +10,17 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <sched.h>
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
+
+extern char** environ;
 
 using exc::test::read_text_file;
 
@@ -128,6 +133,21 @@ TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive bea
       CHECK(l.first_seq == 0);
       CHECK(l.gaps == 0);
       CHECK(l.last_seq == 9999);
+    }
+    // The report's CSVs (excavator-log export, as the report writes them) have one row per cycle.
+    {
+      const fs::path csv = r.dir / ("csv_" + std::string(c));
+      const std::string cmd = std::string(EXC_LOG_TOOL) + " export '" + (r.dir / "out" / "run.lcm").string() +
+                              "' --csv '" + csv.string() + "' > /dev/null 2>&1";
+      REQUIRE(std::system(cmd.c_str()) == 0);
+      for (const char* base : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
+        std::ifstream in(csv / (std::string(base) + "__" + c + ".csv"));
+        std::string line;
+        long rows = -1;  // the header
+        while (std::getline(in, line)) ++rows;
+        INFO(base);
+        CHECK(rows == 10000);
+      }
     }
     // The telemetry path's own counters: nothing dropped (blocking publisher), every message published.
     INFO(c);
@@ -258,4 +278,51 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
   }
   fs::remove(refused);
   fs::remove(forced);
+}
+
+TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records every message of the main job") {
+  // Multicast on the loopback must work: a machine without it fails here with what to run.
+  const int port = 17700 + static_cast<int>(getpid() % 200);
+  const std::string url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
+  const int route = std::system("ip route get 239.255.76.67 2>/dev/null | grep -q ' dev lo '");
+  REQUIRE_MESSAGE(route == 0, "239.255.0.0/16 is not routed to the loopback; as root run: ip link set lo multicast on; "
+                              "ip route add 239.255.0.0/16 dev lo (tools/install-deps test does)");
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
+  fs::create_directories(dir);
+  const fs::path log_path = (fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : dir) /
+                            ("exc-main-job-" + std::to_string(getpid()) + ".lcm");
+  fs::remove(log_path);
+  const std::string log_arg = log_path.string(), url_arg = "--lcm-url=" + url;
+  const char* argv[] = {"lcm-logger", "-f", "-q", url_arg.c_str(), log_arg.c_str(), nullptr};
+  pid_t logger = 0;
+  REQUIRE_MESSAGE(posix_spawnp(&logger, "lcm-logger", nullptr, nullptr, const_cast<char* const*>(argv), environ) == 0,
+                  "cannot start lcm-logger (Debian package liblcm-bin)");
+  // The logger's main thread must not fall behind LCM's 30-message subscription queue: real-time
+  // priority where permitted (root in CI), and the publisher paces udpm to 4 messages per ms.
+  sched_param priority{};
+  priority.sched_priority = 10;
+  sched_setscheduler(logger, SCHED_FIFO, &priority);
+  // Ready once its file exists (lcm-logger creates it when it starts listening).
+  for (int i = 0; i < 250 && !fs::exists(log_path); ++i) usleep(20000);
+  usleep(200000);
+  const Run r = run_sim("run " + kDig + " --duration 1 --quiet --no-report --lcm '" + url + "' --out out");
+  usleep(500000);  // the tail reaches the logger
+  kill(logger, SIGINT);
+  int status = 0;
+  waitpid(logger, &status, 0);
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  REQUIRE(fs::exists(log_path));
+  const std::map<std::string, LogChannel> log = read_log_channels(log_path);
+  for (const char* c : {"pid", "adaptive"}) {
+    for (const char* base : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
+      const std::string channel = std::string(base) + "/" + c;
+      INFO(channel);
+      REQUIRE(log.count(channel) == 1);
+      CHECK(log.at(channel).count == 1000);
+      CHECK(log.at(channel).gaps == 0);
+      CHECK(log.at(channel).first_seq == 0);
+    }
+  }
+  fs::remove(log_path);
 }

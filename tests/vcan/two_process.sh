@@ -29,13 +29,16 @@ usage() {
   cat <<'EOF'
 Usage: two_process.sh --vcan-vm PATH --plant PATH --firmware PATH --sim PATH --capture-check PATH
                       --scene FILE --work DIR [--duration S] [--watchdog-cycles N]
-                      [--scenario all|run|kill-plant|kill-firmware] [--timeout S]
+                      [--scenario all|run|kill-plant|kill-firmware|realtime] [--timeout S]
 Runs the two-process scenarios (see the head of this file) inside vcan-vm, in one VM.
   --work DIR          output directory (made writable in the VM): captures, program output, JSON
   --duration S        simulated seconds of the run scenario (default 3)
   --watchdog-cycles N the firmware's watchdog in cycles (default 20: 20 ms at 1 kHz); the safe
                       stop must come within N + 2 cycles of the plant's last frame
   --timeout S         wall-clock limit for the whole VM run (default 280)
+  realtime            (not in all) excavator-firmware --realtime at a period the VM holds (10 ms:
+                      exit 0, ok, tracked, no overrun) and at one it cannot (1 ms: exit 1, ok false,
+                      the missed deadlines named); the real programs only
 Exit status: 0 when every scenario passed; 1 when one failed (the reasons are printed); 2 for bad
 arguments; otherwise vcan-vm's (124 timeout, 125 VM failure).
 EOF
@@ -69,7 +72,7 @@ done
 [ -n "$work" ] || { echo "two_process.sh: --work DIR is required" >&2; exit 2; }
 [[ $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "two_process.sh: --duration '$duration': must be positive seconds" >&2; exit 2; }
 [[ $watchdog_cycles =~ ^[0-9]+$ ]] || { echo "two_process.sh: --watchdog-cycles '$watchdog_cycles': must be a whole number" >&2; exit 2; }
-case $scenario in all|run|kill-plant|kill-firmware) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant or kill-firmware" >&2; exit 2 ;; esac
+case $scenario in all|run|kill-plant|kill-firmware|realtime) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware or realtime" >&2; exit 2 ;; esac
 
 if [ "$inside" = 0 ]; then
   [ -n "$vcan_vm" ] && [ -x "$vcan_vm" ] || { echo "two_process.sh: --vcan-vm '$vcan_vm': not an executable program" >&2; exit 2; }
@@ -182,6 +185,12 @@ if figures[0] != figures[1]:
 print("tracking figures equal:", json.dumps(figures[0], sort_keys=True))
 PY
   then note "$(cat "$dir/compare.out")"; else fail "$(cat "$dir/compare.out")"; fi
+  # The capture lost nothing: one SYNC on the bus per firmware cycle.
+  local syncs cycles
+  syncs=$(grep -c ' 080#' "$dir/capture.log")
+  cycles=$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["cycles"])' "$dir/two_process.json" 2>/dev/null)
+  if [ "$syncs" = "$cycles" ]; then note "capture: $syncs SYNC frames for $cycles cycles"
+  else fail "capture: $syncs SYNC frames for ${cycles:-?} firmware cycles"; fi
 }
 
 scenario_kill_plant() {
@@ -233,6 +242,43 @@ scenario_kill_firmware() {
   grep -q -i 'hold' "$dir/plant.out" || fail "the plant did not report that it holds: $(tail -3 "$dir/plant.out")"
 }
 
+# The scene at another control period: controller.period and the plant's cycle (its integrator
+# step of 1 ms divides every period used here).
+scene_at_period() {  # scene, period in s, output file
+  sed -e "s/step: 0.001}/step: 0.001, cycle: $2}/" -e "s/^controller:$/controller:\n  period: $2/" "$1" > "$3"
+  grep -q "cycle: $2" "$3" && grep -q "period: $2" "$3"
+}
+json_field() {  # file, python expression on j
+  python3 -c "import json, sys; j = json.load(open(sys.argv[1])); print($2)" "$1" 2>/dev/null
+}
+
+scenario_realtime() {
+  current=realtime
+  local dir=$work/realtime base=$scene p rc
+  rm -rf "$dir"; mkdir -p "$dir"
+  for p in 0.01 0.001; do
+    scene_at_period "$base" "$p" "$dir/scene_$p.yaml" || { fail "cannot write the scene at $p s"; return; }
+    scene=$dir/scene_$p.yaml
+    start_capture_and_plant "$dir" "$duration" || { scene=$base; return; }
+    # shellcheck disable=SC2046
+    "$firmware" $(expand "$FIRMWARE_ARGS" "$duration" "$dir/firmware_$p.json") --realtime > "$dir/firmware_$p.out" 2>&1
+    rc=$?
+    stop "$plant_pid"; stop_capture "$dir"
+    scene=$base
+    note "period $p s: exit $rc; $(grep -E '^excavator-firmware: (ok|FAILED)' "$dir/firmware_$p.out")"
+    note "period $p s: $(grep -E 'deadline overruns' "$dir/firmware_$p.out" | sed 's/^excavator-firmware: //')"
+    if [ "$p" = 0.01 ]; then
+      [ $rc -eq 0 ] || fail "at 10 ms the real-time run exited $rc: $(tail -2 "$dir/firmware_$p.out")"
+      [ "$(json_field "$dir/firmware_$p.json" 'j["ok"] and j["tracking"]["rms_error"] is not None and j["deadlines"]["skipped_periods"] == 0')" = True ] ||
+        fail "at 10 ms the summary is not ok, tracked and on time: $(cat "$dir/firmware_$p.json" 2>/dev/null | head -c 600)"
+    else
+      [ $rc -eq 1 ] || fail "at 1 ms the real-time run exited $rc (a run that cannot hold its period must fail)"
+      [ "$(json_field "$dir/firmware_$p.json" 'j["ok"] is False and ("skipped" in j["failure"] or "overran" in j["failure"] or "never tracked" in j["failure"])')" = True ] ||
+        fail "at 1 ms the summary does not report the missed deadlines: $(cat "$dir/firmware_$p.json" 2>/dev/null | head -c 600)"
+    fi
+  done
+}
+
 current=setup
 # The programs may write defaults (telemetry logs, out/) relative to the working directory: the
 # work directory is the one place the VM can write that the host sees.
@@ -243,6 +289,7 @@ case $scenario in
   run) scenario_run ;;
   kill-plant) scenario_kill_plant ;;
   kill-firmware) scenario_kill_firmware ;;
+  realtime) scenario_realtime ;;
 esac
 if [ $failures -eq 0 ]; then echo "two_process.sh: all scenarios passed ($scenario)"; exit 0; fi
 echo "two_process.sh: $failures failure(s)"

@@ -33,6 +33,7 @@ struct Options {
 struct Figures {
   double sum_sq[kAxisCount] = {};
   long samples = 0;
+  long cycles = 0;  // SYNC frames sent (firmware) or cycles computed (reference)
   void add(const double* q, std::uint64_t cycle) {
     for (int j = 0; j < kAxisCount; ++j) {
       const double e = q[j] - desired_at(cycle, j);
@@ -43,7 +44,7 @@ struct Figures {
   bool write(const std::string& path) const {
     FILE* f = std::fopen(path.c_str(), "w");
     if (!f) return false;
-    std::fprintf(f, "{\"tracking\": {\"samples\": %ld, \"rms\": [", samples);
+    std::fprintf(f, "{\"cycles\": %ld, \"tracking\": {\"samples\": %ld, \"rms\": [", cycles, samples);
     for (int j = 0; j < kAxisCount; ++j)
       std::fprintf(f, "%s%.17g", j ? ", " : "", samples ? std::sqrt(sum_sq[j] / samples) : 0.0);
     std::fprintf(f, "]}}\n");
@@ -124,6 +125,7 @@ int run_firmware(const Options& o) {
     c.cycle = cycle;
     port.write(c);
   }
+  figures.cycles = o.cycles;
   if (!o.json.empty() && !figures.write(o.json)) return 1;
   return safe_stop ? 3 : 0;
 }
@@ -145,6 +147,7 @@ int run_reference(const Options& o) {
     }
     figures.add(q, static_cast<std::uint64_t>(k));
   }
+  figures.cycles = o.cycles;
   return (!o.json.empty() && !figures.write(o.json)) ? 1 : 0;
 }
 

@@ -2,11 +2,8 @@
 // SYNC, waits for the plant's sensor set, computes and sends the commands. By default it runs in
 // lockstep (the next cycle starts when the plant has answered or the sensor timeout expired), so a
 // run is deterministic and equals the in-process run of excavator-sim; --realtime runs on absolute
-// 1 ms deadlines instead.
+// deadlines of the controller's period instead, and a run that misses them says so.
 #include <CLI/CLI.hpp>
-
-#include <sched.h>
-#include <sys/mman.h>
 
 #include <atomic>
 #include <csignal>
@@ -17,151 +14,233 @@
 
 #include "app/firmware_node.hpp"
 #include "app/firmware_settings.hpp"
+#include "app/node_io.hpp"
+#include "app/realtime_setup.hpp"
 #include "hal/clock.hpp"
-#include "hal/socketcan_bus.hpp"
-#include "telemetry/telemetry_publisher.hpp"
 
 namespace {
-std::atomic<bool> g_stop{false};
-void on_signal(int) { g_stop = true; }
 
-void try_realtime() {
-  if (mlockall(MCL_CURRENT | MCL_FUTURE) != 0)
-    std::fprintf(stderr, "excavator-firmware: warning: mlockall refused (%s); page faults may add latency\n",
-                 std::strerror(errno));
-  sched_param p{};
-  p.sched_priority = 80;
-  if (sched_setscheduler(0, SCHED_FIFO, &p) != 0)
-    std::fprintf(stderr, "excavator-firmware: warning: SCHED_FIFO refused (%s); running at normal priority\n",
-                 std::strerror(errno));
-}
+std::atomic<int> g_signals{0};
+void on_signal(int) { g_signals.fetch_add(1); }
 
+// Per joint; null when the firmware never tracked (a metric of no samples is not 0).
 nlohmann::json per_joint(const exc::TrackingMetrics& m, bool rms) {
+  if (m.samples() == 0) return nullptr;
   nlohmann::json j;
   for (int i = 0; i < 4; ++i) j[exc::kActiveNames[i]] = rms ? m.rms(i) : m.max_abs(i);
   return j;
 }
+
+std::string format_ms(double seconds) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g ms", seconds * 1e3);
+  return b;
+}
+
+std::string percent(double fraction) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g %%", fraction * 100);
+  return b;
+}
+
+nlohmann::json timing_json(const exc::control::PerfCounter& c) {
+  if (c.count() == 0) return nullptr;
+  return {{"median", c.median_us()}, {"p99", c.p99_us()}, {"p99_9", c.percentile_us(0.999)}, {"max", c.max_us()},
+          {"count", c.count()}};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README)."};
-  std::string iface, scene_path, controller = "adaptive", json_path, lcm_url;
-  double duration = 0, sensor_timeout_ms = 250;
-  double startup_s = 60;
+  CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
+  std::string iface, scene_path, controller, json_path, lcm_url;
+  double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;
   bool realtime = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
-  app.add_option("--scene", scene_path, "scene file (task, controller section, machine)")->required();
-  app.add_option("--controller", controller, "pid, adaptive or slotine_li")
+  app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
+  app.add_option("--controller", controller, "pid, adaptive or slotine_li (default: the scene's controller.type)")
       ->check(CLI::IsMember({"pid", "adaptive", "slotine_li"}));
-  app.add_option("--duration", duration, "cycles to run, in seconds (default: the scene's duration)")
-      ->check(CLI::PositiveNumber);
-  app.add_option("--json", json_path, "write the run's summary (tracking figures, timing) here");
+  app.add_option("--duration", duration, "seconds to run (default: the scene's duration)")->check(CLI::PositiveNumber);
+  app.add_option("--json", json_path, "write the run's summary (ok, tracking figures, timing, deadlines) here");
   app.add_option("--lcm", lcm_url, "publish telemetry to this LCM URL (default: none)");
   app.add_option("--sensor-timeout-ms", sensor_timeout_ms,
-                 "lockstep: how long a cycle waits for the plant's sensor set (wall clock)")
+                 "how long a cycle waits for the plant's sensor set: lockstep default 250 ms; real time default "
+                 "and upper bound: the cycle's deadline less 10 % of the period")
       ->check(CLI::PositiveNumber);
   app.add_option("--startup-timeout", startup_s,
-                 "lockstep: how long the first cycle waits for the plant's first answer (s)")
+                 "how long the first cycle waits for the plant's first answer (s), in both modes")
       ->check(CLI::PositiveNumber);
-  app.add_flag("--realtime", realtime, "run on absolute 1 ms deadlines instead of lockstep");
+  app.add_flag("--realtime", realtime, "run on absolute deadlines of controller.period instead of lockstep");
+  app.add_option("--max-overrun-fraction", max_overrun_fraction,
+                 "real time: the run fails when more than this fraction of cycles overran their deadline "
+                 "(any skipped period fails it)")
+      ->check(CLI::Range(0.0, 1.0));
   CLI11_PARSE(app, argc, argv);
 
   try {
     const exc::app::FirmwareSettings settings = exc::app::load_firmware_settings(scene_path);
     const exc::Model model = exc::build_model(settings.machine);
-    std::uint32_t ids[32];
-    const std::size_t n = exc::hal::receive_ids(exc::hal::Node::firmware, ids, 32);
-    std::string error;
-    auto bus = exc::hal::SocketCanBus::open(iface, ids, n, error);
-    if (!bus) {
-      std::cerr << "excavator-firmware: " << error << "\n";
-      return 3;
-    }
-    std::unique_ptr<exc::telemetry::TelemetryPublisher> publisher;
-    if (!lcm_url.empty()) {
-      exc::telemetry::TelemetryConfig tc;
-      tc.lcm_url = lcm_url;
-      // Real time: a full ring must not stall the loop, so it refuses and counts (reported below);
-      // lockstep has no deadline, so it waits and records every message.
-      tc.overflow = realtime ? exc::telemetry::OverflowPolicy::drop_newest : exc::telemetry::OverflowPolicy::block;
-      publisher = std::make_unique<exc::telemetry::TelemetryPublisher>(tc);
-      if (!publisher->start(&error)) {
-        std::cerr << "excavator-firmware: --lcm: " << error << "\n";
-        return 2;
-      }
-    }
-    exc::hal::FirmwareCanPort port(*bus);
     exc::app::FirmwareNodeConfig fc;
-    fc.kind = controller == "pid" ? exc::control::ControllerKind::pid
-              : controller == "slotine_li" ? exc::control::ControllerKind::slotine_li
-                                           : exc::control::ControllerKind::adaptive;
+    fc.kind = settings.controller.kind;  // the scene's controller.type unless --controller says otherwise
+    if (!controller.empty())
+      fc.kind = controller == "pid" ? exc::control::ControllerKind::pid
+                : controller == "slotine_li" ? exc::control::ControllerKind::slotine_li
+                                             : exc::control::ControllerKind::adaptive;
     fc.controller = settings.controller;
     fc.terrain_height = settings.terrain_height;
-    exc::app::FirmwareNode node(model, settings.task, fc, port, publisher.get());
+    const char* const kind_name = exc::control::to_string(fc.kind);
+
+    const double period_s = settings.controller.period;
+    const auto period_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
+    // Real time: sensors may be waited for until 10 % of the period before the next deadline, the
+    // rest is the cycle's own work. A longer timeout cannot be honoured there: refused.
+    const double rt_wait_ms = 0.9 * period_s * 1e3;
+    if (realtime && sensor_timeout_ms > rt_wait_ms) {
+      std::cerr << "excavator-firmware: --sensor-timeout-ms " << sensor_timeout_ms << " cannot be honoured with --realtime at a "
+                << period_s * 1e3 << " ms period (controller.period): at most " << rt_wait_ms << " ms\n";
+      return 2;
+    }
+    const double wait_ms = sensor_timeout_ms > 0 ? sensor_timeout_ms : (realtime ? rt_wait_ms : 250.0);
+
+    exc::app::NodeIo io;
+    std::string error;
+    // Real time: a full telemetry ring must not stall the loop (refused and counted); lockstep has
+    // no deadline, so it waits and records every message.
+    const auto overflow = realtime ? exc::telemetry::OverflowPolicy::drop_newest : exc::telemetry::OverflowPolicy::block;
+    if (const int code = exc::app::open_node_io(exc::hal::Node::firmware, iface, lcm_url, overflow, io, error)) {
+      std::cerr << "excavator-firmware: " << error << "\n";
+      return code;
+    }
+    exc::hal::FirmwareCanPort port(*io.bus);
+    exc::app::FirmwareNode node(model, settings.task, fc, port, io.publisher.get());
 
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    if (realtime) try_realtime();
-    const double cycle_s = settings.controller.period;
-    const auto cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / cycle_s));
-    const auto wait_ns = static_cast<std::int64_t>(realtime ? 0.8 * cycle_s * 1e9 : sensor_timeout_ms * 1e6);
+    std::string rt_notes;
+    if (realtime) {
+      exc::app::RealtimeRequest request;
+      request.fifo_priority = 80;
+      const exc::app::RealtimeSetup rt = exc::app::prepare_realtime(request);
+      rt_notes = std::string(rt.memory_locked ? "memory locked" : "memory NOT locked") +
+                 (rt.fifo ? ", SCHED_FIFO 80" : ", normal priority");
+      if (!rt.warnings.empty()) std::fprintf(stderr, "excavator-firmware: warning: %s", rt.warnings.c_str());
+    }
+    const auto cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / period_s));
+    const auto wait_ns = static_cast<std::int64_t>(wait_ms * 1e6);
     const auto startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
-    exc::hal::DeadlineSleeper sleeper(static_cast<std::int64_t>(std::llround(cycle_s * 1e9)));
-    sleeper.start(exc::hal::monotonic_now_ns());
-    std::printf("excavator-firmware: %s on %s, %lld cycles, %s\n", controller.c_str(), iface.c_str(),
-                static_cast<long long>(cycles), realtime ? "real time (1 ms deadlines)" : "lockstep with the plant");
+    exc::hal::DeadlineSleeper sleeper(period_ns);
+    std::printf("excavator-firmware: %s on %s, %lld cycles of %.3g ms, %s; sensor wait %.3g ms%s%s\n", kind_name,
+                iface.c_str(), static_cast<long long>(cycles), period_s * 1e3,
+                realtime ? "real time (absolute deadlines)" : "lockstep with the plant", wait_ms,
+                rt_notes.empty() ? "" : "; ", rt_notes.c_str());
     std::fflush(stdout);
-    for (std::int64_t k = 0; k < cycles && !g_stop; ++k) {
-      if (realtime) sleeper.wait_next();
+
+    std::int64_t last_wake = 0;
+    bool grid_started = false;
+    std::int64_t stop_cycle = -1;  // cycle of the stop request: the machine then holds, and the run ends
+    for (std::int64_t k = 0; k < cycles && g_signals.load() < 2; ++k) {
+      if (g_signals.load() == 1 && stop_cycle < 0) {
+        // A tracking machine is brought to hold first; in any other mode there is nothing to stop.
+        if (!node.tracking()) break;
+        node.request_stop();
+        stop_cycle = k;
+        std::printf("excavator-firmware: stop requested: holding for %.2f s, then exiting\n", fc.controller.blend_time);
+      }
+      if (stop_cycle >= 0 && static_cast<double>(k - stop_cycle) * period_s > fc.controller.blend_time) break;
+      if (realtime && grid_started) {
+        sleeper.wait_next();
+        const std::int64_t now = exc::hal::monotonic_now_ns();
+        node.record_wakeup(now - last_wake, sleeper.overruns(), sleeper.skipped_periods());
+        last_wake = now;
+      }
+      const std::int64_t cycle_start = exc::hal::monotonic_now_ns();
       node.begin_cycle();
-      // Until the plant has answered once, lockstep waits as long as start-up takes (a slow first
-      // cycle must not desynchronise the counters); afterwards the sensor timeout feeds the watchdog.
-      const std::int64_t wait = (realtime || node.has_sensors()) ? wait_ns : startup_wait_ns;
-      const std::int64_t deadline = exc::hal::monotonic_now_ns() + wait;
+      // Until the plant has answered once, a cycle waits as long as start-up takes (a slow first
+      // cycle must not desynchronise the counters); afterwards the sensor wait feeds the watchdog.
+      std::int64_t deadline = cycle_start + (node.has_sensors() ? wait_ns : startup_wait_ns);
+      if (realtime && grid_started) deadline = std::min(deadline, sleeper.next_deadline_ns() - period_ns / 10);
       while (!node.receive()) {
         const std::int64_t left = deadline - exc::hal::monotonic_now_ns();
         if (left <= 0) break;
-        bus->wait_readable(left);
+        io.bus->wait_readable(left);
       }
       node.end_cycle();
+      if (realtime && !grid_started && node.has_sensors()) {
+        // The deadline grid starts once the plant has answered: start-up is not a missed deadline.
+        grid_started = true;
+        last_wake = exc::hal::monotonic_now_ns();
+        sleeper.start(last_wake);
+      }
       const exc::control::Transition& t = node.last_transition();
       if (t.changed) {
-        std::printf("excavator-firmware: cycle %llu (%.3f s): %s -> %s: %s\n",
+        std::printf("excavator-firmware: cycle %llu (%.3f s): %s -> %s: %s%s%s\n",
                     static_cast<unsigned long long>(node.cycle()), node.time(), exc::control::to_string(t.from),
-                    exc::control::to_string(t.to), t.reason);
+                    exc::control::to_string(t.to), t.reason, t.to == exc::control::Mode::safe_stop ? ": " : "",
+                    t.to == exc::control::Mode::safe_stop ? node.last_fault_text() : "");
         std::fflush(stdout);
       }
     }
     node.publish_counters();
-    if (publisher) publisher->stop();
+    if (io.publisher) io.publisher->stop();
+
+    // The verdict: a run that never tracked, went to its safe state, or missed its deadlines failed.
+    const std::uint64_t done = node.cycle();
+    const std::uint64_t overruns = sleeper.overruns(), skipped = sleeper.skipped_periods();
+    std::string failure;
+    if (node.measured_tracking().samples() == 0)
+      failure = std::string("the firmware never tracked (mode ") + exc::control::to_string(node.mode()) + ")";
+    else if (node.safe_stops() > 0)
+      failure = std::string("safe state: ") + node.last_fault_text();
+    else if (realtime && skipped > 0)
+      failure = std::to_string(skipped) + " whole periods skipped: the loop cannot hold its " + format_ms(period_s) + " period";
+    else if (realtime && static_cast<double>(overruns) > max_overrun_fraction * static_cast<double>(done))
+      failure = std::to_string(overruns) + " of " + std::to_string(done) + " cycles overran their deadline (allowed: " +
+                percent(max_overrun_fraction) + ")";
+    const bool ok = failure.empty();
+    std::uint64_t telemetry_dropped = 0;
+    exc::telemetry::TelemetryCounters tcn;
+    if (io.publisher) {
+      tcn = io.publisher->counters();
+      telemetry_dropped = tcn.dropped_full_total;
+    }
     const auto& c = node.control_timing();
-    std::printf("excavator-firmware: %llu cycles; control step median %.1f us, p99 %.1f us, max %.1f us; "
-                "deadline overruns %llu; safe stops %llu; CAN rejects %llu\n",
-                static_cast<unsigned long long>(node.cycle()), c.median_us(), c.p99_us(), c.max_us(),
-                static_cast<unsigned long long>(sleeper.overruns()), static_cast<unsigned long long>(node.safe_stops()),
-                static_cast<unsigned long long>(port.rx_stats().rejected()));
+    std::printf("excavator-firmware: %llu cycles of %.3g ms; control step median %.1f us, p99 %.1f us, max %.1f us; "
+                "deadline overruns %llu, skipped periods %llu; safe stops %llu; CAN rejects %llu; telemetry dropped %llu\n",
+                static_cast<unsigned long long>(done), period_s * 1e3, c.median_us(), c.p99_us(), c.max_us(),
+                static_cast<unsigned long long>(overruns), static_cast<unsigned long long>(skipped),
+                static_cast<unsigned long long>(node.safe_stops()), static_cast<unsigned long long>(port.rx_stats().rejected()),
+                static_cast<unsigned long long>(telemetry_dropped));
+    std::printf("excavator-firmware: %s%s\n", ok ? "ok" : "FAILED: ", failure.c_str());
     if (!json_path.empty()) {
       nlohmann::json j;
-      j["controller"] = controller;
-      j["cycles"] = node.cycle();
+      j["ok"] = ok;
+      if (!ok) j["failure"] = failure;
+      j["controller"] = kind_name;
+      j["mode"] = realtime ? "realtime" : "lockstep";
+      j["period_s"] = period_s;
+      j["cycles"] = done;
       j["tracking"] = {{"rms_error", per_joint(node.measured_tracking(), true)},
                        {"max_error", per_joint(node.measured_tracking(), false)}};
-      j["control_step_us"] = {{"median", c.median_us()}, {"p99", c.p99_us()}, {"max", c.max_us()}};
+      j["tracking_samples"] = node.measured_tracking().samples();
+      j["control_step_us"] = timing_json(c);
+      j["cycle_us"] = timing_json(node.cycle_timing());
+      j["deadlines"] = {{"overruns", overruns}, {"skipped_periods", skipped},
+                        {"interval_us", timing_json(node.interval_timing())}};
       j["safe_stops"] = node.safe_stops();
+      if (node.safe_stops() > 0) j["last_fault"] = node.last_fault_text();
+      j["task_finished"] = node.trajectory_finished();
       j["can_frames_rejected"] = port.rx_stats().rejected();
-      if (publisher) {
-        const exc::telemetry::TelemetryCounters tcn = publisher->counters();
+      if (io.publisher) {
         nlohmann::json dropped;
         for (std::size_t i = 0; i < exc::telemetry::channel_count; ++i)
-          dropped[publisher->channel_name(static_cast<exc::telemetry::Channel>(i))] = tcn.dropped_full[i];
-        j["telemetry"] = {{"enqueued", tcn.enqueued}, {"published", tcn.published},
-                          {"dropped", tcn.dropped_full_total}, {"dropped_by_channel", dropped},
-                          {"ring_high_water", tcn.ring_high_water}, {"ring_capacity", tcn.ring_capacity},
-                          {"overflow_policy", exc::telemetry::to_string(tcn.dropped_full_total ? exc::telemetry::OverflowPolicy::drop_newest : (realtime ? exc::telemetry::OverflowPolicy::drop_newest : exc::telemetry::OverflowPolicy::block))}};
+          dropped[io.publisher->channel_name(static_cast<exc::telemetry::Channel>(i))] = tcn.dropped_full[i];
+        j["telemetry"] = {{"enqueued", tcn.enqueued}, {"published", tcn.published}, {"dropped", telemetry_dropped},
+                          {"dropped_by_channel", dropped}, {"ring_high_water", tcn.ring_high_water},
+                          {"ring_capacity", tcn.ring_capacity}, {"overflow_policy", exc::telemetry::to_string(overflow)}};
       }
       std::ofstream(json_path) << j.dump(2) << "\n";
     }
-    return 0;
+    return ok ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "excavator-firmware: " << e.what() << "\n";
     return 2;

@@ -70,6 +70,7 @@ void visit_fields(const exlcm::timing_t& m, Visitor& v) {
   v.number("p99_us", &m.p99_us, 1);
   v.number("max_us", &m.max_us, 1);
   v.number("overruns", &m.overruns, 1);
+  v.number("skipped", &m.skipped, 1);
   v.number("bin_width_us", &m.bin_width_us, 1);
   v.number("bins", m.bins, 64);
 }

@@ -10,7 +10,7 @@
 #include <iostream>
 #include <memory>
 
-#include "hal/socketcan_bus.hpp"
+#include "app/node_io.hpp"
 #include "hal/can_protocol.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "sim_plant/plant.hpp"
@@ -38,24 +38,16 @@ int main(int argc, char** argv) {
 
   try {
     exc::plant::Plant plant(exc::plant::load_scene(scene_path));
-    std::uint32_t ids[32];
-    const std::size_t n = exc::hal::receive_ids(exc::hal::Node::plant, ids, 32);
+    exc::app::NodeIo io;
     std::string error;
-    auto bus = exc::hal::SocketCanBus::open(iface, ids, n, error);
-    if (!bus) {
+    // No deadline on the plant's side (it steps on SYNC): telemetry waits rather than drops.
+    if (const int code = exc::app::open_node_io(exc::hal::Node::plant, iface, lcm_url,
+                                                exc::telemetry::OverflowPolicy::block, io, error)) {
       std::cerr << "excavator-plant: " << error << "\n";
-      return 3;
+      return code;
     }
-    std::unique_ptr<exc::telemetry::TelemetryPublisher> publisher;
-    if (!lcm_url.empty()) {
-      exc::telemetry::TelemetryConfig tc;
-      tc.lcm_url = lcm_url;
-      publisher = std::make_unique<exc::telemetry::TelemetryPublisher>(tc);
-      if (!publisher->start(&error)) {
-        std::cerr << "excavator-plant: --lcm: " << error << "\n";
-        return 2;
-      }
-    }
+    auto& bus = io.bus;
+    auto& publisher = io.publisher;
     exc::hal::PlantCanPort port(*bus);
     exc::app::PlantNode node(plant, port, publisher.get());
     std::signal(SIGINT, on_signal);
