@@ -326,3 +326,32 @@ TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback reco
   }
   fs::remove(log_path);
 }
+
+TEST_CASE("tools/excavator-sim paper writes the paper's Figs. 4-12 from both shipped scenes, each figure on file and its figures equal to the scene's summary") {
+  const std::string scenes = " --free-motion " + std::string(EXC_SOURCE_DIR) + "/scenes/free_motion.yaml --dig " + kDig;
+  const Run r = run_sim("paper" + scenes + " --duration 3 --quiet --out paper");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  const fs::path out = r.dir / "paper";
+  const std::string page = read_text_file(out / "report.md");
+  for (int fig = 4; fig <= 12; ++fig) {
+    const std::string tag = "![Fig. " + std::to_string(fig) + "](";
+    const auto at = page.find(tag);
+    INFO("Fig. " << fig);
+    REQUIRE(at != std::string::npos);
+    const auto end = page.find(')', at + tag.size());
+    const fs::path png = out / page.substr(at + tag.size(), end - at - tag.size());
+    CHECK(fs::exists(png));
+    CHECK(fs::file_size(png) > 10000);
+  }
+  // The page's numbers are the scenes' own: Fig. 11's arm RMS figures, formatted from summary.json.
+  const nlohmann::json dig = nlohmann::json::parse(read_text_file(out / "dig" / "summary.json"));
+  char expected[96];
+  std::snprintf(expected, sizeof expected, "RMS error PID %.3g mm, adaptive %.3g mm",
+                dig["pid"]["rms_error"]["arm"].get<double>() * 1e3, dig["adaptive"]["rms_error"]["arm"].get<double>() * 1e3);
+  const auto fig11 = page.find("### Fig. 11");
+  REQUIRE(fig11 != std::string::npos);
+  CHECK(page.find(expected, fig11) < page.find("### Fig. 12"));
+  CHECK(fs::exists(out / "free_motion" / "run.lcm"));
+  CHECK(fs::exists(out / "dig" / "report" / "report.md"));
+}

@@ -3,6 +3,7 @@
 // writes the summary (stdout and JSON), the CSVs, the plots and a report page.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -13,7 +14,9 @@
 
 #include "in_process_run.hpp"
 #include "robustness.hpp"
+#include "paper_report.hpp"
 #include "run_report.hpp"
+#include "scene_job.hpp"
 
 namespace fs = std::filesystem;
 
@@ -22,7 +25,8 @@ int main(int argc, char** argv) {
       "excavator-sim: runs the firmware against the simulated excavator over the in-memory CAN bus.\n"
       "  excavator-sim run scenes/dig.yaml            PID and adaptive, summary, log, plots, report\n"
       "  excavator-sim run scenes/dig.yaml --controller adaptive --json out.json\n"
-      "  excavator-sim robustness scenes/dig.yaml     the same with wrong masses, noise, delay, stiffer soil"};
+      "  excavator-sim robustness scenes/dig.yaml     the same with wrong masses, noise, delay, stiffer soil\n"
+      "  excavator-sim paper --out out/paper          both shipped scenes and the paper's Figs. 4-12"};
   app.require_subcommand(1);
   auto* run = app.add_subcommand("run", "run a scene with one or more controllers");
   std::string scene_path;
@@ -65,6 +69,18 @@ int main(int argc, char** argv) {
   robust->add_option("--out", robust_out,
                      "output directory for robustness.json and robustness.png (default: out/<scene name>-robustness)");
   robust->add_flag("--no-plots", robust_no_plots, "skip robustness.png");
+  auto* paper = app.add_subcommand(
+      "paper", "the paper's whole figure set: the free-motion scene (Figs. 4-7) and the digging scene (Figs. 8-12), "
+               "each with PID and adaptive, their reports, and one page with every figure under the paper's number");
+  std::string paper_free = "scenes/free_motion.yaml", paper_dig = "scenes/dig.yaml", paper_out = "out/paper";
+  double paper_duration = 0;
+  bool paper_quiet = false;
+  paper->add_option("--free-motion", paper_free, "the free-motion scene (default: scenes/free_motion.yaml)");
+  paper->add_option("--dig", paper_dig, "the digging scene (default: scenes/dig.yaml)");
+  paper->add_option("--out", paper_out, "output directory (default: out/paper): report.md, free_motion/, dig/");
+  paper->add_option("--duration", paper_duration, "simulated seconds of each scene (default: each scene's)")
+      ->check(CLI::PositiveNumber);
+  paper->add_flag("--quiet", paper_quiet, "no progress output");
   CLI11_PARSE(app, argc, argv);
 
   if (robust->parsed()) {
@@ -108,33 +124,45 @@ int main(int argc, char** argv) {
     }
   }
 
-  try {
-    exc::sim::RunOptions options;
-    options.scene_path = scene_path;
-    options.controllers = controllers.empty() ? std::vector<std::string>{"pid", "adaptive"} : controllers;
-    options.duration_override = duration;
-    options.progress = !quiet;
-    exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(scene_path);
-    if (out_dir.empty()) out_dir = (fs::path("out") / bundle.name).string();
-    fs::create_directories(out_dir);
-    options.lcm_url = lcm_url.empty() ? "file://" + (fs::absolute(out_dir) / "run.lcm").string() + "?mode=w" : lcm_url;
-
-    const exc::sim::Summary summary = exc::sim::run_all(bundle, options);
-    exc::sim::print_summary(summary, std::cout);
-    const nlohmann::json j = exc::sim::to_json(summary);
-    const fs::path summary_path = fs::path(out_dir) / "summary.json";
-    std::ofstream(summary_path) << j.dump(2) << "\n";
-    if (!json_path.empty()) std::ofstream(json_path) << j.dump(2) << "\n";
-    if (!no_report && options.lcm_url.rfind("file://", 0) == 0) {
-      const int rc = exc::sim::write_report(argv[0], fs::path(out_dir), summary_path);
-      if (rc != 0) {
-        std::cerr << "excavator-sim: the report step failed (exit " << rc << "); the log and summary are in "
-                  << out_dir << "\n";
+  if (paper->parsed()) {
+    try {
+      // Both shipped scenes, each into its own folder with its own report, then the paper's page.
+      const fs::path out = paper_out;
+      fs::create_directories(out);
+      exc::sim::SceneJob free_job, dig_job;
+      free_job.scene_path = paper_free;
+      free_job.out_dir = out / "free_motion";
+      dig_job.scene_path = paper_dig;
+      dig_job.out_dir = out / "dig";
+      for (exc::sim::SceneJob* job : {&free_job, &dig_job}) {
+        job->progress = !paper_quiet;
+        job->duration = paper_duration;
+      }
+      const exc::sim::SceneJobResult free_result = exc::sim::run_scene_job(free_job);
+      const exc::sim::SceneJobResult dig_result = exc::sim::run_scene_job(dig_job);
+      if (!exc::sim::write_paper_report(out, free_result, dig_result)) {
+        std::cerr << "excavator-sim: cannot write " << (out / "report.md").string() << "\n";
         return 1;
       }
-      std::cout << "report: " << (fs::path(out_dir) / "report" / "report.md").string() << "\n";
+      std::cout << "paper figures: " << (out / "report.md").string() << "\n";
+      return std::max(free_result.exit_code, dig_result.exit_code);
+    } catch (const std::exception& e) {
+      std::cerr << "excavator-sim: " << e.what() << "\n";
+      return 2;
     }
-    return summary.all_ok ? 0 : 1;
+  }
+
+  try {
+    exc::sim::SceneJob job;
+    job.scene_path = scene_path;
+    job.out_dir = out_dir;
+    job.controllers = controllers;
+    job.lcm_url = lcm_url;
+    job.json_path = json_path;
+    job.duration = duration;
+    job.report = !no_report;
+    job.progress = !quiet;
+    return exc::sim::run_scene_job(job).exit_code;
   } catch (const std::exception& e) {
     std::cerr << "excavator-sim: " << e.what() << "\n";
     return 2;

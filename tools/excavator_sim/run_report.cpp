@@ -141,10 +141,10 @@ int run_program(const std::vector<std::string>& argv) {
 
 }  // namespace
 
-int write_report(const char* /*argv0*/, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json) {
+int write_report(const std::filesystem::path& out_dir, const std::filesystem::path& summary_json,
+                 const std::string& title) {
   return run_program({EXC_LOG_TOOL, "report", (out_dir / "run.lcm").string(), "--out", (out_dir / "report").string(),
-                      "--summary", summary_json.string(), "--title",
-                      "Digging scene: PID against adaptive computed torque"});
+                      "--summary", summary_json.string(), "--title", title});
 }
 
 int plot_robustness(const std::filesystem::path& json, const std::filesystem::path& out_dir) {

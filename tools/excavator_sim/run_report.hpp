@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <string>
 
 #include "in_process_run.hpp"
 
@@ -12,7 +13,7 @@ namespace exc::sim {
 void print_summary(const Summary& summary, std::ostream& out);
 nlohmann::json to_json(const Summary& summary);
 // Runs `excavator-log report` on out_dir/run.lcm; returns its exit status.
-int write_report(const char* argv0, const std::filesystem::path& out_dir, const std::filesystem::path& summary_json);
+int write_report(const std::filesystem::path& out_dir, const std::filesystem::path& summary_json, const std::string& title);
 // Runs `plot-run --robustness JSON --out DIR` (robustness.png); returns its exit status.
 int plot_robustness(const std::filesystem::path& json, const std::filesystem::path& out_dir);
 

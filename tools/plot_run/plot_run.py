@@ -89,6 +89,14 @@ def seconds(columns):
     return [u * 1e-6 for u in columns.get("utime", [])]
 
 
+def commanded(ctrl, column):
+    """The column where the firmware commands the machine (hold or track); NaN before, so that the
+    desired trajectory is not drawn at 0 while the firmware starts up."""
+    modes = ctrl.get("mode", [])
+    return [v if i < len(modes) and modes[i] in (2.0, 3.0) else float("nan")
+            for i, v in enumerate(ctrl[column])]
+
+
 def new_figure(plt, rows, cols, title):
     fig, axes = plt.subplots(rows, cols, figsize=FIG_INCHES, dpi=FIG_DPI, squeeze=False)
     fig.suptitle(title)
@@ -111,7 +119,7 @@ def plot_tracking(plt, runs, out_dir, written):
             state = channels.get("EXC_STATE", {})
             ctrl = channels.get("EXC_CONTROLLER", {})
             if ctrl:
-                ax.plot(seconds(ctrl), ctrl["q_desired_%d" % j], "--", color="black",
+                ax.plot(seconds(ctrl), commanded(ctrl, "q_desired_%d" % j), "--", color="black",
                         label="desired")
             if state:
                 ax.plot(seconds(state), state["q_active_%d" % j], color="tab:blue", label="actual")

@@ -1,0 +1,46 @@
+#include "scene_job.hpp"
+
+#include <fstream>
+#include <iostream>
+
+#include "run_report.hpp"
+
+namespace exc::sim {
+
+namespace fs = std::filesystem;
+
+SceneJobResult run_scene_job(const SceneJob& job) {
+  SceneJobResult result;
+  RunOptions options;
+  options.scene_path = job.scene_path;
+  options.controllers = job.controllers.empty() ? std::vector<std::string>{"pid", "adaptive"} : job.controllers;
+  options.duration_override = job.duration;
+  options.progress = job.progress;
+  const SceneBundle bundle = load_scene_bundle(job.scene_path);
+  result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
+  fs::create_directories(result.out_dir);
+  options.lcm_url =
+      job.lcm_url.empty() ? "file://" + (fs::absolute(result.out_dir) / "run.lcm").string() + "?mode=w" : job.lcm_url;
+
+  result.summary = run_all(bundle, options);
+  print_summary(result.summary, std::cout);
+  const nlohmann::json j = to_json(result.summary);
+  const fs::path summary_path = result.out_dir / "summary.json";
+  std::ofstream(summary_path) << j.dump(2) << "\n";
+  if (!job.json_path.empty()) std::ofstream(job.json_path) << j.dump(2) << "\n";
+  result.exit_code = result.summary.all_ok ? 0 : 1;
+  if (job.report && options.lcm_url.rfind("file://", 0) == 0) {
+    const std::string title = bundle.name + ": " + bundle.scene.description;
+    const int rc = write_report(result.out_dir, summary_path, title);
+    if (rc != 0) {
+      std::cerr << "excavator-sim: the report step failed (exit " << rc << "); the log and summary are in "
+                << result.out_dir.string() << "\n";
+      result.exit_code = 1;
+    } else {
+      std::cout << "report: " << (result.out_dir / "report" / "report.md").string() << "\n";
+    }
+  }
+  return result;
+}
+
+}  // namespace exc::sim
