@@ -19,15 +19,6 @@ using namespace exc::control;
 
 namespace {
 
-// Issue 16's scene: the swing turns 2 rad in 2.5 s, inside its speed limit.
-const char* kFastSwing = R"(
-task:
-  type: joint_waypoints
-  waypoints:
-    - {t: 0.0, q: [0.0, 2.45, 2.40, 2.10]}
-    - {t: 2.5, q: [2.0, 2.45, 2.40, 2.10]}
-)";
-
 // The largest |tau_j| / limit_j along a trajectory, by plain inverse dynamics every 0.5 ms.
 double worst_load(const Model& model, const JointTrajectory& tr, int joint) {
   Workspace ws(model);
@@ -47,7 +38,7 @@ double worst_load(const Model& model, const JointTrajectory& tr, int joint) {
 
 TEST_CASE("firmware/feasibility refuses a 2 rad swing in 2.5 s, naming the swing, its torque and the timing that fits") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(kFastSwing)["task"], "scene.yaml", model.machine);
+  const Task task = parse_task(YAML::Load(sim::kFastSwingTask)["task"], "scene.yaml", model.machine);
   const FeasibilityReport r = check_effort_feasibility(model, task.trajectory);
   CHECK_FALSE(r.ok);
   CHECK(r.joint == 0);
@@ -68,7 +59,7 @@ TEST_CASE("firmware/feasibility refuses a 2 rad swing in 2.5 s, naming the swing
 
 TEST_CASE("firmware/feasibility's time scale is exact: the rescaled path touches the limit and stays within it") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(kFastSwing)["task"], "scene.yaml", model.machine);
+  const Task task = parse_task(YAML::Load(sim::kFastSwingTask)["task"], "scene.yaml", model.machine);
   const double s = check_effort_feasibility(model, task.trajectory).time_scale;
   const JointTrajectory fit = scale_timing(task.trajectory, s * 1.001);
   const JointTrajectory tight = scale_timing(task.trajectory, s * 0.97);

@@ -259,17 +259,10 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
 }
 
 TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated) trips the tracking-error fault within one cycle's motion past the limit") {
-  const char* fast_swing = R"(
-task:
-  type: joint_waypoints
-  waypoints:
-    - {t: 0.0, q: [0.0, 2.45, 2.40, 2.10]}
-    - {t: 2.5, q: [2.0, 2.45, 2.40, 2.10]}
-)";
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   cfg.kind = ControllerKind::pid;
-  Loop loop(model, fast_swing, cfg);
+  Loop loop(model, sim::kFastSwingTask, cfg);
   const double limit = cfg.controller.tracking_error_limit[0];
   double error_before = 0, desired_step = 0;
   Vec4 last_qd = loop.node.q_desired();

@@ -6,6 +6,7 @@
 
 #include "app/firmware_settings.hpp"
 #include "control/effort_feasibility.hpp"
+#include "scenes.hpp"
 
 using namespace exc;
 
@@ -73,9 +74,10 @@ namespace {
 
 // Issue 16's scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
 std::string fast_swing_scene(const std::string& efforts) {
-  return "name: fast_swing\nduration: 3\n"
-         "task:\n  type: joint_waypoints\n" + efforts +
-         "  waypoints:\n    - {t: 0.0, q: [0.0, 2.45, 2.40, 2.10]}\n    - {t: 2.5, q: [2.0, 2.45, 2.40, 2.10]}\n";
+  std::string task = exc::control::sim::kFastSwingTask;
+  const std::string type = "  type: joint_waypoints\n";
+  task.insert(task.find(type) + type.size(), efforts);
+  return "name: fast_swing\nduration: 3\n" + task;
 }
 
 }  // namespace
