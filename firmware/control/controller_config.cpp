@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "control/config_fields.hpp"
+#include "control/controller_kinds.hpp"
 
 namespace exc::control {
 namespace {
@@ -24,11 +25,8 @@ Eigen::Matrix<double, N, 1> read_vector(const YAML::Node& n, const std::string& 
 }  // namespace
 
 const char* to_string(ControllerKind kind) {
-  switch (kind) {
-    case ControllerKind::pid: return "pid";
-    case ControllerKind::adaptive: return "adaptive";
-    case ControllerKind::slotine_li: return "slotine_li";
-  }
+  for (const ControllerKindEntry& e : kControllerKinds)
+    if (e.kind == kind) return e.name;
   return "unknown";
 }
 
@@ -45,10 +43,10 @@ ControllerConfig parse_controller_config(const YAML::Node& node, const std::stri
                   "lyapunov_q_integral"});
   if (node["type"]) {
     const std::string t = node["type"].as<std::string>();
-    if (t == "pid") c.kind = ControllerKind::pid;
-    else if (t == "adaptive") c.kind = ControllerKind::adaptive;
-    else if (t == "slotine_li") c.kind = ControllerKind::slotine_li;
-    else throw ConfigError(file, s + ".type", "'" + t + "' (allowed: pid, adaptive, slotine_li)");
+    const std::optional<ControllerKind> kind = controller_kind_named(t);
+    if (!kind) throw ConfigError(file, s + ".type", "'" + t + "' (allowed: " + controller_kind_names() + ")");
+    c.kind = *kind;
+    c.kind_given = true;
   }
   if (node["period"]) c.period = read_number(node["period"], file, s + ".period", 1e-5, 0.1);
   if (node["kp"]) c.gains.kp = read_vector<4>(node["kp"], file, s + ".kp", 1e-3, 1e6);

@@ -21,6 +21,7 @@ enum class RegressorAcceleration : std::uint8_t { filtered = 0, desired = 1 };
 
 struct ControllerConfig {
   ControllerKind kind = ControllerKind::adaptive;
+  bool kind_given = false;  // the scene set controller.type (it then chooses the controller to run)
   double period = 1e-3;  // s, the control period (update law integrated at it)
 
   // Computed-torque error dynamics e'' + kv e' + kp e (+ ki int e for the PID baseline).

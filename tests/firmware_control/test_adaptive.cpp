@@ -196,7 +196,7 @@ TEST_CASE("firmware/adaptive and Slotine-Li freeze the soil estimate while the a
   }
 }
 
-TEST_CASE("firmware/adaptive with integral action removes the steady error of a wrong mass model; without it the error stays") {
+TEST_CASE("firmware/adaptive with integral action removes the steady error of a wrong mass model, without it the error stays") {
   // Holding a pose in the air with a controller whose links are 20 % too light: the gravity it does
   // not cancel is a constant disturbance. Without integral action the error settles where K_p e
   // balances it; with K_i the integral takes it over and e goes to zero (s^3 + K_v s^2 + K_p s + K_i

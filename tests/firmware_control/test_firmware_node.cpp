@@ -96,7 +96,7 @@ Vec2 tip_of(const Model& model, const Vec4& q) {
 
 }  // namespace
 
-TEST_CASE("firmware/node: after its task the machine holds the final pose; the path never restarts and the command never jumps") {
+TEST_CASE("firmware/node: after its task the machine holds the final pose, the path never restarts and the command never jumps") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   cfg.kind = ControllerKind::adaptive;

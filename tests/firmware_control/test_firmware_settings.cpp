@@ -92,7 +92,7 @@ TEST_CASE("firmware/settings refuse a task the actuators cannot drive, naming th
   CHECK(e.find("or set task.efforts.fit_timing: true") != std::string::npos);
 }
 
-TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much; check: false forces it as written") {
+TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much, check: false forces it as written") {
   const app::FirmwareSettings fit =
       app::parse_firmware_settings(YAML::Load(fast_swing_scene("  efforts: {fit_timing: true}\n")), "scene.yaml", ".");
   MESSAGE("timing scaled by " << fit.task.timing_scale);

@@ -16,6 +16,7 @@
 #include "app/firmware_settings.hpp"
 #include "app/node_io.hpp"
 #include "app/realtime_setup.hpp"
+#include "control/controller_kinds.hpp"
 #include "hal/clock.hpp"
 
 namespace {
@@ -49,6 +50,12 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
           {"count", c.count()}};
 }
 
+std::vector<std::string> kind_names() {
+  std::vector<std::string> v;
+  for (const auto& e : exc::control::kControllerKinds) v.push_back(e.name);
+  return v;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,8 +65,8 @@ int main(int argc, char** argv) {
   bool realtime = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
-  app.add_option("--controller", controller, "pid, adaptive or slotine_li (default: the scene's controller.type)")
-      ->check(CLI::IsMember({"pid", "adaptive", "slotine_li"}));
+  app.add_option("--controller", controller, exc::control::controller_kind_names() + " (default: the scene's controller.type, else adaptive)")
+      ->check(CLI::IsMember(kind_names()));
   app.add_option("--duration", duration, "seconds to run (default: the scene's duration)")->check(CLI::PositiveNumber);
   app.add_option("--json", json_path, "write the run's summary (ok, tracking figures, timing, deadlines) here");
   app.add_option("--lcm", lcm_url, "publish telemetry to this LCM URL (default: none)");
@@ -82,10 +89,14 @@ int main(int argc, char** argv) {
     const exc::Model model = exc::build_model(settings.machine);
     exc::app::FirmwareNodeConfig fc;
     fc.kind = settings.controller.kind;  // the scene's controller.type unless --controller says otherwise
-    if (!controller.empty())
-      fc.kind = controller == "pid" ? exc::control::ControllerKind::pid
-                : controller == "slotine_li" ? exc::control::ControllerKind::slotine_li
-                                             : exc::control::ControllerKind::adaptive;
+    if (!controller.empty()) {
+      if (settings.controller.kind_given && *exc::control::controller_kind_named(controller) != settings.controller.kind) {
+        std::cerr << "excavator-firmware: --controller " << controller << " conflicts with the scene's controller.type "
+                  << exc::control::to_string(settings.controller.kind) << " (" << scene_path << "); give one of them\n";
+        return 2;
+      }
+      fc.kind = *exc::control::controller_kind_named(controller);
+    }
     fc.controller = settings.controller;
     fc.terrain_height = settings.terrain_height;
     const char* const kind_name = exc::control::to_string(fc.kind);

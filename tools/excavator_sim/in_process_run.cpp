@@ -5,17 +5,16 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "control/controller_kinds.hpp"
 #include "telemetry/lcm_output.hpp"
 
 namespace exc::sim {
 namespace {
 
 control::ControllerKind parse_kind(const std::string& name) {
-  if (name == "pid") return control::ControllerKind::pid;
-  if (name == "adaptive") return control::ControllerKind::adaptive;
-  if (name == "slotine_li") return control::ControllerKind::slotine_li;
-  throw std::invalid_argument("--controller: unknown controller '" + name +
-                              "' (allowed: pid, adaptive, slotine_li)");
+  if (const auto kind = control::controller_kind_named(name)) return *kind;
+  throw std::invalid_argument("--controller: unknown controller '" + name + "' (allowed: " +
+                              control::controller_kind_names() + ")");
 }
 
 // The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of it,

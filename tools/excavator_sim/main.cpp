@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "control/controller_kinds.hpp"
 #include "in_process_run.hpp"
 #include "robustness.hpp"
 #include "paper_report.hpp"
@@ -39,7 +40,8 @@ int main(int argc, char** argv) {
   bool quiet = false;
   run->add_option("scene", scene_path, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   run->add_option("--controller", controllers,
-                  "controller(s) to run: pid, adaptive, slotine_li (default: pid and adaptive)")
+                  "controller(s) to run: " + exc::control::controller_kind_names() +
+                      " (default: the scene's controller.type, else pid and adaptive)")
       ->delimiter(',');
   run->add_option("--out", out_dir, "output directory (default: out/<scene name>)");
   run->add_option("--json", json_path, "also write the summary as JSON to this file");
@@ -60,7 +62,8 @@ int main(int argc, char** argv) {
   double robust_duration = 0;
   bool robust_quiet = false;
   robust->add_option("scene", robust_scene, "scene file (YAML), e.g. scenes/dig.yaml")->required();
-  robust->add_option("--controller", robust_controllers, "controller(s): pid, adaptive, slotine_li (default: pid and adaptive)")
+  robust->add_option("--controller", robust_controllers,
+                     "controller(s): " + exc::control::controller_kind_names() + " (default: pid and adaptive)")
       ->delimiter(',');
   robust->add_option("--json", robust_json, "write the table as JSON to this file");
   robust->add_option("--duration", robust_duration, "simulated seconds per run (default: the scene's duration)")

@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <iostream>
+#include <stdexcept>
 
 #include "run_report.hpp"
 
@@ -13,10 +14,18 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   SceneJobResult result;
   RunOptions options;
   options.scene_path = job.scene_path;
-  options.controllers = job.controllers.empty() ? std::vector<std::string>{"pid", "adaptive"} : job.controllers;
   options.duration_override = job.duration;
   options.progress = job.progress;
   const SceneBundle bundle = load_scene_bundle(job.scene_path);
+  // Which controllers: --controller, else the scene's controller.type, else the paper's comparison.
+  const control::ControllerConfig& cc = bundle.firmware.controller;
+  const std::string scene_kind = control::to_string(cc.kind);
+  if (!job.controllers.empty() && cc.kind_given && job.controllers != std::vector<std::string>{scene_kind})
+    throw std::invalid_argument("--controller conflicts with " + job.scene_path + "'s controller.type: " + scene_kind +
+                                "; give one of them");
+  options.controllers = !job.controllers.empty() ? job.controllers
+                        : cc.kind_given          ? std::vector<std::string>{scene_kind}
+                                                 : std::vector<std::string>{"pid", "adaptive"};
   result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   fs::create_directories(result.out_dir);
   options.lcm_url =
