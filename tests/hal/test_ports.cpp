@@ -6,6 +6,7 @@
 #include <string>
 
 #include "allocation_counter.hpp"
+#include "port_fixtures.hpp"
 #include "hal/can_ports.hpp"
 #include "hal/clock.hpp"
 #include "hal/fault_injecting_bus.hpp"
@@ -13,57 +14,9 @@
 #include "hal/socketcan_bus.hpp"
 
 using namespace exc::hal;
+using namespace exc::hal::test;
 
 namespace {
-
-// What the plant reports at cycle k, and what the firmware commands at cycle k: smooth functions of
-// k inside the signal ranges, so every received value can be checked against the cycle it claims.
-SensorState sensors_for(std::uint64_t k, bool hydraulic) {
-  SensorState s;
-  const double t = 1e-3 * static_cast<double>(k);
-  s.cycle = k;
-  s.position = {1.2 * std::sin(t), 2.2 + 0.5 * std::sin(0.7 * t), 2.8 + 0.6 * std::cos(0.5 * t), 2.0 + 0.3 * std::sin(t)};
-  s.velocity = {1.2 * std::cos(t), 0.35 * std::cos(0.7 * t), -0.3 * std::sin(0.5 * t), 0.3 * std::cos(t)};
-  for (int c = 0; c < kCylinderCount; ++c) {
-    s.pressure_a[c] = 20e6 + 10e6 * std::sin(t + c);
-    s.pressure_b[c] = 15e6 + 5e6 * std::cos(t + c);
-    s.pressure_valid[c] = hydraulic;
-  }
-  s.plant_state = static_cast<std::uint8_t>(k % 7);
-  s.plant_faults = static_cast<std::uint8_t>(k % 251);
-  return s;
-}
-
-CommandState command_for(std::uint64_t k, CommandMode mode) {
-  CommandState c;
-  const double t = 1e-3 * static_cast<double>(k);
-  c.mode = mode;
-  c.cycle = k;
-  if (mode == CommandMode::effort) {
-    c.value = {60000 * std::sin(t), 700000 * std::cos(t), -500000 * std::sin(0.3 * t), 300000 * std::cos(2 * t)};
-  } else {
-    c.value = {std::sin(t), std::cos(t), -std::sin(0.3 * t), 0.5 * std::cos(2 * t)};
-  }
-  return c;
-}
-
-bool same_motion(const SensorState& got, const SensorState& want) {
-  const double tol_position[] = {0.5e-6, 0.5e-5, 0.5e-5, 0.5e-5};
-  for (int i = 0; i < kAxisCount; ++i) {
-    if (std::fabs(got.position[i] - want.position[i]) > tol_position[i] * 1.001) return false;
-    if (std::fabs(got.velocity[i] - want.velocity[i]) > 0.5e-4 * 1.001) return false;
-  }
-  return got.plant_state == want.plant_state && got.plant_faults == want.plant_faults;
-}
-
-bool same_command(const CommandState& got, const CommandState& want) {
-  const double tol_effort[] = {2.0, 12.5, 12.5, 12.5};
-  for (int i = 0; i < kAxisCount; ++i) {
-    const double tol = (want.mode == CommandMode::effort ? tol_effort[i] : 0.00025) * 1.001;
-    if (std::fabs(got.value[i] - want.value[i]) > tol) return false;
-  }
-  return got.mode == want.mode;
-}
 
 struct LoopResult {
   int cycles = 0;
@@ -285,50 +238,4 @@ TEST_CASE("hal/ports allocate nothing over 100000 cycles on the memory bus") {
   CHECK(allocations == 0);
   CHECK(r.cycles == 100000);
   CHECK(r.complete > 90000);
-}
-
-TEST_CASE("hal/ports run whole cycles over SocketCAN vcan0") {
-  std::string why;
-  if (!SocketCanBus::kernel_supports_can(&why)) {
-    MESSAGE("SKIPPED: no SocketCAN in this kernel (", why, ")");
-    return;
-  }
-  std::uint32_t fw_ids[kMessageCount];
-  std::uint32_t plant_ids[kMessageCount];
-  const std::size_t fw_count = receive_ids(Node::firmware, fw_ids, kMessageCount);
-  const std::size_t plant_count = receive_ids(Node::plant, plant_ids, kMessageCount);
-  std::string error;
-  auto fw_bus = SocketCanBus::open("vcan0", fw_ids, fw_count, error);
-  if (!fw_bus) {
-    MESSAGE("SKIPPED: vcan0 not available (", error, ")");
-    return;
-  }
-  auto plant_bus = SocketCanBus::open("vcan0", plant_ids, plant_count, error);
-  REQUIRE(plant_bus != nullptr);
-  FirmwareCanPort firmware(*fw_bus);
-  PlantCanPort plant(*plant_bus);
-  int complete = 0, mismatches = 0;
-  SensorState seen;
-  CommandState applied;
-  for (std::uint64_t k = 0; k < 1000; ++k) {
-    REQUIRE(firmware.send_sync(k));
-    std::uint64_t cycle = 0;
-    REQUIRE(plant.wait_sync(cycle, 100'000'000));
-    CHECK(cycle == k);
-    if (plant.read(applied) && !same_command(applied, command_for(applied.cycle, CommandMode::effort))) ++mismatches;
-    REQUIRE(plant.write(sensors_for(cycle, true)));
-    const std::int64_t deadline = exc::hal::monotonic_now_ns() + 100'000'000;
-    bool got = false;
-    while (!(got = firmware.read(seen)) && exc::hal::monotonic_now_ns() < deadline) fw_bus->wait_readable(1'000'000);
-    if (got) {
-      ++complete;
-      if (!same_motion(seen, sensors_for(k, true))) ++mismatches;
-    }
-    REQUIRE(firmware.write(command_for(k, CommandMode::effort)));
-  }
-  CHECK(complete == 1000);
-  CHECK(mismatches == 0);
-  CHECK(firmware.rx_stats().rejected() == 0);
-  CHECK(plant.rx_stats().rejected() == 0);
-  CHECK(firmware.last_valid_rx_ns() > 0);
 }

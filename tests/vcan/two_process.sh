@@ -261,7 +261,9 @@ scenario_realtime() {
     scene=$dir/scene_$p.yaml
     start_capture_and_plant "$dir" "$duration" || { scene=$base; return; }
     # shellcheck disable=SC2046
-    "$firmware" $(expand "$FIRMWARE_ARGS" "$duration" "$dir/firmware_$p.json") --realtime > "$dir/firmware_$p.out" 2>&1
+    # The emulated clock stalls when the host is busy: the run that must hold its period may miss
+    # up to 3 % of its deadlines; the 1 ms run misses far more than all of its cycles.
+    "$firmware" $(expand "$FIRMWARE_ARGS" "$duration" "$dir/firmware_$p.json") --realtime --max-overrun-fraction 0.03 > "$dir/firmware_$p.out" 2>&1
     rc=$?
     stop "$plant_pid"; stop_capture "$dir"
     scene=$base
@@ -269,11 +271,11 @@ scenario_realtime() {
     note "period $p s: $(grep -E 'deadline overruns' "$dir/firmware_$p.out" | sed 's/^excavator-firmware: //')"
     if [ "$p" = 0.01 ]; then
       [ $rc -eq 0 ] || fail "at 10 ms the real-time run exited $rc: $(tail -2 "$dir/firmware_$p.out")"
-      [ "$(json_field "$dir/firmware_$p.json" 'j["ok"] and j["tracking"]["rms_error"] is not None and j["deadlines"]["skipped_periods"] == 0')" = True ] ||
+      [ "$(json_field "$dir/firmware_$p.json" 'j["ok"] and j["tracking"]["rms_error"] is not None and j["deadlines"]["overruns"] + j["deadlines"]["skipped_periods"] <= 0.03 * j["cycles"]')" = True ] ||
         fail "at 10 ms the summary is not ok, tracked and on time: $(cat "$dir/firmware_$p.json" 2>/dev/null | head -c 600)"
     else
       [ $rc -eq 1 ] || fail "at 1 ms the real-time run exited $rc (a run that cannot hold its period must fail)"
-      [ "$(json_field "$dir/firmware_$p.json" 'j["ok"] is False and ("skipped" in j["failure"] or "overran" in j["failure"] or "never tracked" in j["failure"])')" = True ] ||
+      [ "$(json_field "$dir/firmware_$p.json" 'j["ok"] is False and ("deadline" in j["failure"] or "never tracked" in j["failure"])')" = True ] ||
         fail "at 1 ms the summary does not report the missed deadlines: $(cat "$dir/firmware_$p.json" 2>/dev/null | head -c 600)"
     fi
   done
