@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -92,6 +93,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   const std::int64_t progress_every = std::max<std::int64_t>(1, cycles / 10);
   const bool interactive = isatty(STDERR_FILENO) != 0;
   std::uint64_t allocations = 0;
+  // Per work cycle: sized before the loop, so the loop allocates nothing.
+  const std::vector<double>& starts = firmware.task.cycle_starts;
+  std::vector<CycleRecord> cycles_acc(std::max<std::size_t>(1, starts.size()));
+  std::vector<std::array<double, 4>> cycle_sum_sq(cycles_acc.size(), std::array<double, 4>{});
   const double cpu_start = thread_cpu_seconds();
   {
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
@@ -102,9 +107,25 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
       node.begin_cycle();
       plant_node.poll();
       node.end_cycle();
-      if (node.tracking()) metrics.add(plant.state().q_a, node.q_desired());
       const plant::PlantState& s = plant.state();
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
+      if (node.tracking()) {
+        metrics.add(s.q_a, node.q_desired());
+        const double tt = node.task_time();
+        const std::size_t c = starts.empty() ? 0
+            : static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, std::upper_bound(starts.begin(), starts.end(), tt) - starts.begin() - 1));
+        CycleRecord& rec = cycles_acc[c];
+        if (rec.samples == 0) rec.start = s.time;
+        rec.end = s.time;
+        ++rec.samples;
+        for (int j = 0; j < 4; ++j) {
+          const double e = s.q_a[j] - node.q_desired()[j];
+          cycle_sum_sq[c][j] += e * e;
+          rec.max_error[j] = std::max(rec.max_error[j], std::abs(e));
+        }
+        rec.peak_soil_force = std::max(rec.peak_soil_force, s.soil_force.norm());
+        for (int i = 0; i < 6; ++i) rec.theta_hat[i] = node.last_output().theta_hat[i];
+      }
       if (options.observer) options.observer(k, plant, node);
       if (plant_node.failed()) break;
       if (options.stop_at_safe_state && node.safe_stops() > 0) break;
@@ -150,6 +171,12 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   result.heap_allocations_in_loop = allocations;
   result.safe_stops = node.safe_stops();
   result.rx_rejected = firmware_port.rx_stats().rejected() + plant_port.rx_stats().rejected();
+  for (std::size_t c = 0; c < cycles_acc.size(); ++c) {
+    CycleRecord& rec = cycles_acc[c];
+    for (int j = 0; j < 4; ++j)
+      rec.rms_error[j] = rec.samples ? std::sqrt(cycle_sum_sq[c][j] / static_cast<double>(rec.samples)) : 0;
+    if (rec.samples > 0) result.cycles.push_back(rec);
+  }
   result.task_finished = node.trajectory_finished();
   result.task_finish_time = node.finish_time();
   if (plant_node.failed()) {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "app/firmware_settings.hpp"
 #include "control/controller_config.hpp"
@@ -41,6 +42,16 @@ struct Timing {
   std::uint64_t count = 0;
 };
 
+// One work cycle of a run (a task done once has one): while tracking, true q_a against q_d.
+struct CycleRecord {
+  double start = 0, end = 0;        // s of the run, first and last tracked cycle
+  std::uint64_t samples = 0;
+  double rms_error[4] = {0, 0, 0, 0};
+  double max_error[4] = {0, 0, 0, 0};
+  double peak_soil_force = 0;       // N
+  double theta_hat[6] = {0, 0, 0, 0, 0, 0};  // the soil estimates at the cycle's end
+};
+
 // One closed-loop run, as every report reads it.
 struct RunRecord {
   std::string controller;
@@ -69,6 +80,7 @@ struct RunRecord {
   // refused because the ring was full (never with the blocking publisher the harness uses).
   std::uint64_t telemetry_enqueued = 0, telemetry_published = 0, telemetry_dropped = 0;
   std::size_t telemetry_ring_high_water = 0;
+  std::vector<CycleRecord> cycles;    // per work cycle of the task
   bool task_finished = false;         // the task ran to its end (then the machine held its final pose)
   double task_finish_time = 0;        // s
 };

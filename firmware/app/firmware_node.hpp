@@ -78,6 +78,11 @@ class FirmwareNode {
   // The trajectory ran to its end (the node then holds its last point until the run ends or a
   // stop arrives; it never restarts the task by itself), and the loop time when it did (s).
   bool trajectory_finished() const { return finished_; }
+  // The trajectory time being tracked this cycle (task clock: the first waypoint's time at the start
+  // of tracking); negative when not tracking.
+  double task_time() const {
+    return machine_.mode() == control::Mode::track ? time() - track_start_ + task_.start_time() : -1.0;
+  }
   double finish_time() const { return finish_time_; }
   // Desired and measured q_a of the last cycle (valid while tracking or holding).
   const Vec4& q_desired() const { return q_d_; }

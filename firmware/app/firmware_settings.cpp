@@ -32,14 +32,19 @@ void check_task_efforts(FirmwareSettings& s) {
   const Model model = build_model(s.machine);
   const control::FeasibilityReport r = control::check_effort_feasibility(model, task.trajectory, o);
   if (r.ok) return;
-  const std::string field = task.type == control::TaskType::dig ? "task.path" : "task.waypoints";
+  // The place is named by waypoint for a task done once, by cycle for work cycles.
+  const bool cycles = task.cycles() > 1 || task.type == control::TaskType::truck_loading;
+  const std::string field = cycles ? "task.cycle" : task.type == control::TaskType::dig ? "task.path" : "task.waypoints";
+  std::vector<double> marks = cycles ? task.cycle_starts : task.waypoint_times;
+  if (cycles) marks.push_back(task.end_time());
   if (!task.efforts.fit_timing || std::isinf(r.time_scale))
-    throw control::ConfigError(s.file, field, r.message(task.waypoint_times, field) +
+    throw control::ConfigError(s.file, field, r.message(marks, field) +
                                                   (std::isinf(r.time_scale) ? "" : "; or set task.efforts.fit_timing: true"));
   task.timing_scale = r.time_scale * 1.02;
   task.trajectory = control::scale_timing(task.trajectory, task.timing_scale);
   const double t0 = task.waypoint_times.front();
   for (double& t : task.waypoint_times) t = t0 + (t - t0) * task.timing_scale;
+  for (double& t : task.cycle_starts) t = t0 + (t - t0) * task.timing_scale;
   for (control::DigWaypoint& w : task.path) w.t = t0 + (w.t - t0) * task.timing_scale;
 }
 

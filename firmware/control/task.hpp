@@ -9,6 +9,14 @@
 //     swing: 0.0                   # rad, held
 //     path:                        # x: from the swing axis (m), z: world height (m)
 //       - {t: 0.0, x: 7.0, z: 1.0, pitch_deg: -60}   # pitch: angle of M->L above swing x
+//     repeat: 3                    # optional, both types: work cycles, return_time s apart
+//   task:
+//     type: truck_loading          # dig pass, lift and swing to the truck, dump, swing back
+//     swing: 0.0                   # rad, the dig pass's swing angle
+//     path: [...]                  # the dig pass, as for type dig
+//     dump: {swing_deg: 90, x: 6.0, z: 3.5, pitch_deg: -40, open_pitch_deg: 45}
+//     times: {to_dump: 6, dump: 2, back: 6}
+//     repeat: 5
 // Errors (ConfigError) name the file, the field (task.waypoints[2].q[1]) and the allowed values;
 // limits (stroke, speed, reach) are checked here, before the run starts.
 #include <string>
@@ -22,7 +30,7 @@ class Node;
 
 namespace exc::control {
 
-enum class TaskType { joint_waypoints, dig };
+enum class TaskType { joint_waypoints, dig, truck_loading };
 
 // The effort check before the run (effort_feasibility.hpp), from the task's `efforts:` mapping.
 struct TaskEffortCheck {
@@ -40,6 +48,10 @@ struct Task {
   double start_time() const { return trajectory.start_time(); }
   double end_time() const { return trajectory.end_time(); }
   TaskEffortCheck efforts;
+  // Work cycles (repeat: N): the trajectory time at which each cycle starts (one entry for a task
+  // done once). Cycle k+1 begins with the return move from where cycle k ended.
+  std::vector<double> cycle_starts;
+  int cycles() const { return static_cast<int>(cycle_starts.size()); }
   double timing_scale = 1;             // > 1 when fit_timing slowed the path down (times multiplied)
 };
 

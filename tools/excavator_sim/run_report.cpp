@@ -26,6 +26,27 @@ nlohmann::json timing_json(const Timing& t) {
 
 }  // namespace
 
+// Work cycles: one row per cycle and controller, when the task repeats.
+void print_cycles(const Summary& summary, std::ostream& out) {
+  std::size_t most = 0;
+  for (const RunRecord& r : summary.runs) most = std::max(most, r.cycles.size());
+  if (most < 2) return;
+  char line[256];
+  out << "\nper work cycle: RMS error (mm; swing mrad), worst bucket error, peak soil force, K_x estimate at the end\n";
+  std::snprintf(line, sizeof line, "%-6s %-10s %8s %8s %8s %8s %10s %10s %10s %10s\n", "cycle", "controller", "swing",
+                "boom", "arm", "bucket", "bucket max", "time (s)", "soil (kN)", "K_x est");
+  out << line;
+  for (std::size_t c = 0; c < most; ++c)
+    for (const RunRecord& r : summary.runs) {
+      if (c >= r.cycles.size()) continue;
+      const CycleRecord& k = r.cycles[c];
+      std::snprintf(line, sizeof line, "%-6zu %-10s %8.3f %8.3f %8.3f %8.3f %10.2f %10.2f %10.1f %10.4g\n", c + 1,
+                    r.controller.c_str(), k.rms_error[0] * 1e3, k.rms_error[1] * 1e3, k.rms_error[2] * 1e3,
+                    k.rms_error[3] * 1e3, k.max_error[3] * 1e3, k.end - k.start, k.peak_soil_force * 1e-3, k.theta_hat[2]);
+      out << line;
+    }
+}
+
 void print_summary(const Summary& summary, std::ostream& out) {
   char line[256];
   out << "\nscene " << summary.scene << ": " << summary.setup << "\n\n";
@@ -44,6 +65,7 @@ void print_summary(const Summary& summary, std::ostream& out) {
     }
     out << "\n";
   }
+  print_cycles(summary, out);
   out << "\nsoil estimates at the end (true value)\n";
   for (int i = 0; i < 6; ++i) {
     std::snprintf(line, sizeof line, "  %-4s true %10.4g   ", kTheta[i], summary.runs.empty() ? 0.0 : summary.runs[0].theta_true[i]);
@@ -102,6 +124,17 @@ nlohmann::json to_json(const Summary& summary) {
     run["wall_seconds"] = r.wall_seconds;
     run["safe_stops"] = r.safe_stops;
     run["can_frames_rejected"] = r.rx_rejected;
+    run["task_finished"] = r.task_finished;
+    if (r.task_finished) run["task_finish_time"] = r.task_finish_time;
+    nlohmann::json cycles = nlohmann::json::array();
+    for (const CycleRecord& k : r.cycles) {
+      nlohmann::json theta;
+      for (int i = 0; i < 6; ++i) theta[kTheta[i]] = k.theta_hat[i];
+      cycles.push_back({{"start", k.start}, {"end", k.end}, {"rms_error", per_joint(k.rms_error)},
+                        {"max_error", per_joint(k.max_error)}, {"peak_soil_force", k.peak_soil_force},
+                        {"theta_hat", theta}});
+    }
+    run["cycles"] = cycles;
     run["telemetry"] = {{"enqueued", r.telemetry_enqueued}, {"published", r.telemetry_published},
                         {"dropped", r.telemetry_dropped}, {"ring_high_water", r.telemetry_ring_high_water},
                         {"overflow_policy", "block"}};

@@ -18,13 +18,14 @@ controller side by side (Figs. 4-7 free motion, 9-12 digging); tracking_error.pn
 import argparse
 import csv
 import json
+import math
 import os
 import sys
 
 from plot_failure import fail
 from report_page import write_report
 from run_figures import (plot_errors, plot_robustness, plot_soil_estimates, plot_soil_force,
-                         plot_timing, plot_tracking)
+                         plot_timing, plot_tracking, plot_work_cycles)
 
 
 def load_matplotlib():
@@ -37,8 +38,18 @@ def load_matplotlib():
         fail("matplotlib is not available (%s); install python3-matplotlib" % error)
 
 
-def read_csv(path):
-    """Columns of a CSV as lists of floats (text columns are kept as strings)."""
+# Rows kept per CSV for the figures: a run of any length is drawn from at most this many rows (every
+# k-th), so the report's memory does not grow with the run; the RMS figures use every row.
+MAX_ROWS = 20000
+
+
+def read_csv(path, max_rows=MAX_ROWS):
+    """Columns of a CSV as lists of floats (text columns are kept as strings), every k-th row of a
+    long file (k in columns["__stride__"]); columns["__rms__"] holds the exact RMS of every error_*
+    column over all rows."""
+    with open(path, newline="") as f:
+        rows = sum(1 for _ in f) - 1
+    stride = max(1, math.ceil(rows / max_rows)) if rows > 0 else 1
     with open(path, newline="") as f:
         reader = csv.reader(f)
         try:
@@ -46,14 +57,30 @@ def read_csv(path):
         except StopIteration:
             return {}
         columns = {name: [] for name in header}
+        errors = [i for i, name in enumerate(header) if name.startswith("error_")]
+        sum_sq = [0.0] * len(errors)
+        counted = [0] * len(errors)
         for line_no, row in enumerate(reader, start=2):
             if len(row) != len(header):
                 fail("%s line %d: %d fields, header has %d" % (path, line_no, len(row), len(header)))
+            for k, i in enumerate(errors):
+                try:
+                    v = float(row[i])
+                except ValueError:
+                    continue
+                if not math.isnan(v):
+                    sum_sq[k] += v * v
+                    counted[k] += 1
+            if (line_no - 2) % stride:
+                continue
             for name, value in zip(header, row):
                 try:
                     columns[name].append(float(value))
                 except ValueError:
                     columns[name].append(value)
+    columns["__stride__"] = stride
+    columns["__rms__"] = {header[i]: math.sqrt(sum_sq[k] / counted[k]) if counted[k] else float("nan")
+                          for k, i in enumerate(errors)}
     return columns
 
 
@@ -115,6 +142,7 @@ def main(argv):
     plot_soil_force(plt, runs, args.out, written)
     plot_soil_estimates(plt, runs, args.out, written)
     plot_timing(plt, runs, args.out, written)
+    plot_work_cycles(plt, summary, args.out, written)
     report = write_report(runs, summary, args.title, args.out, written)
     print("plot-run: runs %s; wrote %d figures and %s" % (", ".join(runs), len(written), report))
     return 0

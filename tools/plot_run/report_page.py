@@ -2,7 +2,7 @@
 import math
 import os
 
-from run_figures import JOINTS
+from run_figures import JOINTS, work_cycles
 
 def rms(values):
     finite = [v for v in values if isinstance(v, float) and not math.isnan(v)]
@@ -83,6 +83,28 @@ def summary_table(summary):
     return lines
 
 
+def cycle_table(summary):
+    """Markdown rows per work cycle and controller (tasks that repeat)."""
+    cycles = work_cycles(summary)
+    if not cycles:
+        return []
+    lines = ["## Per work cycle", "",
+             "| cycle | controller | cycle time (s) | RMS boom / arm / bucket (mm) | worst bucket (mm) |"
+             " peak soil force (kN) | soil estimates at the end (M_x B_x K_x M_z B_z K_z) |",
+             "|---|---|---|---|---|---|---|"]
+    for c in range(max(len(v) for v in cycles.values())):
+        for controller, rows in cycles.items():
+            if c >= len(rows):
+                continue
+            r = rows[c]
+            theta = " ".join("%.3g" % r["theta_hat"][k] for k in ("M_x", "B_x", "K_x", "M_z", "B_z", "K_z"))
+            lines.append("| %d | %s | %.2f | %.3g / %.3g / %.3g | %.3g | %.1f | %s |" % (
+                c + 1, controller, r["end"] - r["start"], 1e3 * r["rms_error"]["boom"],
+                1e3 * r["rms_error"]["arm"], 1e3 * r["rms_error"]["bucket"], 1e3 * r["max_error"]["bucket"],
+                1e-3 * r["peak_soil_force"], theta))
+    return lines + [""]
+
+
 def write_report(runs, summary, title, out_dir, written):
     lines = ["# %s" % title, ""]
     if summary is not None:
@@ -101,11 +123,14 @@ def write_report(runs, summary, title, out_dir, written):
         cells = []
         for channels in runs.values():
             ctrl = channels.get("EXC_CONTROLLER", {})
-            cells.append("%.4g" % rms(ctrl["error_%d" % j]) if ctrl else "n/a")
+            exact = ctrl.get("__rms__", {}).get("error_%d" % j) if ctrl else None
+            cells.append("%.4g" % (exact if exact is not None else rms(ctrl["error_%d" % j])) if ctrl else "n/a")
         lines.append("| %s (%s) | " % (joint, unit.split("[")[-1].rstrip("]")) + " | ".join(cells)
                      + " |")
     lines.append("")
+    lines += cycle_table(summary)
     captions = {
+        "work_cycles.png": "Work cycles: RMS error per joint and peak soil force, per cycle and controller",
         "tracking_error.png": "Tracking error of each active joint",
         "soil_force.png": "Soil force at the tip (the zig-zag of the paper's Fig. 8)",
         "soil_estimates.png": "Soil parameter estimates against the true values",

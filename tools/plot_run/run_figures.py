@@ -198,3 +198,36 @@ def plot_robustness(plt, path, out_dir):
     written = []
     save(fig, out_dir, "robustness.png", written)
     return written
+
+
+def work_cycles(summary):
+    """{controller: [cycle, ...]} from an excavator-sim summary whose task repeats (else {})."""
+    if not isinstance(summary, dict):
+        return {}
+    found = {k: v["cycles"] for k, v in summary.items()
+             if isinstance(v, dict) and isinstance(v.get("cycles"), list) and len(v["cycles"]) > 1}
+    order = {"pid": 0, "adaptive": 1}
+    return dict(sorted(found.items(), key=lambda kv: (order.get(kv[0], 2), kv[0])))
+
+
+def plot_work_cycles(plt, summary, out_dir, written):
+    """work_cycles.png: per cycle and controller, RMS error of boom, arm and bucket, and the peak soil
+    force: whether a law learns from pass to pass (the adaptive law's estimates carry over)."""
+    cycles = work_cycles(summary)
+    if not cycles:
+        return
+    fig, axes = new_figure(plt, 2, 2, "Work cycles: tracking error and soil force per cycle")
+    panels = [("boom", "RMS error boom [mm]"), ("arm", "RMS error arm [mm]"),
+              ("bucket", "RMS error bucket [mm]"), (None, "peak soil force [kN]")]
+    for ax, (joint, label) in zip([a for row in axes for a in row], panels):
+        for controller, rows in cycles.items():
+            xs = list(range(1, len(rows) + 1))
+            ys = [1e3 * r["rms_error"][joint] if joint else 1e-3 * r["peak_soil_force"] for r in rows]
+            ax.plot(xs, ys, "o-", label=controller)
+        ax.set_xlabel("cycle")
+        ax.set_ylabel(label)
+        ax.set_xticks(range(1, max(len(r) for r in cycles.values()) + 1))
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="best")
+    save(fig, out_dir, "work_cycles.png", written)
+    plt.close(fig)
