@@ -61,7 +61,7 @@ double ActuatorModel::chamber_volume_b(int i, const Vec4& q_a) const {
   return params_.dead_volume + area_b_[i] * stroke;
 }
 
-void ActuatorModel::reset(const Vec4& /*q_a*/, const Vec4& hold) {
+void ActuatorModel::reset(const Vec4& q_a, const Vec4& hold) {
   command_ = ActuatorCommand{};
   lagged_ = hold.cwiseMax(effort_min_).cwiseMin(effort_max_);
   if (params_.fidelity == ActuatorFidelity::ideal) command_.value = hold;
@@ -81,6 +81,7 @@ void ActuatorModel::reset(const Vec4& /*q_a*/, const Vec4& hold) {
     }
   }
   if (params_.fidelity == ActuatorFidelity::hydraulic) command_.mode = ActuatorCommand::valve;
+  applied_ = effort(q_a);
 }
 
 Vec4 ActuatorModel::effort(const Vec4& /*q_a*/) const {
@@ -92,12 +93,25 @@ Vec4 ActuatorModel::effort(const Vec4& /*q_a*/) const {
   return Vec4::Zero();
 }
 
+Vec4 ActuatorModel::effort_over(double dt, const Vec4& q_a) {
+  if (params_.fidelity == ActuatorFidelity::limited) {
+    // y(t) = c + (y0 - c) exp(-t / lag) toward the clamped command c; its mean over [0, dt] is
+    // c + (y0 - c) (lag / dt) (1 - exp(-dt / lag)), and c itself without a lag.
+    const Vec4 target = command_.value.cwiseMax(effort_min_).cwiseMin(effort_max_);
+    const double w = params_.lag > 0 ? params_.lag / dt * -std::expm1(-dt / params_.lag) : 0.0;
+    applied_ = target + w * (lagged_ - target);
+  } else {
+    applied_ = effort(q_a);
+  }
+  return applied_;
+}
+
 void ActuatorModel::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   if (params_.fidelity == ActuatorFidelity::ideal) return;
   if (params_.fidelity == ActuatorFidelity::limited) {
     // First-order lag toward the clamped command, solved exactly over dt (no step-size limit).
     const Vec4 target = command_.value.cwiseMax(effort_min_).cwiseMin(effort_max_);
-    const double a = params_.lag > 0 ? 1.0 - std::exp(-dt / params_.lag) : 1.0;
+    const double a = params_.lag > 0 ? -std::expm1(-dt / params_.lag) : 1.0;
     lagged_ += a * (target - lagged_);
     return;
   }

@@ -44,8 +44,14 @@ class ActuatorModel {
   // The command of this cycle (the plant checks the mode against the fidelity first).
   void set_command(const ActuatorCommand& command) { command_ = command; }
 
-  // The effort acting on the machine now (N m, N).
+  // The effort held on the machine over the next substep of length dt, from the state now: ideal
+  // the command; limited the exact mean of its lag's response over the substep (so the command acts
+  // within the cycle it is sent in: no delay beyond the lag); hydraulic the chamber pressures now.
+  Vec4 effort_over(double dt, const Vec4& q_a);
+  // The effort at this instant (limited: the lag's state; hydraulic: from the pressures).
   Vec4 effort(const Vec4& q_a) const;
+  // The effort effort_over() last returned (the one that acted over the last substep).
+  const Vec4& applied() const { return applied_; }
   // Advance the actuator states over dt with the machine's motion (lag, spool, pressures).
   void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
 
@@ -68,6 +74,7 @@ class ActuatorModel {
   Vec4 area_a_ = Vec4::Zero(), area_b_ = Vec4::Zero(), valve_gain_ = Vec4::Zero();
   ActuatorCommand command_;
   Vec4 lagged_ = Vec4::Zero();  // limited: the lagged effort
+  Vec4 applied_ = Vec4::Zero();
   Vec4 spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();
   int relief_events_ = 0;
 };

@@ -132,7 +132,7 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
     const MechanicalState before = mech_;
     // Soil and dynamics are evaluated inside the integrator's stages (the soil load at each stage's
     // tip); the actuators' effort is held over the substep.
-    const Vec4 tau = actuators_.effort(mech_.q_a);
+    const Vec4 tau = actuators_.effort_over(h, mech_.q_a);
     const StepOutcome out = integrator_.step(ws_, soil_, tau, h, mech_, start);
     state_.implicit_iterations = out.iterations;
     ModelReport report = out.report;
@@ -210,7 +210,8 @@ void Plant::fill_state(const Evaluation& last) {
   state_.in_soil = soil_.in_soil();
   state_.depth = soil_.depth(rho_);
   state_.reanchor_count = soil_.reanchor_count();
-  state_.effort = actuators_.effort(mech_.q_a);
+  const bool hydraulic = scene_.actuators.fidelity == ActuatorFidelity::hydraulic;
+  state_.effort = hydraulic ? actuators_.effort(mech_.q_a) : actuators_.applied();
   state_.spool = actuators_.spool();
   state_.pressure_a = actuators_.pressure_a();
   state_.pressure_b = actuators_.pressure_b();

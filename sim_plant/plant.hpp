@@ -28,7 +28,7 @@ struct PlantState {
   bool in_soil = false;
   double depth = 0;                // m, terrain height - tip z
   int reanchor_count = 0;          // shear failures so far (eq. 11)
-  Vec4 effort = Vec4::Zero();      // N m, N: efforts actually applied
+  Vec4 effort = Vec4::Zero();      // N m, N: efforts actually applied (limited: over the last substep)
   Vec4 spool = Vec4::Zero();       // hydraulic: spool positions (-1..1)
   Vec4 pressure_a = Vec4::Zero(), pressure_b = Vec4::Zero();  // Pa (hydraulic; swing motor ports first)
   double kinetic_energy = 0, potential_energy = 0;  // J

@@ -1,9 +1,11 @@
-// Actuators: the limited lag against its closed-form step response, relief clamps, and the hydraulic
-// chamber pressures against closed forms (oil spring, orifice filling, spool lag), relief valve.
+// Actuators: the limited lag against its closed-form step response and its timing (no delay beyond
+// the lag, checked against the swing's impulse), relief clamps, and the hydraulic chamber pressures
+// against closed forms (oil spring, orifice filling, spool lag), relief valve.
 #include <doctest/doctest.h>
 
 #include <cmath>
 
+#include "model/closed_chain.hpp"
 #include "plant_scenes.hpp"
 
 using namespace exc;
@@ -170,4 +172,67 @@ TEST_CASE("plant/hydraulic plant holds its load with closed valves and extends t
   const PlantStatus st = p.step(force);
   CHECK(st.failure == PlantFailure::bad_command);
   CHECK(std::string(st.text()).find("valve") != std::string::npos);
+}
+
+namespace {
+// The swing's inertia at a pose, from the model's mass matrix (eq. 17).
+double swing_inertia(const Plant& p) {
+  Workspace ws(p.model());
+  REQUIRE(update_closed_chain(p.model(), ws, p.state().q_a, Vec4::Zero()).ok());
+  Mat4 M;
+  mass_matrix(p.model(), ws, M);
+  return M(0, 0);
+}
+}  // namespace
+
+TEST_CASE("plant/limited actuator with lag 0 acts in the cycle it is sent: the same run as ideal, bit for bit") {
+  test::SceneText t;
+  Plant ideal(t.scene());
+  t.actuators = "fidelity: limited, lag: 0";
+  Plant limited(t.scene());
+  ActuatorCommand c;
+  for (int k = 0; k < 300; ++k) {
+    c.value = ideal.hold_effort();
+    c.value[0] = 2e4;                           // a swing torque step from the first cycle
+    c.value[1] += 3e4 * std::sin(0.05 * k);     // and a boom force that changes every cycle
+    REQUIRE(ideal.step(c).ok());
+    REQUIRE(limited.step(c).ok());
+    CAPTURE(k);
+    REQUIRE(limited.state().q_a == ideal.state().q_a);
+    REQUIRE(limited.state().qd_a == ideal.state().qd_a);
+    REQUIRE(limited.state().effort == c.value);
+  }
+  // One cycle in, the swing already turns at h T / I (a 1 ms delay would leave it at rest).
+  Plant fresh(t.scene());
+  const double inertia = swing_inertia(fresh);
+  c.value = fresh.hold_effort();
+  c.value[0] = 2e4;
+  REQUIRE(fresh.step(c).ok());
+  CHECK(fresh.state().qd_a[0] == doctest::Approx(1e-3 * 2e4 / inertia).epsilon(1e-6));
+}
+
+TEST_CASE("plant/limited actuator with lag tau: the swing's speed is the impulse of exactly T (1 - exp(-t / tau))") {
+  // The swing feels no gravity and (in the plane of the front) no coupling to the cylinders, so its
+  // speed is the impulse of the applied torque over its inertia: with a first-order lag and no extra
+  // delay, qd(t) = T / I (t - tau (1 - exp(-t / tau))). One cycle of delay would give
+  // T / I ((t - h) - tau (1 - exp(-(t - h) / tau))), 10 % less at t = 20 ms.
+  const double tau = 0.05, T = 2e4, h = 1e-3;
+  test::SceneText t;
+  t.actuators = "fidelity: limited, lag: 0.05";
+  Plant p(t.scene());
+  const double inertia = swing_inertia(p);
+  ActuatorCommand c;
+  c.value = p.hold_effort();
+  c.value[0] = T;
+  for (int k = 1; k <= 200; ++k) {
+    REQUIRE(p.step(c).ok());
+    const double time = k * h;
+    const double expected = T / inertia * (time - tau * (1.0 - std::exp(-time / tau)));
+    CAPTURE(k);
+    CHECK(p.state().qd_a[0] == doctest::Approx(expected).epsilon(1e-6));
+  }
+  // The effort reported is the one that acted over the last step: the lag's mean over that step.
+  const double t1 = 0.2, t0 = t1 - h;
+  const double mean = T * (1.0 - tau / h * (std::exp(-t0 / tau) - std::exp(-t1 / tau)));
+  CHECK(p.state().effort[0] == doctest::Approx(mean).epsilon(1e-9));
 }
