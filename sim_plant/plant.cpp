@@ -1,6 +1,7 @@
 // The plant: soil -> actuators -> dynamics -> integrate -> checks, once per substep.
 #include "sim_plant/plant.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "model/loop_closure.hpp"
@@ -59,51 +60,91 @@ void Plant::reset() {
   none.rho = rho_;
   none.rhod = rhod_;
   fill_state(none);
-  sensors_.sample(0, mech_.q_a, mech_.qd_a, actuators_.pressure_a(), actuators_.pressure_b());
+  sensors_.sample(0, mech_.q_a, mech_.qd_a, actuators_.pressure_a(), actuators_.pressure_b(),
+                  actuators_.hydraulics().report().pump_pressure);
 }
 
 bool Plant::accept_command(const ActuatorCommand& command) {
-  const bool hydraulic = scene_.actuators.fidelity == ActuatorFidelity::hydraulic;
-  if (!command.value.allFinite()) {
+  const ActuatorFidelity fidelity = scene_.actuators.fidelity;
+  const bool hydraulic = fidelity == ActuatorFidelity::hydraulic;
+  if (!command.value.allFinite() || !command.pilot_a.allFinite() || !command.pilot_b.allFinite()) {
     set_failure(status_, PlantFailure::bad_command, state_.time, state_.cycle,
                 "the command holds NaN or Inf; send finite values");
     return false;
   }
-  if (hydraulic != (command.mode == ActuatorCommand::valve)) {
+  // A command of a kind the actuators cannot use stops the plant: running on would silently ignore it.
+  if (hydraulic == (command.mode == ActuatorCommand::effort)) {
     set_failure(status_, PlantFailure::bad_command, state_.time, state_.cycle,
-                "a %s command for actuators.fidelity %s; %s", command.mode == ActuatorCommand::valve ? "valve" : "effort",
-                to_string(scene_.actuators.fidelity),
-                hydraulic ? "hydraulic actuators take valve openings -1..1" : "ideal and limited actuators take efforts");
+                "%s commands for actuators.fidelity %s; %s", to_string(command.mode), to_string(fidelity),
+                hydraulic ? "hydraulic actuators take valve openings -1..1 or pilot pressures, not efforts"
+                          : "ideal and limited actuators take efforts (N m, N), not valve or pilot commands");
     return false;
   }
-  if (hydraulic && command.value.cwiseAbs().maxCoeff() > 1.0 + 1e-12) {
+  if (command.mode == ActuatorCommand::valve && command.value.cwiseAbs().maxCoeff() > 1.0 + 1e-12) {
     set_failure(status_, PlantFailure::bad_command, state_.time, state_.cycle,
                 "valve opening outside -1..1 (largest %.4g); clamp the command", command.value.cwiseAbs().maxCoeff());
     return false;
+  }
+  if (command.mode == ActuatorCommand::pilot) {
+    const double full = scene_.actuators.hydraulic.pilot_full_stroke;
+    const double lo = std::min(command.pilot_a.minCoeff(), command.pilot_b.minCoeff());
+    const double hi = std::max(command.pilot_a.maxCoeff(), command.pilot_b.maxCoeff());
+    if (lo < 0 || hi > full * (1 + 1e-12)) {
+      set_failure(status_, PlantFailure::bad_command, state_.time, state_.cycle,
+                  "pilot pressure outside 0..%.4g MPa (%.4g .. %.4g MPa); clamp the command", full * 1e-6, lo * 1e-6,
+                  hi * 1e-6);
+      return false;
+    }
   }
   return true;
 }
 
 // End stops and the flow (speed) limit of limited and hydraulic actuators: inelastic, so the state
-// stays on its stroke. Returns true if the state was changed.
-bool Plant::apply_limits() {
+// stays on its stroke. A cylinder through its stop is put back on it, and its velocity into the stop
+// removed, both along M_a^-1 e_i: an inelastic contact of the coupled coordinates (the other joints
+// keep the momentum the stop does not absorb; kinetic energy can only fall). Clamping the one
+// coordinate alone let a force held against the stop accelerate the joints coupled to it through
+// M_a without doing work on them: energy from nowhere. The impact's energy 1/2 v^2 / (M_a^-1)_ii,
+// v the speed into the stop at the substep's start, goes to state_.end_stop_loss; a cylinder resting
+// on its stop (v = 0) loses nothing. Returns true if the state was changed.
+bool Plant::apply_limits(const Vec4& qd_start) {
   if (scene_.actuators.fidelity == ActuatorFidelity::ideal) return false;
   bool changed = false;
+  bool have_inverse = false;
+  Mat4 m_inv = Mat4::Identity();
   for (int i = 0; i < kNumActive; ++i) {
-    if (mech_.q_a[i] < q_min_[i]) {
-      mech_.q_a[i] = q_min_[i];
-      mech_.qd_a[i] = std::max(mech_.qd_a[i], 0.0);
+    const bool below = mech_.q_a[i] < q_min_[i], above = mech_.q_a[i] > q_max_[i];
+    if (below || above) {
       changed = true;
-    } else if (mech_.q_a[i] > q_max_[i]) {
-      mech_.q_a[i] = q_max_[i];
-      mech_.qd_a[i] = std::min(mech_.qd_a[i], 0.0);
-      changed = true;
+      if (!have_inverse) {
+        integrator_.invalidate_cache();
+        Mat4 M;
+        if (update_closed_chain(model_, ws_, mech_.q_a, mech_.qd_a).ok()) {
+          mass_matrix(model_, ws_, M);
+          m_inv = M.inverse();
+        }
+        have_inverse = true;
+      }
+      const double stop = below ? q_min_[i] : q_max_[i];
+      // Back onto the stop along the same direction: the joints coupled to the cylinder give back the
+      // displacement the stop's reaction would have denied them within the substep, whatever the
+      // integrator's position update was.
+      mech_.q_a -= m_inv.col(i) * ((mech_.q_a[i] - stop) / m_inv(i, i));
+      mech_.q_a[i] = stop;
+      const double into = below ? std::min(mech_.qd_a[i], 0.0) : std::max(mech_.qd_a[i], 0.0);
+      if (into != 0) {
+        mech_.qd_a -= m_inv.col(i) * (into / m_inv(i, i));
+        mech_.qd_a[i] = 0;
+        const double arriving = below ? std::min(qd_start[i], 0.0) : std::max(qd_start[i], 0.0);
+        state_.end_stop_loss += 0.5 * arriving * arriving / m_inv(i, i);
+      }
     }
     if (scene_.actuators.fidelity == ActuatorFidelity::limited && std::abs(mech_.qd_a[i]) > speed_max_[i]) {
       mech_.qd_a[i] = std::copysign(speed_max_[i], mech_.qd_a[i]);
       changed = true;
     }
   }
+  if (changed) integrator_.invalidate_cache();
   return changed;
 }
 
@@ -126,22 +167,28 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
   actuators_.set_command(command);
   const double h = scene_.integrator.step;
   const bool augmented = scene_.integrator.formulation != Formulation::independent;
+  const bool hydraulic = scene_.actuators.fidelity == ActuatorFidelity::hydraulic;
   Evaluation start;
   for (int k = 0; k < substeps_; ++k) {
     const double t = state_.time + (k + 1) * h;
     const MechanicalState before = mech_;
     // Soil and dynamics are evaluated inside the integrator's stages (the soil load at each stage's
     // tip); the actuators' effort is held over the substep.
-    const Vec4 tau = actuators_.effort(mech_.q_a);
+    const Vec4 tau = actuators_.effort_over(h, mech_.q_a);
     const StepOutcome out = integrator_.step(ws_, soil_, tau, h, mech_, start);
     state_.implicit_iterations = out.iterations;
     ModelReport report = out.report;
     if (report.ok()) {
-      actuators_.advance(h, mech_.q_a, mech_.qd_a);
-      if (apply_limits()) {
+      if (apply_limits(before.qd_a)) {
         ++state_.end_stop_events;
         report = integrator_.project(ws_, mech_);
       }
+      // The actuators follow the motion (after the stops): the chambers sweep A qd h with the
+      // substep's end velocity. With the effort held from the substep's start this pairs the oil
+      // spring and the mass as symplectic Euler does (stable for every integrator); sweeping the
+      // mean velocity (q1 - q0) / h instead makes RK4 and the midpoint rule grow the oil columns'
+      // ringing. Against the positions the swept volume is off by h (v_end - v_start) / 2: bounded.
+      actuators_.advance(h, mech_.q_a, mech_.qd_a);
     }
     if (report.ok() && mech_.q_a.allFinite() && mech_.qd_a.allFinite()) {
       report = integrator_.kinematics(ws_, mech_, rho_, rhod_);
@@ -165,7 +212,16 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
       state_.kinetic_energy = kinetic_energy(model_, ws_);
       state_.potential_energy = potential_energy(model_, ws_);
       in.energy = state_.kinetic_energy + state_.potential_energy;
-      in.energy_expected = energy0_ + state_.actuator_work + state_.soil_work;
+      in.energy_expected = energy0_ + state_.actuator_work + state_.soil_work - state_.end_stop_loss;
+      if (hydraulic) {
+        const HydraulicEnergy& e = actuators_.hydraulics().report().energy;
+        in.energy += e.stored;
+        in.energy_expected += e.stored0 + e.supplied() - state_.actuator_work;
+        in.pressure_a = &actuators_.pressure_a();
+        in.pressure_b = &actuators_.pressure_b();
+        in.pressure_min = actuators_.hydraulics().pressure_floor();
+        in.pressure_max = actuators_.hydraulics().pressure_ceiling();
+      }
       in.work_exchanged = work_abs_;
       if (augmented) {
         Vec8 residual;
@@ -192,7 +248,8 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
     state_.constraint_residual = residual.norm();
   }
   fill_state(start);
-  sensors_.sample(state_.cycle, mech_.q_a, mech_.qd_a, actuators_.pressure_a(), actuators_.pressure_b());
+  sensors_.sample(state_.cycle, mech_.q_a, mech_.qd_a, actuators_.pressure_a(), actuators_.pressure_b(),
+                  actuators_.hydraulics().report().pump_pressure);
   return status_;
 }
 
@@ -210,12 +267,18 @@ void Plant::fill_state(const Evaluation& last) {
   state_.in_soil = soil_.in_soil();
   state_.depth = soil_.depth(rho_);
   state_.reanchor_count = soil_.reanchor_count();
-  state_.effort = actuators_.effort(mech_.q_a);
+  const bool hydraulic = scene_.actuators.fidelity == ActuatorFidelity::hydraulic;
+  state_.effort = hydraulic ? actuators_.effort(mech_.q_a) : actuators_.applied();
   state_.spool = actuators_.spool();
   state_.pressure_a = actuators_.pressure_a();
   state_.pressure_b = actuators_.pressure_b();
-  state_.energy_error =
-      state_.kinetic_energy + state_.potential_energy - (energy0_ + state_.actuator_work + state_.soil_work);
+  state_.hydraulics = actuators_.hydraulics().report();
+  state_.energy_error = state_.kinetic_energy + state_.potential_energy -
+                        (energy0_ + state_.actuator_work + state_.soil_work - state_.end_stop_loss);
+  if (hydraulic) {
+    const HydraulicEnergy& e = state_.hydraulics.energy;
+    state_.energy_error += e.stored - e.stored0 - e.supplied() + state_.actuator_work;
+  }
   if (state_.cycle == 0) {
     state_.kinetic_energy = kinetic_energy(model_, ws_);
     state_.potential_energy = potential_energy(model_, ws_);

@@ -28,14 +28,19 @@ struct PlantState {
   bool in_soil = false;
   double depth = 0;                // m, terrain height - tip z
   int reanchor_count = 0;          // shear failures so far (eq. 11)
-  Vec4 effort = Vec4::Zero();      // N m, N: efforts actually applied
+  Vec4 effort = Vec4::Zero();      // N m, N: efforts actually applied (limited: over the last substep)
   Vec4 spool = Vec4::Zero();       // hydraulic: spool positions (-1..1)
   Vec4 pressure_a = Vec4::Zero(), pressure_b = Vec4::Zero();  // Pa (hydraulic; swing motor ports first)
+  HydraulicReport hydraulics;      // hydraulic: pumps, flows, relief/cavitation/saturation counts, energy
   double kinetic_energy = 0, potential_energy = 0;  // J
-  double energy_error = 0;         // J: energy minus (initial energy + work of actuators and soil)
+  // J: energy minus (initial energy + work of actuators and soil); hydraulic: energy includes the
+  // oil's compression energy and the actuators' work is what the pumps and the tank line supplied
+  // net of the circuit's losses (HydraulicEnergy).
+  double energy_error = 0;
   double actuator_work = 0, soil_work = 0;          // J, done on the machine
   double constraint_residual = 0;  // m, |h(q)|
   int end_stop_events = 0;         // substeps at which an end stop or a speed limit acted
+  double end_stop_loss = 0;        // J the end stops' impacts took (inelastic), in the energy balance
   int implicit_iterations = 0;     // of the last substep (implicit_midpoint)
 };
 
@@ -63,7 +68,7 @@ class Plant {
 
  private:
   bool accept_command(const ActuatorCommand& command);
-  bool apply_limits();
+  bool apply_limits(const Vec4& qd_start);
   void account_work(const Vec4& tau, const MechanicalState& before, const Evaluation& start, const Vec2& rho1,
                     const Vec2& rhod1);
   void fill_state(const Evaluation& last);

@@ -18,6 +18,7 @@ const char* to_string(PlantFailure f) {
     case PlantFailure::end_stop: return "end_stop";
     case PlantFailure::not_converged: return "not_converged";
     case PlantFailure::bad_command: return "bad_command";
+    case PlantFailure::pressure_range: return "pressure_range";
   }
   return "?";
 }
@@ -58,6 +59,10 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
     unstable(status, PlantFailure::non_finite, in, "NaN or Inf in the state", NAN, 0);
     return false;
   }
+  if (in.pressure_a != nullptr && (!in.pressure_a->allFinite() || !in.pressure_b->allFinite())) {
+    unstable(status, PlantFailure::non_finite, in, "NaN or Inf in a chamber pressure", NAN, 0);
+    return false;
+  }
   if (in.model_report.status == ModelStatus::near_toggle) {
     set_failure(status, PlantFailure::near_toggle, in.time, in.cycle,
                 "loop %d is near its toggle (conditioning %.3g) at q_a = [%.4f %.4f %.4f %.4f]; keep the bucket "
@@ -84,6 +89,22 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
   if (excess > energy_limit) {
     unstable(status, PlantFailure::energy_growth, in, "energy grew beyond the work put in (J)", excess, energy_limit);
     return false;
+  }
+  if (in.pressure_a != nullptr) {
+    for (int i = 0; i < kNumActive; ++i) {
+      for (int side = 0; side < 2; ++side) {
+        const double p = side == 0 ? (*in.pressure_a)[i] : (*in.pressure_b)[i];
+        if (p >= in.pressure_min && p <= in.pressure_max) continue;
+        set_failure(status, PlantFailure::pressure_range, in.time, in.cycle,
+                    "the %s %s pressure is %.6g MPa, outside [%.4g, %.4g] MPa (vapour .. highest relief + "
+                    "hydraulic.pressure_check_margin): a relief passes more than its override allows (a load the "
+                    "reliefs cannot hold) or the pressures were integrated wrongly; check the reliefs and "
+                    "actuators.bulk_modulus",
+                    kActiveNames[i], side == 0 ? (i == 0 ? "port A" : "bore-side") : (i == 0 ? "port B" : "rod-side"),
+                    p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6);
+        return false;
+      }
+    }
   }
   if (in.constraint_residual > settings.constraint_tolerance) {
     set_failure(status, PlantFailure::constraint_drift, in.time, in.cycle,

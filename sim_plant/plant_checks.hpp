@@ -1,6 +1,8 @@
 #pragma once
 // The plant's watchdogs (run after every substep): non-finite state, energy growing beyond what the
-// actuators and the soil put in, constraint residual above tolerance, the loop solver near the
+// actuators and the soil put in (with hydraulic actuators: the pumps and the tank line, net of the
+// circuit's losses, with the oil's compression energy counted in), a chamber pressure outside
+// [vapour, highest relief + margin], constraint residual above tolerance, the loop solver near the
 // four-bar toggle (or with no assembly), a cylinder driven through its end stop, an implicit solve
 // that did not converge. A failure stops the plant with a message naming what failed, when, and
 // what to change. Messages are written into a fixed buffer: nothing allocates.
@@ -31,6 +33,7 @@ enum class PlantFailure {
   end_stop,          // a cylinder driven through its end stop (ideal actuators have none)
   not_converged,     // the implicit iteration did not converge
   bad_command,       // command not finite, or of the wrong mode for the fidelity
+  pressure_range,    // a hydraulic chamber pressure outside [vapour, highest relief + margin]
 };
 const char* to_string(PlantFailure f);
 
@@ -48,8 +51,9 @@ struct CheckInputs {
   double time = 0;
   std::int64_t cycle = 0;
   const MechanicalState* state = nullptr;
-  double energy = 0;            // J, kinetic + potential now
-  double energy_expected = 0;   // J, initial energy + work of actuators and soil so far
+  double energy = 0;            // J, kinetic + potential now (hydraulic: + the oil's compression energy)
+  double energy_expected = 0;   // J, initial energy + work of actuators (hydraulic: of pumps and tank
+                                // line net of losses) and soil so far
   double work_exchanged = 0;    // J, integral of |power| exchanged (scale for the tolerance)
   double constraint_residual = 0;  // m
   ModelReport model_report;
@@ -57,6 +61,11 @@ struct CheckInputs {
   Vec4 q_min = Vec4::Zero(), q_max = Vec4::Zero();
   ActuatorFidelity fidelity = ActuatorFidelity::ideal;
   const IntegratorSettings* integrator = nullptr;
+  // Hydraulic chamber pressures (Pa, swing motor ports first) and the range they must stay in;
+  // null for the other fidelities.
+  const Vec4* pressure_a = nullptr;
+  const Vec4* pressure_b = nullptr;
+  double pressure_min = 0, pressure_max = 0;
 };
 
 // Runs every check in order of severity; on failure fills 'status' and returns false.

@@ -59,23 +59,24 @@ void PlantNode::step(std::uint64_t cycle) {
   // The firmware's safe state is "valves centred" (valve command of zeros); a force-commanded
   // plant has no valves, so it brakes instead.
   const bool hydraulic = plant_.scene().actuators.fidelity == plant::ActuatorFidelity::hydraulic;
-  const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && !hydraulic;
+  bool centred = true;
+  for (double v : command_.value) centred = centred && v == 0;
+  const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && centred && !hydraulic;
   const bool hold = timed_out || command_.emergency_stop || firmware_holds;
   if (hold && !holding_) ++holds_;
   holding_ = hold;
 
+  // Any other command goes to the plant as the kind it is: a kind the actuators cannot use (efforts
+  // for valves, openings for force actuators) stops the plant with its message, so a mismatched
+  // setup fails at once instead of running on with the commands ignored.
   plant::ActuatorCommand actuator;
-  if (hydraulic) {
-    actuator.mode = plant::ActuatorCommand::valve;
-    if (!hold && command_.mode == hal::CommandMode::valve)
-      for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
+  const bool valve = command_.mode == hal::CommandMode::valve;
+  actuator.mode = valve ? plant::ActuatorCommand::valve : plant::ActuatorCommand::effort;
+  if (hold) {
+    actuator.mode = hydraulic ? plant::ActuatorCommand::valve : plant::ActuatorCommand::effort;
+    if (!hydraulic) actuator.value = hold_effort();  // valves: centred (zeros)
   } else {
-    actuator.mode = plant::ActuatorCommand::effort;
-    if (hold) {
-      actuator.value = hold_effort();
-    } else {
-      for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
-    }
+    for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
   }
   const std::int64_t step_start = hal::monotonic_now_ns();
   plant_.step(actuator);

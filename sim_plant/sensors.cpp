@@ -19,7 +19,7 @@ double SensorModel::quantise(double v, double quantum) {
 }
 
 void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a,
-                         const Vec4& p_b) {
+                         const Vec4& p_b, const Vec2& pump) {
   SensorReading& r = ring_[write_index_];
   for (int i = 0; i < 4; ++i) {
     // Noise first, then the converter's quantisation, as a real encoder chain does.
@@ -32,6 +32,8 @@ void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, 
     r.pressure_a[i] = quantise(p_a[i + 1], params_.pressure_quantum);
     r.pressure_b[i] = quantise(p_b[i + 1], params_.pressure_quantum);
   }
+  r.swing_pressure = Vec2(quantise(p_a[0], params_.pressure_quantum), quantise(p_b[0], params_.pressure_quantum));
+  for (int i = 0; i < 2; ++i) r.pump_pressure[i] = quantise(pump[i], params_.pressure_quantum);
   r.cycle = cycle;
   const int n = static_cast<int>(ring_.size());
   const int latency = params_.latency_cycles;

@@ -24,6 +24,8 @@ struct SensorReading {
   Vec4 position = Vec4::Zero();  // swing rad, cylinder lengths m
   Vec4 velocity = Vec4::Zero();  // rad/s, m/s
   Vec3 pressure_a = Vec3::Zero(), pressure_b = Vec3::Zero();  // cylinders (boom, arm, bucket), Pa
+  Vec2 swing_pressure = Vec2::Zero();  // swing motor ports A, B, Pa
+  Vec2 pump_pressure = Vec2::Zero();   // the two pumps, Pa
   std::int64_t cycle = 0;        // the plant cycle the values were measured in
 };
 
@@ -33,7 +35,9 @@ class SensorModel {
   explicit SensorModel(const SensorParameters& params);
   void reset();
   // Measure the true values of cycle 'cycle'; the reading returned by latest() lags by the latency.
-  void sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a, const Vec4& p_b);
+  // p_a, p_b: chamber pressures, swing motor ports first; pump: the two pumps' pressures.
+  void sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a, const Vec4& p_b,
+              const Vec2& pump = Vec2::Zero());
   const SensorReading& latest() const { return ring_[read_index_]; }
 
  private:

@@ -1,0 +1,53 @@
+#pragma once
+// One oil chamber (a cylinder side or a swing-motor port) over one substep. The pressure obeys
+// dp/dt = beta / V (Q - dV/dt) (hydraulics.md), stiff because beta / V is large and the orifices
+// couple the pressure to itself (beta / V * dQ/dp reaches 1e4 1/s). It is integrated by backward
+// Euler in the chamber's own pressure, with the piston's swept volume from the mechanical step:
+//   V1 / beta (p1 - p0) = dt Q(p1) - dV
+// Every element's net inflow Q(p) (meter-in, make-up, minus meter-out, minus relief) is
+// non-increasing in p, so the left side minus the right is strictly increasing in p1: one root,
+// found by Newton's method safeguarded by bisection once bracketed. Unconditionally stable, no
+// overshoot past a relief setting or below the make-up valve's tank pressure.
+#include "sim_plant/orifice.hpp"
+
+namespace exc::plant {
+
+// The valves connected to one chamber during a substep (all gains already include the opening).
+struct ChamberValves {
+  // Meter-in from the pump through a post-compensated orifice: drop = min(margin, supply_limit - p),
+  // never negative (a load-check valve stops backflow into the pump).
+  double meter_in_gain = 0;   // m^3/s/sqrt(Pa): K_in x the opening x the flow-sharing factor
+  double margin = 0;          // Pa, the load-sensing margin (the compensated drop)
+  double supply_limit = 0;    // Pa, the pump's pressure limit (main relief)
+  // Meter-out to tank through the spool (either direction, an orifice).
+  double meter_out_gain = 0;  // m^3/s/sqrt(Pa)
+  double tank = 0;            // Pa
+  // Anti-cavitation (make-up) check valve from the tank line, open while p < tank.
+  double makeup_gain = 0;     // m^3/s/sqrt(Pa)
+  // Port relief to tank: Q = gain (p - setting) above its setting (linear override).
+  double relief_setting = 0;  // Pa
+  double relief_gain = 0;     // m^3/s/Pa
+  double laminar = 0;         // Pa, orifices are linear below this drop
+};
+
+struct ChamberFlows {
+  double meter_in = 0, meter_out = 0, makeup = 0, relief = 0;  // m^3/s, each >= 0 except meter_out (signed, out)
+  double net() const { return meter_in + makeup - meter_out - relief; }
+};
+
+// Flows at pressure p; dnet_dp (<= 0) is the derivative of the net inflow.
+ChamberFlows chamber_flows(const ChamberValves& v, double p, double& dnet_dp);
+
+struct ChamberStep {
+  double pressure = 0;     // Pa at the end of the substep (>= floor)
+  ChamberFlows flows;      // over the substep (backward Euler: at the end pressure)
+  double void_volume = 0;  // m^3 of vapour that opened because the make-up could not keep up (p hit the floor)
+  int iterations = 0;      // Newton (and bisection) iterations used
+};
+
+// p0: pressure at the start; volume: chamber volume at the end; swept: how much the piston's (or
+// motor's) motion grew the chamber during the substep (m^3, negative when it shrank it).
+ChamberStep step_chamber(const ChamberValves& v, double p0, double volume, double bulk_modulus, double dt,
+                         double swept, double floor);
+
+}  // namespace exc::plant

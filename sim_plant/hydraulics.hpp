@@ -1,0 +1,169 @@
+#pragma once
+// The hydraulic machine of a 20 t excavator (hydraulics.md): two pumps with load-sensing flow
+// sharing (flow_sharing.hpp), four pilot-operated main-valve spools with lag and dead zones
+// (spool_valve.hpp), the boom, arm and bucket cylinders and the swing motor with their chamber
+// pressures (chamber.hpp), main relief, port reliefs and anti-cavitation make-up valves.
+//
+// Per function i (swing, boom, arm, bucket), spool x in -1..1, metering opening a = dead-zoned |x|:
+//   extending (x > 0): P -> A through the compensated meter-in, B -> T through the meter-out;
+//   retracting (x < 0): P -> B, A -> T; closed (a = 0): both chambers trapped.
+//   meter-in  Q_in  = s K_in a sqrt(min(margin, p_relief_main - p_load))   (s: flow-sharing factor)
+//   meter-out Q_out = K_out a sqrt(p - p_tank)
+//   make-up   Q_mk  = K_mk sqrt(p_tank - p) while p < p_tank
+//   relief    Q_r   = K_r (p - p_setting) above the port relief's setting
+//   chambers  dp_A/dt = beta / V_A (Q_A - A_A v),  dp_B/dt = beta / V_B (Q_B + A_B v)
+//   effort    F = p_A A_A - p_B A_B  (swing: T = D (p_A - p_B), D the displacement at the swing axis)
+// (orifices are linear below the laminar pressure). Cylinder areas and the swing displacement come
+// from the machine file's effort limits at its relief pressure; valve gains from its speed limits.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "model/machine.hpp"
+
+namespace exc::plant {
+
+struct ActuatorParameters;
+
+inline constexpr int kNumPumps = 2;
+
+// Parameters of the hydraulic machine that the scene file does not read yet (they are C++ only
+// until the settings reader takes them). Each: unit, source, allowed range (validate()).
+struct HydraulicParameters {
+  // m^3/s, both pumps together at rated speed: 2 x 112 cm^3/rev, 439 L/min (Komatsu PC200-8,
+  // hydraulics.md). Range [1e-4, 0.05].
+  double pump_flow = 439.0 / 60000.0;
+  // true: both pumps feed one gallery (the PC200-8's CLSS joins them in normal work); false: each
+  // pump feeds its own functions (pump_of) with half the flow.
+  bool pumps_merged = true;
+  // With split pumps, the pump (0 or 1) of swing, boom, arm, bucket (estimate: the usual two-pump
+  // layout, boom and bucket on one, swing and arm on the other).
+  std::array<int, 4> pump_of = {1, 0, 1, 0};
+  // Pa, pump pressure above the highest load (the load-sensing differential; estimate, typical
+  // 1.5-3 MPa, not on the spec page). The meter-in orifices are sized to pass the speed-limit flow
+  // at this drop. Range [0.3e6, 5e6].
+  double load_sensing_margin = 2.0e6;
+  // Pa, main relief: the pumps' pressure limit (34.3 MPa, Cat 320C service data, hydraulics.md).
+  // actuators.supply_pressure, when the scene sets it (> 0), takes its place. Range [5e6, 60e6].
+  double main_relief_pressure = 34.3e6;
+  // Pa, port reliefs on the boom, arm and bucket chambers (36.8 MPa, Cat 320C, hydraulics.md).
+  // Range [5e6, 60e6].
+  double port_relief_pressure = 36.8e6;
+  // Pa, the swing motor's port reliefs (estimate: the spec page gives none; 34.3 MPa is the pressure
+  // at which the machine file's 65 kN m swing torque is stated). Range [5e6, 60e6].
+  double swing_relief_pressure = 34.3e6;
+  // Pa above its setting at which a relief passes pump_flow (linear override; estimate).
+  // Range [1e4, 10e6].
+  double relief_override = 1.5e6;
+  // Pa below tank pressure at which a make-up (anti-cavitation) valve passes pump_flow (estimate).
+  // Range [1e4, 2e6].
+  double makeup_pressure_drop = 0.2e6;
+  // Pa (gauge, like every pressure of the plant): the floor no chamber goes below; below it the
+  // oil would release air and vapour (hydraulics.md: never below zero or vapour pressure).
+  // Range [-0.1e6, 0.1e6], and at most actuators.tank_pressure.
+  double vapour_pressure = 0.0;
+  // Pa, pilot pressure difference for full spool stroke (0-5 MPa pilots, the ZX200's 0.02 MPa/bit
+  // commands, hydraulics.md). Range [1e6, 10e6].
+  double pilot_full_stroke = 5.0e6;
+  // Fraction of the spool stroke before the metering notch opens, per function (swing, boom, arm,
+  // bucket) and direction (estimate: ~0.75 MPa of a 5 MPa pilot; hydraulics.md: calibrated per
+  // machine and direction). Range [0, 0.9].
+  Vec4 dead_zone_extend = Vec4::Constant(0.15);
+  Vec4 dead_zone_retract = Vec4::Constant(0.15);
+  // Pa above the highest relief setting a chamber may reach before the plant's check stops it
+  // (a relief's override at full flow is ~relief_override). Range [0, 50e6].
+  double pressure_check_margin = 5.0e6;
+
+  // "" when every field is inside its range, else the first offending field, its value and range.
+  std::string validate() const;
+};
+
+// Energy bookkeeping of the circuit since reset (J). Pressures are gauge: the tank line at
+// tank_pressure exchanges p_tank Q with the chambers (tank_work). With E_oil the oil's compression
+// energy sum V p^2 / (2 beta), the circuit closes
+//   E_oil - E_oil(0) = pump_work + tank_work + vapour_work + volume_term - losses() - piston_work
+// exactly (chamber.hpp's discrete balance, trapezoidal pressures); piston_work is what the
+// cylinders and the swing motor did on the machine.
+struct HydraulicEnergy {
+  double stored = 0, stored0 = 0;   // E_oil now and at reset
+  double pump_work = 0;             // pump pressure x delivered flow
+  double tank_work = 0;             // p_tank x (make-up - return flow)
+  double vapour_work = 0;           // pressure x void volume (cavitation; 0 when the make-up keeps up)
+  double volume_term = 0;           // p0^2 / (2 beta) dV: the linear oil spring's term for a chamber
+                                    // whose volume changes (it is not a state function then)
+  double meter_in_loss = 0, meter_out_loss = 0, relief_loss = 0, makeup_loss = 0;
+  double piston_work = 0;           // sum of p dV of the moving chambers (the actuators' work on the machine)
+  double losses() const { return meter_in_loss + meter_out_loss + relief_loss + makeup_loss; }
+  // What entered the circuit from outside the machine's mechanism, net of its losses.
+  double supplied() const { return pump_work + tank_work + vapour_work + volume_term - losses(); }
+};
+
+// The circuit's state beyond the chamber pressures, for the plant's state and its checks.
+struct HydraulicReport {
+  Vec2 pump_pressure = Vec2::Zero();  // Pa, each pump (equal when merged)
+  Vec2 pump_flow = Vec2::Zero();      // m^3/s, each pump
+  Vec2 flow_scale = Vec2::Ones();     // flow-sharing factor of each pump (1: the demand is met)
+  Vec4 opening = Vec4::Zero();        // signed metering opening after the dead zone (-1..1)
+  Vec4 meter_in_flow = Vec4::Zero();  // m^3/s per function over the last substep
+  Vec4 meter_out_flow = Vec4::Zero();
+  Vec4 makeup_flow = Vec4::Zero();    // both chambers of the function together
+  Vec4 relief_flow = Vec4::Zero();
+  std::int64_t relief_substeps = 0;     // substeps with any relief flow
+  std::int64_t saturated_substeps = 0;  // substeps with a pump's demand above its flow
+  std::int64_t cavitation_substeps = 0; // substeps with a chamber held at the vapour floor
+  double min_pressure = 0, max_pressure = 0;  // Pa, over all chambers now
+  int solver_iterations = 0;            // of the eight chamber solves in the last substep
+  HydraulicEnergy energy;
+};
+
+class HydraulicCircuit {
+ public:
+  HydraulicCircuit() = default;
+  // Throws std::invalid_argument naming the field when the parameters are outside their ranges.
+  HydraulicCircuit(const Machine& machine, const ActuatorParameters& params);
+
+  // Chamber pressures that hold 'hold' (the lower side at twice tank pressure), spools centred.
+  void reset(const Vec4& q_a, const Vec4& hold);
+  // Spool targets: a signed opening per function (-1..1) or pilot pressures on each spool end (Pa).
+  void command_opening(const Vec4& opening);
+  void command_pilots(const Vec4& pilot_a, const Vec4& pilot_b);
+
+  // Advance spools, pumps and chambers over dt; q_a is the position at the end, qd_a the velocity
+  // over the substep (the piston sweeps A qd_a dt).
+  void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
+
+  Vec4 effort() const { return area_a_.cwiseProduct(p_a_) - area_b_.cwiseProduct(p_b_); }
+  const Vec4& spool() const { return spool_; }
+  const Vec4& pressure_a() const { return p_a_; }
+  const Vec4& pressure_b() const { return p_b_; }
+  const Vec4& area_a() const { return area_a_; }  // m^2; swing: displacement m^3/rad
+  const Vec4& area_b() const { return area_b_; }
+  const Vec4& meter_in_gain() const { return k_in_a_; }  // fully open, m^3/s/sqrt(Pa), into A (extend)
+  const HydraulicReport& report() const { return report_; }
+  const HydraulicParameters& parameters() const { return hp_; }
+  double main_relief() const { return main_relief_; }
+  double tank_pressure() const { return tank_; }
+  // The range the plant's check holds the chamber pressures to.
+  double pressure_floor() const { return hp_.vapour_pressure; }
+  double pressure_ceiling() const;
+  double stored_energy(const Vec4& q_a) const;
+
+ private:
+  double volume_a(int i, const Vec4& q_a) const;
+  double volume_b(int i, const Vec4& q_a) const;
+  void update_pump_report(const Vec4& load_a, const Vec4& load_b);
+
+  HydraulicParameters hp_;
+  double bulk_ = 1e9, dead_volume_ = 0, swing_volume_ = 0, tank_ = 0, laminar_ = 0, spool_tau_ = 0;
+  double main_relief_ = 0;
+  Vec4 q_min_ = Vec4::Zero(), q_max_ = Vec4::Zero();
+  Vec4 area_a_ = Vec4::Zero(), area_b_ = Vec4::Zero();
+  Vec4 k_in_a_ = Vec4::Zero(), k_in_b_ = Vec4::Zero(), k_out_a_ = Vec4::Zero(), k_out_b_ = Vec4::Zero();
+  Vec4 relief_setting_ = Vec4::Zero();
+  double k_relief_ = 0, k_makeup_ = 0;
+  Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();
+  Vec4 v_a_ = Vec4::Zero(), v_b_ = Vec4::Zero();  // chamber volumes at the end of the last substep
+  HydraulicReport report_;
+};
+
+}  // namespace exc::plant
