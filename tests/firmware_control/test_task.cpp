@@ -105,7 +105,7 @@ task:
 }
 
 TEST_CASE("firmware/task schema errors name the field and the allowed values") {
-  CHECK(error_of("task: {type: wiggle}").find("task.type | 'wiggle' (allowed: joint_waypoints, dig)") == 0);
+  CHECK(error_of("task: {type: wiggle}").find("task.type | 'wiggle' (allowed: joint_waypoints, dig, truck_loading)") == 0);
   CHECK(error_of("other: 1").find("task | missing") == 0);
   CHECK(error_of("task: {type: dig, path: [{t: 0, x: 8, z: 0.6, pitch_deg: 60}]}").find("task.path | must be a list of at least 2") == 0);
   CHECK(error_of("task: {type: dig, path: [{t: 0, x: 8, z: 0.6, pitch_deg: 60}, {t: 1, x: 8, z: 0.5, pitch: 60}]}")
