@@ -72,10 +72,13 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   }
 
   // Update law (eq. 27), explicit Euler at the control period, then the projection.
-  if (out.in_soil && out.saturated == 0 && in.actuator_limited == 0) {
+  const std::uint8_t off_dynamics = out.saturated | in.actuator_limited;  // joints not driven as commanded
+  if (out.in_soil && off_dynamics != 0x0F) {
     const Eigen::LDLT<Mat4> ldlt(M_a);
     const Mat4x6 Phi = ldlt.solve(Y);                       // M_a^-1 Y
-    const Vec4 BtPx = P_.bottomRows<4>() * z;               // B^T P x (or z)
+    Vec4 BtPx = P_.bottomRows<4>() * z;                     // B^T P x (or z)
+    for (int j = 0; j < 4; ++j)
+      if ((off_dynamics >> j) & 1u) BtPx[j] = 0;            // its error is the limit's, not the soil's
     const Vec6 theta_dot = -config_.adaptation_rate.cwiseProduct(Phi.transpose() * BtPx);
     theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
   }

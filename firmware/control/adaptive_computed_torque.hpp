@@ -15,7 +15,11 @@
 // - Update law integrated by explicit Euler at the control period, then projected onto
 //   [theta_min, theta_max] per parameter. Gamma is diagonal, so the clamp is the projection in the
 //   Gamma metric and V stays non-increasing.
-// - Adaptation frozen on any step whose effort saturated (the error dynamics above no longer hold).
+// - Saturation: a joint whose effort saturated (or whose command the actuator-lag stage clamped) does
+//   not follow the error dynamics above, so its error is left out of the update (its term of B^T P x
+//   is zeroed: P is block-diagonal per joint); the other joints keep adapting. Before, any saturated
+//   joint froze the whole update, so a swing at its torque limit (which the soil regressor does not
+//   even act on: J_t has no swing column) stopped the arm and bucket from learning the soil.
 // - rho_env: SoilAnchorEstimator on the controller's own rho (or given, in simulation tests).
 // - Tip acceleration for Y: rhodd = J_t qdd_a + Jd_t qd_a with qdd_a the filtered estimate
 //   (state_estimator.hpp) or qdd_d, by config (regressor_acceleration).

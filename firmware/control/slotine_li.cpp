@@ -46,8 +46,13 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
       if (config_.sl_adaptation_rate[i] > 0)
         out.lyapunov += 0.5 * tilde[i] * tilde[i] / config_.sl_adaptation_rate[i];
   }
-  if (out.in_soil && out.saturated == 0 && in.actuator_limited == 0) {
-    const Vec6 theta_dot = -config_.sl_adaptation_rate.cwiseProduct(Y.transpose() * s);
+  // A joint not driven as commanded (saturated, or clamped by the lag stage) is left out of the update.
+  const std::uint8_t off_dynamics = out.saturated | in.actuator_limited;
+  if (out.in_soil && off_dynamics != 0x0F) {
+    Vec4 s_used = s;
+    for (int j = 0; j < 4; ++j)
+      if ((off_dynamics >> j) & 1u) s_used[j] = 0;
+    const Vec6 theta_dot = -config_.sl_adaptation_rate.cwiseProduct(Y.transpose() * s_used);
     theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
   }
   return out;
