@@ -3,11 +3,15 @@
 #include <time.h>
 #include <unistd.h>
 
+#include <yaml-cpp/yaml.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 #include "allocation_counter.hpp"
@@ -45,9 +49,16 @@ double thread_cpu_seconds() {
 }  // namespace
 
 SceneBundle load_scene_bundle(const std::string& path) {
+  // The file is opened once; each side parses its own sections from the same text.
+  std::ifstream in(path);
+  if (!in) throw plant::SceneError(path, "", "cannot open the file");
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto slash = path.find_last_of('/');
+  const std::string directory = slash == std::string::npos ? "." : path.substr(0, slash);
   SceneBundle b;
-  b.scene = plant::load_scene(path);
-  b.firmware = app::load_firmware_settings(path);
+  b.scene = plant::load_scene_from_string(text.str(), path, directory);  // YAML syntax errors named here
+  b.firmware = app::parse_firmware_settings(YAML::Load(text.str()), path, directory);
   b.name = b.scene.name;
   return b;
 }

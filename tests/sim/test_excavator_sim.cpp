@@ -403,3 +403,23 @@ TEST_CASE("tools/excavator-sim truck loading: five cycles of all four actuators,
   CHECK(ad[1]["rms_error"]["bucket"].get<double>() < ad[0]["rms_error"]["bucket"].get<double>());
   CHECK(r.out.find("per work cycle") != std::string::npos);
 }
+
+TEST_CASE("tools/excavator-sim opens a scene file once per run, counted by strace") {
+  // Both sides (plant and firmware) read their sections from one reading of the file.
+  const Run r = run_sim("run " + kDig + " --duration 0.05 --quiet --no-report");
+  REQUIRE(r.status == 0);
+  const fs::path trace = r.dir / "opens.txt";
+  const std::string cmd = "strace -f -qq -e trace=open,openat -o '" + trace.string() + "' " + EXC_SIM_TOOL + " run " +
+                          kDig + " --duration 0.05 --quiet --no-report --out '" + (r.dir / "traced").string() + "' > /dev/null 2>&1";
+  REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, "strace (Debian package strace, installed by tools/install-deps test)");
+  std::ifstream in(trace);
+  std::string line;
+  int opens = 0, lines = 0;
+  while (std::getline(in, line)) {
+    ++lines;
+    if (line.find("scenes/dig.yaml\"") != std::string::npos && line.find("ENOENT") == std::string::npos) ++opens;
+  }
+  INFO(lines << " open calls traced");
+  CHECK(lines > 10);  // the trace is real: the loader, libraries and the log are opened too
+  CHECK(opens == 1);
+}
