@@ -2,6 +2,7 @@
 // sees, through the program itself (firmware and plant over the in-memory CAN bus).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -422,4 +423,35 @@ TEST_CASE("tools/excavator-sim opens a scene file once per run, counted by strac
   INFO(lines << " open calls traced");
   CHECK(lines > 10);  // the trace is real: the loader, libraries and the log are opened too
   CHECK(opens == 1);
+}
+
+TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to the same table as one process, case for case, and a missing shard's cases are named") {
+  const Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  {
+    std::string spec = read_text_file(std::string(EXC_SOURCE_DIR) + "/sweeps/dig_monte_carlo.yaml");
+    const auto replace = [&spec](const std::string& from, const std::string& to) {
+      const auto at = spec.find(from);
+      REQUIRE(at != std::string::npos);
+      spec.replace(at, from.size(), to);
+    };
+    replace("cases: 1000", "cases: 8");
+    replace("../scenes/dig.yaml", kDig);
+    std::ofstream(dir / "spec.yaml") << spec << "  duration: 0.3\n";
+  }
+  const std::string tool = EXC_SIM_TOOL;
+  const std::string in_dir = "cd '" + dir.string() + "' && ";
+  REQUIRE(std::system((in_dir + tool + " sweep spec.yaml --quiet --out one.jsonl > /dev/null 2>&1").c_str()) == 0);
+  REQUIRE(std::system((in_dir + tool + " sweep-merge spec.yaml one.jsonl --out single > /dev/null 2>&1").c_str()) == 0);
+  const int par = std::system((in_dir + "parallel -j2 " + tool + " sweep spec.yaml --quiet --shard {}/4 --out shard{}.jsonl ::: 0 1 2 3 > /dev/null 2>&1").c_str());
+  REQUIRE_MESSAGE(par == 0, "GNU parallel (Debian package parallel, installed by tools/install-deps test)");
+  REQUIRE(std::system((in_dir + tool + " sweep-merge spec.yaml shard0.jsonl shard1.jsonl shard2.jsonl shard3.jsonl --out merged > /dev/null 2>&1").c_str()) == 0);
+  const std::string single = read_text_file(dir / "single" / "sweep.csv");
+  CHECK(std::count(single.begin(), single.end(), '\n') == 1 + 8);  // header and one row per case
+  CHECK(read_text_file(dir / "merged" / "sweep.csv") == single);
+  // A shard that never ran: the merge fails and names its cases (1 and 5 of 8 in 4 shards).
+  const int partial = std::system((in_dir + tool + " sweep-merge spec.yaml shard0.jsonl shard2.jsonl shard3.jsonl --out partial > /dev/null 2>&1").c_str());
+  CHECK(partial != 0);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "partial" / "sweep.json"));
+  CHECK(j["missing"] == nlohmann::json::array({1, 5}));
 }

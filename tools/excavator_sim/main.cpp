@@ -18,6 +18,7 @@
 #include "paper_report.hpp"
 #include "run_report.hpp"
 #include "scene_job.hpp"
+#include "sweep.hpp"
 
 namespace fs = std::filesystem;
 
@@ -84,7 +85,48 @@ int main(int argc, char** argv) {
   paper->add_option("--duration", paper_duration, "simulated seconds of each scene (default: each scene's)")
       ->check(CLI::PositiveNumber);
   paper->add_flag("--quiet", paper_quiet, "no progress output");
+  auto* sweep = app.add_subcommand(
+      "sweep", "run a sweep's cases (all, or one shard of them for GNU parallel or a Slurm job array) into a JSON-lines "
+               "file; spec format: tools/excavator_sim/sweep.hpp and docs/sweeps.md");
+  std::string sweep_spec, sweep_shard = "0/1", sweep_out;
+  bool sweep_quiet = false;
+  sweep->add_option("spec", sweep_spec, "sweep spec (YAML)")->required();
+  sweep->add_option("--shard", sweep_shard, "I/N: run cases I, I+N, I+2N, ... (default 0/1: every case)");
+  sweep->add_option("--out", sweep_out, "the shard's result file (default: out/sweep/shard-I-of-N.jsonl)");
+  sweep->add_flag("--quiet", sweep_quiet, "no progress output");
+  auto* merge = app.add_subcommand("sweep-merge", "merge shard files into sweep.csv and sweep.json; names missing cases");
+  std::string merge_spec, merge_out = "out/sweep";
+  std::vector<std::string> merge_files;
+  merge->add_option("spec", merge_spec, "the sweep spec the shards ran")->required();
+  merge->add_option("shards", merge_files, "shard result files")->required();
+  merge->add_option("--out", merge_out, "output directory (default out/sweep)");
   CLI11_PARSE(app, argc, argv);
+
+  if (sweep->parsed() || merge->parsed()) {
+    try {
+      if (merge->parsed()) {
+        const exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(merge_spec);
+        std::vector<fs::path> files(merge_files.begin(), merge_files.end());
+        const bool complete = exc::sim::merge_sweep(spec, files, merge_out);
+        std::cout << "sweep: " << (fs::path(merge_out) / "sweep.csv").string() << (complete ? "" : " (cases missing)") << "\n";
+        return complete ? 0 : 1;
+      }
+      int shard = 0, shards = 1;
+      if (std::sscanf(sweep_shard.c_str(), "%d/%d", &shard, &shards) != 2 || shards < 1 || shard < 0 || shard >= shards) {
+        std::cerr << "excavator-sim sweep: --shard '" << sweep_shard << "': must be I/N with 0 <= I < N\n";
+        return 2;
+      }
+      const exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(sweep_spec);
+      if (sweep_out.empty())
+        sweep_out = (fs::path("out/sweep") / ("shard-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl")).string();
+      const int n = exc::sim::run_sweep_shard(spec, shard, shards, sweep_out, !sweep_quiet);
+      std::cout << "sweep shard " << shard << "/" << shards << ": " << n << " cases -> " << sweep_out << "\n";
+      return 0;
+    } catch (const std::exception& e) {
+      std::cerr << "excavator-sim: " << e.what() << "\n";
+      return 2;
+    }
+  }
 
   if (robust->parsed()) {
     try {

@@ -1,0 +1,205 @@
+#include "sweep.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+#include "control/config_fields.hpp"
+#include "control/controller_kinds.hpp"
+#include "harness/lockstep_run.hpp"
+
+namespace exc::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using control::ConfigError;
+
+SweepRange read_range(const YAML::Node& n, const std::string& file, const std::string& field, double lo, double hi) {
+  SweepRange r;
+  if (!n) return r;
+  if (!n.IsSequence() || n.size() != 2) throw ConfigError(file, field, "must be [min, max]");
+  r.min = control::read_number(n[0], file, field + "[0]", lo, hi);
+  r.max = control::read_number(n[1], file, field + "[1]", lo, hi);
+  if (r.max < r.min) throw ConfigError(file, field, "max is below min");
+  r.given = true;
+  return r;
+}
+
+double draw(std::mt19937_64& rng, const SweepRange& r, double fallback) {
+  if (!r.given) return fallback;
+  return r.min + (r.max - r.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+}
+
+nlohmann::json per_joint(const double (&v)[4]) {
+  return {{"swing", v[0]}, {"boom", v[1]}, {"arm", v[2]}, {"bucket", v[3]}};
+}
+
+}  // namespace
+
+SweepSpec load_sweep_spec(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path, "", "cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path, "", std::string("not valid YAML: ") + e.what());
+  }
+  const YAML::Node s = root["sweep"];
+  if (!s || !s.IsMap()) throw ConfigError(path, "sweep", "missing: the sweep's mapping");
+  control::reject_unknown_keys(s, path, "sweep", {"scene", "controllers", "cases", "seed", "duration", "perturbations"});
+  SweepSpec spec;
+  spec.file = path;
+  if (!s["scene"] || !s["scene"].IsScalar()) throw ConfigError(path, "sweep.scene", "missing: a scene file");
+  const std::string scene = s["scene"].as<std::string>();
+  const auto slash = path.find_last_of('/');
+  spec.scene_path = scene[0] == '/' || slash == std::string::npos ? scene : path.substr(0, slash + 1) + scene;
+  if (const YAML::Node c = s["controllers"]) {
+    if (!c.IsSequence() || c.size() == 0) throw ConfigError(path, "sweep.controllers", "must be a list of controller names");
+    spec.controllers.clear();
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      const std::string name = c[i].as<std::string>();
+      if (!control::controller_kind_named(name))
+        throw ConfigError(path, "sweep.controllers[" + std::to_string(i) + "]",
+                          "'" + name + "' (allowed: " + control::controller_kind_names() + ")");
+      spec.controllers.push_back(name);
+    }
+  }
+  if (s["cases"]) spec.cases = static_cast<int>(control::read_number(s["cases"], path, "sweep.cases", 1, 1e6));
+  if (s["seed"]) spec.seed = static_cast<unsigned>(control::read_number(s["seed"], path, "sweep.seed", 0, 4e9));
+  if (s["duration"]) spec.duration = control::read_number(s["duration"], path, "sweep.duration", 1e-3, 3600, "s");
+  if (const YAML::Node p = s["perturbations"]) {
+    control::reject_unknown_keys(p, path, "sweep.perturbations", {"model_mass", "soil_stiffness", "position_noise", "delay_cycles"});
+    spec.model_mass = read_range(p["model_mass"], path, "sweep.perturbations.model_mass", -0.9, 9);
+    spec.soil_stiffness = read_range(p["soil_stiffness"], path, "sweep.perturbations.soil_stiffness", 0.01, 100);
+    spec.position_noise = read_range(p["position_noise"], path, "sweep.perturbations.position_noise", 0, 0.1);
+    spec.delay_cycles = read_range(p["delay_cycles"], path, "sweep.perturbations.delay_cycles", 0, 100);
+  }
+  return spec;
+}
+
+SweepCase sweep_case(const SweepSpec& spec, int id) {
+  // One generator per case, seeded from (seed, id): independent of which shard runs the case.
+  std::seed_seq seq{spec.seed, static_cast<unsigned>(id), 0x5eedu};
+  std::mt19937_64 rng(seq);
+  SweepCase c;
+  c.id = id;
+  c.model_mass = draw(rng, spec.model_mass, 0);
+  c.soil_stiffness = draw(rng, spec.soil_stiffness, 1);
+  c.position_noise = draw(rng, spec.position_noise, 0);
+  c.delay_cycles = static_cast<int>(std::floor(draw(rng, spec.delay_cycles, 0) + (spec.delay_cycles.given ? 0.5 : 0)));
+  return c;
+}
+
+int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path& out, bool progress) {
+  const SceneBundle nominal = load_scene_bundle(spec.scene_path);
+  if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
+  std::ofstream file(out);
+  if (!file) throw std::runtime_error("cannot write " + out.string());
+  int done = 0;
+  for (int id = shard; id < spec.cases; id += shards) {
+    const SweepCase c = sweep_case(spec, id);
+    SceneBundle b = nominal;
+    for (BodyInertia& body : b.firmware.machine.bodies) {
+      body.mass *= 1 + c.model_mass;
+      body.inertia *= 1 + c.model_mass;
+    }
+    b.scene.soil.stiffness *= c.soil_stiffness;
+    b.scene.sensors.position_noise = Vec4::Constant(c.position_noise);
+    b.scene.sensors.latency_cycles = c.delay_cycles;
+    nlohmann::json line = {{"case", id},
+                           {"model_mass", c.model_mass},
+                           {"soil_stiffness", c.soil_stiffness},
+                           {"position_noise", c.position_noise},
+                           {"delay_cycles", c.delay_cycles}};
+    for (const std::string& name : spec.controllers) {
+      LockstepOptions o;
+      o.controller = *control::controller_kind_named(name);
+      o.duration = spec.duration;
+      const RunRecord r = run_lockstep(b.scene, b.firmware, o);
+      nlohmann::json run = {{"ok", r.ok}, {"rms_error", per_joint(r.rms_error)}, {"max_error", per_joint(r.max_error)}};
+      if (!r.ok) run["failure"] = r.failure;
+      line[name] = run;
+    }
+    file << line.dump() << "\n";
+    file.flush();  // a shard that dies keeps the cases it finished
+    ++done;
+    if (progress && done % 10 == 0)
+      std::fprintf(stderr, "sweep shard %d/%d: %d cases done\n", shard, shards, done);
+  }
+  return done;
+}
+
+bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files, const fs::path& out_dir) {
+  std::map<int, nlohmann::json> cases;
+  for (const fs::path& f : shard_files) {
+    std::ifstream in(f);
+    if (!in) throw std::runtime_error("cannot read shard file " + f.string());
+    std::string line;
+    int n = 0;
+    while (std::getline(in, line)) {
+      ++n;
+      if (line.empty()) continue;
+      nlohmann::json j;
+      try {
+        j = nlohmann::json::parse(line);
+      } catch (const nlohmann::json::exception&) {
+        // A shard killed mid-write leaves a torn last line: that case counts as missing.
+        std::fprintf(stderr, "sweep merge: %s line %d: not a complete record, ignored\n", f.string().c_str(), n);
+        continue;
+      }
+      cases[j["case"].get<int>()] = j;
+    }
+  }
+  fs::create_directories(out_dir);
+  std::ofstream csv(out_dir / "sweep.csv");
+  csv << "case,model_mass,soil_stiffness,position_noise,delay_cycles";
+  for (const std::string& c : spec.controllers)
+    csv << ',' << c << "_ok," << c << "_rms_boom," << c << "_rms_arm," << c << "_rms_bucket";
+  csv << "\n";
+  csv.precision(17);
+  std::vector<int> missing;
+  std::map<std::string, std::map<std::string, int>> failures;  // controller -> region -> count
+  for (int id = 0; id < spec.cases; ++id) {
+    const auto it = cases.find(id);
+    if (it == cases.end()) {
+      missing.push_back(id);
+      continue;
+    }
+    const nlohmann::json& j = it->second;
+    csv << id << ',' << j["model_mass"].get<double>() << ',' << j["soil_stiffness"].get<double>() << ','
+        << j["position_noise"].get<double>() << ',' << j["delay_cycles"].get<int>();
+    for (const std::string& c : spec.controllers) {
+      const nlohmann::json& r = j[c];
+      csv << ',' << (r["ok"].get<bool>() ? 1 : 0) << ',' << r["rms_error"]["boom"].get<double>() << ','
+          << r["rms_error"]["arm"].get<double>() << ',' << r["rms_error"]["bucket"].get<double>();
+      if (!r["ok"].get<bool>()) {
+        // The region of a failure: the perturbation that was largest relative to its range.
+        const double stiff = j["soil_stiffness"].get<double>(), mass = std::abs(j["model_mass"].get<double>());
+        const std::string region = stiff >= 2 ? "soil stiffness >= 2x" : mass >= 0.15 ? "model mass error >= 15 %"
+                                   : j["delay_cycles"].get<int>() >= 2 ? "delay >= 2 cycles" : "elsewhere";
+        ++failures[c][region];
+      }
+    }
+    csv << "\n";
+  }
+  nlohmann::json summary = {{"spec", spec.file}, {"cases", spec.cases}, {"merged", cases.size()},
+                            {"missing", missing}, {"failures", failures}};
+  std::ofstream(out_dir / "sweep.json") << summary.dump(2) << "\n";
+  if (!missing.empty()) {
+    std::fprintf(stderr, "sweep merge: %zu of %d cases missing (first: %d); rerun their shards\n", missing.size(),
+                 spec.cases, missing.front());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace exc::sim
