@@ -17,6 +17,7 @@
 #include "allocation_counter.hpp"
 #include "app/firmware_node.hpp"
 #include "app/tracking_metrics.hpp"
+#include "hal/fault_injecting_bus.hpp"
 #include "hal/memory_bus.hpp"
 #include "sim_plant/plant.hpp"
 #include "sim_plant/plant_node.hpp"
@@ -46,7 +47,52 @@ double thread_cpu_seconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+// The bus of one node end: frames go out through a fault injector while a burst is on.
+class BurstBus final : public hal::CanBus {
+ public:
+  BurstBus(hal::CanBus& inner, const hal::FaultInjection& faults) : inner_(inner), faulty_(inner, faults) {}
+  bool send(const hal::CanFrame& frame) override { return on_ ? faulty_.send(frame) : inner_.send(frame); }
+  bool receive(hal::CanFrame& frame) override { return inner_.receive(frame); }
+  bool wait_readable(std::int64_t timeout_ns) override { return inner_.wait_readable(timeout_ns); }
+  void set(bool on) {
+    if (on_ && !on) faulty_.release_delayed();
+    on_ = on;
+  }
+
+ private:
+  hal::CanBus& inner_;
+  hal::FaultInjectingBus faulty_;
+  bool on_ = false;
+};
+
+app::InjectedFault plant_fault_of(const FaultSchedule& f) {
+  app::InjectedFault p;
+  p.joint = f.joint;
+  p.magnitude = f.magnitude;
+  switch (f.kind) {
+    case FaultSchedule::Kind::sensor_freeze: p.kind = app::InjectedFault::Kind::sensor_freeze; break;
+    case FaultSchedule::Kind::sensor_jump: p.kind = app::InjectedFault::Kind::sensor_jump; break;
+    case FaultSchedule::Kind::actuator_loss: p.kind = app::InjectedFault::Kind::actuator_loss; break;
+    case FaultSchedule::Kind::actuator_jam: p.kind = app::InjectedFault::Kind::actuator_jam; break;
+    default: break;
+  }
+  return p;
+}
+
 }  // namespace
+
+const char* to_string(FaultSchedule::Kind kind) {
+  switch (kind) {
+    case FaultSchedule::Kind::none: return "none";
+    case FaultSchedule::Kind::bus_burst: return "bus_burst";
+    case FaultSchedule::Kind::sensor_freeze: return "sensor_freeze";
+    case FaultSchedule::Kind::sensor_jump: return "sensor_jump";
+    case FaultSchedule::Kind::actuator_loss: return "actuator_loss";
+    case FaultSchedule::Kind::actuator_jam: return "actuator_jam";
+    case FaultSchedule::Kind::rock: return "rock";
+  }
+  return "unknown";
+}
 
 SceneBundle load_scene_bundle(const std::string& path) {
   // The file is opened once; each side parses its own sections from the same text.
@@ -72,8 +118,16 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   hal::MemoryBusHub hub(&SimClock::read, &clock);
   hal::MemoryBusNode* firmware_bus = hub.attach();
   hal::MemoryBusNode* plant_bus = hub.attach();
-  hal::FirmwareCanPort firmware_port(*firmware_bus);
-  hal::PlantCanPort plant_port(*plant_bus);
+  // Both ends' frames pass through a burst injector (idle unless the fault schedule says so).
+  hal::FaultInjection burst;
+  const double share = options.fault.kind == FaultSchedule::Kind::bus_burst ? options.fault.magnitude / 3 : 0;
+  burst.drop_fraction = burst.corrupt_fraction = burst.delay_fraction = share;
+  burst.seed = options.fault.seed;
+  BurstBus firmware_end(*firmware_bus, burst);
+  burst.seed = options.fault.seed + 1;
+  BurstBus plant_end(*plant_bus, burst);
+  hal::FirmwareCanPort firmware_port(firmware_end);
+  hal::PlantCanPort plant_port(plant_end);
 
   std::unique_ptr<telemetry::TelemetryPublisher> publisher;
   if (options.telemetry) {
@@ -113,8 +167,19 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
     // allocations (LCM) are on another thread and not counted.
     test::AllocationCounter counter;
+    const FaultSchedule& fault = options.fault;
+    bool fault_on = false;
     for (std::int64_t k = 0; k < cycles; ++k) {
       clock.now_ns = k * period_ns;
+      const double now = static_cast<double>(k) * scene.cycle;
+      const bool want_fault = fault.kind != FaultSchedule::Kind::none && now >= fault.start && now < fault.start + fault.duration;
+      if (want_fault != fault_on) {
+        fault_on = want_fault;
+        firmware_end.set(fault_on && fault.kind == FaultSchedule::Kind::bus_burst);
+        plant_end.set(fault_on && fault.kind == FaultSchedule::Kind::bus_burst);
+        plant_node.set_fault(fault_on ? plant_fault_of(fault) : app::InjectedFault{});
+        if (fault.kind == FaultSchedule::Kind::rock) plant.set_soil_stiffness_scale(fault_on ? fault.magnitude : 1.0);
+      }
       node.begin_cycle();
       plant_node.poll();
       node.end_cycle();
@@ -137,6 +202,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         rec.peak_soil_force = std::max(rec.peak_soil_force, s.soil_force.norm());
         for (int i = 0; i < 6; ++i) rec.theta_hat[i] = node.last_output().theta_hat[i];
       }
+      if (result.first_safe_stop_time < 0 && node.safe_stops() > 0) result.first_safe_stop_time = s.time;
       if (options.observer) options.observer(k, plant, node);
       if (plant_node.failed()) break;
       if (options.stop_at_safe_state && node.safe_stops() > 0) break;

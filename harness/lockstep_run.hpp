@@ -81,9 +81,23 @@ struct RunRecord {
   std::uint64_t telemetry_enqueued = 0, telemetry_published = 0, telemetry_dropped = 0;
   std::size_t telemetry_ring_high_water = 0;
   std::vector<CycleRecord> cycles;    // per work cycle of the task
+  double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
   bool task_finished = false;         // the task ran to its end (then the machine held its final pose)
   double task_finish_time = 0;        // s
 };
+
+// One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
+struct FaultSchedule {
+  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock };
+  Kind kind = Kind::none;
+  double start = 0, duration = 0;  // s
+  int joint = 1;                   // sensor and actuator faults: 0 swing .. 3 bucket
+  // bus_burst: fraction of frames damaged (split evenly into dropped, corrupted, delayed);
+  // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x.
+  double magnitude = 0;
+  std::uint64_t seed = 1;
+};
+const char* to_string(FaultSchedule::Kind kind);
 
 struct LockstepOptions {
   control::ControllerKind controller = control::ControllerKind::adaptive;
@@ -92,6 +106,7 @@ struct LockstepOptions {
   std::shared_ptr<telemetry::LcmOutput> telemetry;
   bool progress = false;            // one line per tenth of the run on stderr
   bool stop_at_safe_state = false;  // end the run at the firmware's first safe stop (maps, sweeps)
+  FaultSchedule fault;
   // Called after every cycle (e.g. to sample the tip for a chart). Must not allocate in the loop.
   std::function<void(std::int64_t cycle, const plant::Plant&, const app::FirmwareNode&)> observer;
 };

@@ -51,6 +51,8 @@ class Plant {
   Plant(const Plant&) = delete;
   Plant& operator=(const Plant&) = delete;
 
+  // Fault injection (the fault campaign): the soil stiffer by `scale` from now on (1: the scene's).
+  void set_soil_stiffness_scale(double scale) { soil_.set_stiffness_scale(scale, scene_.soil); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.

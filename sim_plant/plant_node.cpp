@@ -78,6 +78,7 @@ void PlantNode::step(std::uint64_t cycle) {
   } else {
     for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
   }
+  apply_actuator_fault(actuator);
   const std::int64_t step_start = hal::monotonic_now_ns();
   plant_.step(actuator);
   step_timing_.record_ns(hal::monotonic_now_ns() - step_start);
@@ -94,6 +95,7 @@ void PlantNode::step(std::uint64_t cycle) {
     sensors_.pressure_b[c] = r.pressure_b[c];
     sensors_.pressure_valid[c] = hydraulic;
   }
+  apply_sensor_fault();
   sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
   sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
   if (!failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
@@ -132,6 +134,36 @@ void PlantNode::publish_counters() {
   exlcm::timing_t m{};
   fill_timing(step_timing_, 4, cs.utime, m);  // stage 4: the plant step
   telemetry_->publish(telemetry::Channel::timing, m);
+}
+
+void PlantNode::set_fault(const InjectedFault& fault) {
+  fault_ = fault;
+  fault_started_ = false;
+}
+
+void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
+  const int j = fault_.joint;
+  if (fault_.kind == InjectedFault::Kind::actuator_loss) {
+    actuator.value[j] *= 1 - fault_.magnitude;
+  } else if (fault_.kind == InjectedFault::Kind::actuator_jam) {
+    // A stuck actuator keeps what it applied when it stuck, whatever is commanded.
+    if (!fault_started_) jammed_effort_ = plant_.state().effort[j];
+    actuator.value[j] = jammed_effort_;
+  }
+  if (fault_.kind == InjectedFault::Kind::actuator_loss || fault_.kind == InjectedFault::Kind::actuator_jam)
+    fault_started_ = true;
+}
+
+void PlantNode::apply_sensor_fault() {
+  if (fault_.kind == InjectedFault::Kind::sensor_freeze) {
+    // A stuck encoder: the values of the moment it stuck, in frames that are otherwise valid.
+    if (!fault_started_) frozen_ = sensors_;
+    fault_started_ = true;
+    sensors_.position[fault_.joint] = frozen_.position[fault_.joint];
+    sensors_.velocity[fault_.joint] = 0;
+  } else if (fault_.kind == InjectedFault::Kind::sensor_jump) {
+    sensors_.position[fault_.joint] += fault_.magnitude;
+  }
 }
 
 }  // namespace exc::app

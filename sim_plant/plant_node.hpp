@@ -17,6 +17,15 @@ class TelemetryPublisher;
 
 namespace exc::app {
 
+// A fault injected into the simulated machine (the fault campaign): what a real machine's sensor or
+// actuator can do while the firmware cannot tell from the frames alone.
+struct InjectedFault {
+  enum class Kind : std::uint8_t { none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam };
+  Kind kind = Kind::none;
+  int joint = 0;          // 0 swing .. 3 bucket
+  double magnitude = 0;   // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost
+};
+
 struct PlantNodeConfig {
   int command_timeout_cycles = 20;  // cycles without a new valid command set -> hold
   double brake_rate = 40.0;         // 1/s, velocity decay rate of the model-based hold
@@ -38,6 +47,8 @@ class PlantNode {
   // repeats the frame (IfActive in the DBC).
   void hold_for_silence();
   bool holding() const { return holding_; }
+  // Starts (kind != none) or ends (none) an injected fault; takes effect from the next step.
+  void set_fault(const InjectedFault& fault);
   std::uint64_t holds() const { return holds_; }     // transitions into hold
   std::uint64_t steps() const { return steps_; }
   const plant::Plant& plant() const { return plant_; }
@@ -45,6 +56,8 @@ class PlantNode {
 
  private:
   void step(std::uint64_t cycle);
+  void apply_actuator_fault(plant::ActuatorCommand& actuator);
+  void apply_sensor_fault();
   // Efforts that brake the machine to rest where it is: g_a(q) - M_a * rate * qd_a.
   Vec4 hold_effort();
   void publish_state();
@@ -62,6 +75,10 @@ class PlantNode {
   bool silence_hold_ = false;
   std::uint64_t holds_ = 0;
   std::uint64_t steps_ = 0;
+  InjectedFault fault_;
+  bool fault_started_ = false;
+  hal::SensorState frozen_;       // sensor_freeze: what the stuck sensor keeps reporting
+  double jammed_effort_ = 0;      // actuator_jam: the effort the stuck actuator keeps applying
   control::PerfCounter step_timing_{"plant_step", 1000.0};
 };
 

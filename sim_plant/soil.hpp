@@ -1,4 +1,5 @@
 #pragma once
+#include <cmath>
 // Soil reaction at the bucket tip (paper eqs. 9-11, model.md s.5): a mass-spring-damper per axis
 // (x, z in the swing plane) anchored at rho_env, active only while the tip is below the terrain,
 // with the shear re-anchoring rho_env = rho when |rho_env - rho| > S_dist(h).
@@ -45,6 +46,11 @@ class SoilModel {
 
   const Terrain& terrain() const { return terrain_; }
   const SoilParameters& parameters() const { return params_; }
+  // A stiffer layer from now on (a rock in the ground: stiffness and damping scaled; 1 restores).
+  void set_stiffness_scale(double scale, const SoilParameters& nominal) {
+    params_.stiffness = nominal.stiffness * scale;
+    params_.damping = nominal.damping * std::sqrt(scale);
+  }
 
   // Depth h = terrain height - tip z (h > 0: in soil).
   double depth(const Vec2& rho) const { return terrain_.height_at(rho.x()) - rho.y(); }

@@ -455,3 +455,36 @@ TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to t
   const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "partial" / "sweep.json"));
   CHECK(j["missing"] == nlohmann::json::array({1, 5}));
 }
+
+TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a random fault ends tracking within its limits or in the safe state, none otherwise, every fault kind drawn") {
+  const Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  {
+    std::string spec = read_text_file(std::string(EXC_SOURCE_DIR) + "/sweeps/fault_campaign.yaml");
+    const auto replace = [&spec](const std::string& from, const std::string& to) {
+      const auto at = spec.find(from);
+      REQUIRE(at != std::string::npos);
+      spec.replace(at, from.size(), to);
+    };
+    replace("cases: 1000", "cases: 24");
+    replace("../scenes/dig.yaml", kDig);
+    std::ofstream(dir / "spec.yaml") << spec;
+  }
+  const std::string in_dir = "cd '" + dir.string() + "' && ";
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --out all.jsonl > /dev/null 2>&1").c_str()) == 0);
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep-merge spec.yaml all.jsonl --out merged > /dev/null 2>&1").c_str()) == 0);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "merged" / "sweep.json"));
+  int runs = 0, kinds = 0;
+  for (const char* c : {"pid", "adaptive"}) {
+    REQUIRE(j["campaign"].contains(c));
+    for (const auto& [kind, k] : j["campaign"][c].items()) {
+      INFO(c << " " << kind);
+      CHECK(k["neither"].get<int>() == 0);
+      CHECK(k["tracked"].get<int>() + k["safe_state"].get<int>() == k["runs"].get<int>());
+      runs += k["runs"].get<int>();
+      ++kinds;
+    }
+  }
+  CHECK(runs == 2 * 24);
+  CHECK(kinds == 2 * 6);
+}

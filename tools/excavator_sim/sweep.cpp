@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -38,6 +39,22 @@ double draw(std::mt19937_64& rng, const SweepRange& r, double fallback) {
   return r.min + (r.max - r.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
 }
 
+}  // namespace
+
+std::optional<FaultSchedule::Kind> fault_kind_named(const std::string& name) {
+  for (const FaultSchedule::Kind k : {FaultSchedule::Kind::bus_burst, FaultSchedule::Kind::sensor_freeze,
+                                      FaultSchedule::Kind::sensor_jump, FaultSchedule::Kind::actuator_loss,
+                                      FaultSchedule::Kind::actuator_jam, FaultSchedule::Kind::rock})
+    if (name == to_string(k)) return k;
+  return std::nullopt;
+}
+
+std::string fault_kind_names() {
+  return "bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock";
+}
+
+namespace {
+
 nlohmann::json per_joint(const double (&v)[4]) {
   return {{"swing", v[0]}, {"boom", v[1]}, {"arm", v[2]}, {"bucket", v[3]}};
 }
@@ -55,7 +72,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
   }
   const YAML::Node s = root["sweep"];
   if (!s || !s.IsMap()) throw ConfigError(path, "sweep", "missing: the sweep's mapping");
-  control::reject_unknown_keys(s, path, "sweep", {"scene", "controllers", "cases", "seed", "duration", "perturbations"});
+  control::reject_unknown_keys(s, path, "sweep", {"scene", "controllers", "cases", "seed", "duration", "perturbations", "faults"});
   SweepSpec spec;
   spec.file = path;
   if (!s["scene"] || !s["scene"].IsScalar()) throw ConfigError(path, "sweep.scene", "missing: a scene file");
@@ -83,6 +100,15 @@ SweepSpec load_sweep_spec(const std::string& path) {
     spec.position_noise = read_range(p["position_noise"], path, "sweep.perturbations.position_noise", 0, 0.1);
     spec.delay_cycles = read_range(p["delay_cycles"], path, "sweep.perturbations.delay_cycles", 0, 100);
   }
+  if (const YAML::Node f = s["faults"]) {
+    if (!f.IsSequence()) throw ConfigError(path, "sweep.faults", "must be a list of fault kinds");
+    for (std::size_t i = 0; i < f.size(); ++i) {
+      const std::string kind = f[i].as<std::string>();
+      if (!fault_kind_named(kind))
+        throw ConfigError(path, "sweep.faults[" + std::to_string(i) + "]", "'" + kind + "' (allowed: " + fault_kind_names() + ")");
+      spec.faults.push_back(kind);
+    }
+  }
   return spec;
 }
 
@@ -96,6 +122,22 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
   c.soil_stiffness = draw(rng, spec.soil_stiffness, 1);
   c.position_noise = draw(rng, spec.position_noise, 0);
   c.delay_cycles = static_cast<int>(std::floor(draw(rng, spec.delay_cycles, 0) + (spec.delay_cycles.given ? 0.5 : 0)));
+  if (!spec.faults.empty()) {
+    // The fault's kind, then when, how long, where and how large (ranges in docs/sweeps.md).
+    const auto pick = std::uniform_int_distribution<std::size_t>(0, spec.faults.size() - 1)(rng);
+    c.fault = spec.faults[pick];
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    c.fault_start = 1.0 + 5.0 * u(rng);
+    c.fault_duration = 0.05 + 0.95 * u(rng);
+    c.fault_joint = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
+    const double x = u(rng);
+    const FaultSchedule::Kind kind = *fault_kind_named(c.fault);
+    c.fault_magnitude = kind == FaultSchedule::Kind::bus_burst     ? 0.2 + 0.7 * x
+                        : kind == FaultSchedule::Kind::sensor_jump  ? 0.02 + 0.3 * x
+                        : kind == FaultSchedule::Kind::actuator_loss ? 0.3 + 0.7 * x
+                        : kind == FaultSchedule::Kind::rock         ? 5 + 45 * x
+                                                                    : 0;
+  }
   return c;
 }
 
@@ -120,13 +162,28 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
                            {"soil_stiffness", c.soil_stiffness},
                            {"position_noise", c.position_noise},
                            {"delay_cycles", c.delay_cycles}};
+    if (c.fault != "none")
+      line["fault"] = {{"kind", c.fault}, {"start", c.fault_start}, {"duration", c.fault_duration},
+                       {"joint", c.fault_joint}, {"magnitude", c.fault_magnitude}};
     for (const std::string& name : spec.controllers) {
       LockstepOptions o;
       o.controller = *control::controller_kind_named(name);
       o.duration = spec.duration;
+      if (c.fault != "none") {
+        o.fault.kind = *fault_kind_named(c.fault);
+        o.fault.start = c.fault_start;
+        o.fault.duration = c.fault_duration;
+        o.fault.joint = c.fault_joint;
+        o.fault.magnitude = c.fault_magnitude;
+        o.fault.seed = spec.seed * 1000003ull + static_cast<std::uint64_t>(id);
+      }
       const RunRecord r = run_lockstep(b.scene, b.firmware, o);
       nlohmann::json run = {{"ok", r.ok}, {"rms_error", per_joint(r.rms_error)}, {"max_error", per_joint(r.max_error)}};
       if (!r.ok) run["failure"] = r.failure;
+      // The outcome the campaign counts: tracked, safe state (and when), or neither.
+      const bool plant_failed = r.failure.rfind("plant stopped", 0) == 0;
+      run["outcome"] = r.ok ? "tracked" : r.first_safe_stop_time >= 0 && !plant_failed ? "safe_state" : "neither";
+      if (r.first_safe_stop_time >= 0) run["safe_state_time"] = r.first_safe_stop_time;
       line[name] = run;
     }
     file << line.dump() << "\n";
@@ -168,6 +225,7 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
   csv.precision(17);
   std::vector<int> missing;
   std::map<std::string, std::map<std::string, int>> failures;  // controller -> region -> count
+  nlohmann::json campaign = nlohmann::json::object();           // controller -> fault kind -> outcomes
   for (int id = 0; id < spec.cases; ++id) {
     const auto it = cases.find(id);
     if (it == cases.end()) {
@@ -181,6 +239,19 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
       const nlohmann::json& r = j[c];
       csv << ',' << (r["ok"].get<bool>() ? 1 : 0) << ',' << r["rms_error"]["boom"].get<double>() << ','
           << r["rms_error"]["arm"].get<double>() << ',' << r["rms_error"]["bucket"].get<double>();
+      if (j.contains("fault")) {
+        const std::string kind = j["fault"]["kind"].get<std::string>();
+        nlohmann::json& k = campaign[c][kind];
+        if (k.is_null()) k = {{"runs", 0}, {"tracked", 0}, {"safe_state", 0}, {"neither", 0}, {"worst_time_to_safe_state", nullptr}};
+        k["runs"] = k["runs"].get<int>() + 1;
+        const std::string outcome = r.value("outcome", r["ok"].get<bool>() ? "tracked" : "neither");
+        k[outcome] = k[outcome].get<int>() + 1;
+        if (outcome == "safe_state" && r.contains("safe_state_time")) {
+          const double dt = r["safe_state_time"].get<double>() - j["fault"]["start"].get<double>();
+          if (k["worst_time_to_safe_state"].is_null() || dt > k["worst_time_to_safe_state"].get<double>())
+            k["worst_time_to_safe_state"] = dt;
+        }
+      }
       if (!r["ok"].get<bool>()) {
         // The region of a failure: the perturbation that was largest relative to its range.
         const double stiff = j["soil_stiffness"].get<double>(), mass = std::abs(j["model_mass"].get<double>());
@@ -192,7 +263,7 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
     csv << "\n";
   }
   nlohmann::json summary = {{"spec", spec.file}, {"cases", spec.cases}, {"merged", cases.size()},
-                            {"missing", missing}, {"failures", failures}};
+                            {"missing", missing}, {"failures", failures}, {"campaign", campaign}};
   std::ofstream(out_dir / "sweep.json") << summary.dump(2) << "\n";
   if (!missing.empty()) {
     std::fprintf(stderr, "sweep merge: %zu of %d cases missing (first: %d); rerun their shards\n", missing.size(),

@@ -13,12 +13,18 @@
 //       soil_stiffness: [0.5, 3]      # the plant's soil K x value
 //       position_noise: [0, 1e-4]     # m (rad on the swing), 1 sigma
 //       delay_cycles: [0, 2]          # whole cycles, drawn as integers
+//     faults: [bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock]
+//                                     # the fault campaign: one fault per case, its kind drawn from
+//                                     # the list, its start, length, joint and size drawn too
 //
 // Case i's perturbation depends on (seed, i) only, so a shard computes exactly the cases a single
 // process would, and any set of shard files merges into the same table.
 #include <filesystem>
 #include <string>
+#include <optional>
 #include <vector>
+
+#include "harness/lockstep_run.hpp"
 
 namespace exc::sim {
 
@@ -35,14 +41,22 @@ struct SweepSpec {
   unsigned seed = 1;
   double duration = 0;
   SweepRange model_mass, soil_stiffness, position_noise, delay_cycles;
+  std::vector<std::string> faults;  // fault kinds to draw from (empty: no fault)
 };
 
 SweepSpec load_sweep_spec(const std::string& path);
+
+// The fault kinds a campaign may draw (FaultSchedule's, by name).
+std::optional<FaultSchedule::Kind> fault_kind_named(const std::string& name);
+std::string fault_kind_names();
 
 struct SweepCase {
   int id = 0;
   double model_mass = 0, soil_stiffness = 1, position_noise = 0;
   int delay_cycles = 0;
+  std::string fault = "none";
+  double fault_start = 0, fault_duration = 0, fault_magnitude = 0;
+  int fault_joint = 0;
 };
 SweepCase sweep_case(const SweepSpec& spec, int id);
 
