@@ -86,14 +86,7 @@ FirmwareSettings parse_firmware_settings(const YAML::Node& root, const std::stri
 }
 
 FirmwareSettings load_firmware_settings(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw control::ConfigError(path, "", "cannot open the file");
-  } catch (const YAML::Exception& e) {
-    throw control::ConfigError(path, "", std::string("not valid YAML: ") + e.what());
-  }
+  const YAML::Node root = control::load_yaml_file(path);
   return parse_firmware_settings(root, path, directory_of(path));
 }
 

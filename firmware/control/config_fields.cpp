@@ -42,4 +42,14 @@ void reject_unknown_keys(const YAML::Node& n, const std::string& file, const std
   }
 }
 
+YAML::Node load_yaml_file(const std::string& path) {
+  try {
+    return YAML::LoadFile(path);
+  } catch (const YAML::BadFile&) {
+    throw ConfigError(path, "", "cannot open the file");
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(path, "", std::string("not valid YAML: ") + e.what());
+  }
+}
+
 }  // namespace exc::control

@@ -7,11 +7,12 @@
 
 #include "control/config_error.hpp"
 
-namespace YAML {
-class Node;
-}
+#include <yaml-cpp/yaml.h>
 
 namespace exc::control {
+
+// The YAML document of a file; ConfigError "cannot open the file" or "not valid YAML: ..." naming it.
+YAML::Node load_yaml_file(const std::string& path);
 
 // A number as errors print it (shortest of %g style, e.g. 1e+06, 0.02).
 std::string format_number(double v);

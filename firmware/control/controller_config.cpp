@@ -144,14 +144,7 @@ void validate(const ControllerConfig& c, const std::string& file) {
 }
 
 ControllerConfig load_controller_config(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path, "", "cannot open the file");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path, "", std::string("not valid YAML: ") + e.what());
-  }
+  const YAML::Node root = load_yaml_file(path);
   return parse_controller_config(root["controller"], path);
 }
 

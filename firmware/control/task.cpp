@@ -150,14 +150,7 @@ Task parse_task(const YAML::Node& node, const std::string& file, const Machine& 
 }
 
 Task load_task(const std::string& scene_path, const Machine& machine, const TrajectoryCheckOptions& options) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(scene_path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(scene_path, "", "cannot open the file");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(scene_path, "", std::string("not valid YAML: ") + e.what());
-  }
+  const YAML::Node root = load_yaml_file(scene_path);
   return parse_task(root["task"], scene_path, machine, options);
 }
 

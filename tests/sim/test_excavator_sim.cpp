@@ -66,6 +66,19 @@ fs::path edited_dig(const std::string& from, const std::string& to, const std::s
 }
 const char* const kJoints[4] = {"swing", "boom", "arm", "bucket"};
 
+// A shipped sweep spec with fewer cases, the shipped dig scene by absolute path and `extra` lines
+// appended to the sweep's mapping, written to `to`.
+void write_sweep_spec(const std::string& shipped, int cases, const std::string& extra, const fs::path& to) {
+  std::string spec = read_text_file(std::string(EXC_SOURCE_DIR) + "/sweeps/" + shipped);
+  for (const auto& [from, with] : {std::pair<std::string, std::string>{"cases: 1000", "cases: " + std::to_string(cases)},
+                                  std::pair<std::string, std::string>{"../scenes/dig.yaml", kDig}}) {
+    const auto at = spec.find(from);
+    REQUIRE(at != std::string::npos);
+    spec.replace(at, from.size(), with);
+  }
+  std::ofstream(to) << spec << extra;
+}
+
 // Per channel of an LCM log: messages and their sequence numbers. Every exlcm type begins with the
 // 8-byte fingerprint, int64 utime and int64 seq (big-endian, LCM's wire format), so the sequence is
 // read from the bytes as the .lcm files define them, without the generated code.
@@ -428,17 +441,7 @@ TEST_CASE("tools/excavator-sim opens a scene file once per run, counted by strac
 TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to the same table as one process, case for case, and a missing shard's cases are named") {
   const Run setup = run_sim("--help");
   const fs::path dir = setup.dir;
-  {
-    std::string spec = read_text_file(std::string(EXC_SOURCE_DIR) + "/sweeps/dig_monte_carlo.yaml");
-    const auto replace = [&spec](const std::string& from, const std::string& to) {
-      const auto at = spec.find(from);
-      REQUIRE(at != std::string::npos);
-      spec.replace(at, from.size(), to);
-    };
-    replace("cases: 1000", "cases: 8");
-    replace("../scenes/dig.yaml", kDig);
-    std::ofstream(dir / "spec.yaml") << spec << "  duration: 0.3\n";
-  }
+  write_sweep_spec("dig_monte_carlo.yaml", 8, "  duration: 0.3\n", dir / "spec.yaml");
   const std::string tool = EXC_SIM_TOOL;
   const std::string in_dir = "cd '" + dir.string() + "' && ";
   REQUIRE(std::system((in_dir + tool + " sweep spec.yaml --quiet --out one.jsonl > /dev/null 2>&1").c_str()) == 0);
@@ -459,17 +462,7 @@ TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to t
 TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a random fault ends tracking within its limits or in the safe state, none otherwise, every fault kind drawn") {
   const Run setup = run_sim("--help");
   const fs::path dir = setup.dir;
-  {
-    std::string spec = read_text_file(std::string(EXC_SOURCE_DIR) + "/sweeps/fault_campaign.yaml");
-    const auto replace = [&spec](const std::string& from, const std::string& to) {
-      const auto at = spec.find(from);
-      REQUIRE(at != std::string::npos);
-      spec.replace(at, from.size(), to);
-    };
-    replace("cases: 1000", "cases: 24");
-    replace("../scenes/dig.yaml", kDig);
-    std::ofstream(dir / "spec.yaml") << spec;
-  }
+  write_sweep_spec("fault_campaign.yaml", 24, "", dir / "spec.yaml");
   const std::string in_dir = "cd '" + dir.string() + "' && ";
   REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --out all.jsonl > /dev/null 2>&1").c_str()) == 0);
   REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep-merge spec.yaml all.jsonl --out merged > /dev/null 2>&1").c_str()) == 0);

@@ -62,14 +62,7 @@ nlohmann::json per_joint(const double (&v)[4]) {
 }  // namespace
 
 SweepSpec load_sweep_spec(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    throw ConfigError(path, "", "cannot open the file");
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(path, "", std::string("not valid YAML: ") + e.what());
-  }
+  const YAML::Node root = control::load_yaml_file(path);
   const YAML::Node s = root["sweep"];
   if (!s || !s.IsMap()) throw ConfigError(path, "sweep", "missing: the sweep's mapping");
   control::reject_unknown_keys(s, path, "sweep", {"scene", "controllers", "cases", "seed", "duration", "perturbations", "faults"});
