@@ -53,6 +53,7 @@ def sim_table(runs):
     for q in ("median", "p99", "max"):
         row("control step %s (us)" % q, lambda r, q=q: "%.1f" % r["control_step_us"][q])
     row("heap allocations in the loop", lambda r: "%d" % r["heap_allocations_in_loop"])
+    row("telemetry messages (dropped)", lambda r: "%d (%d)" % (r["telemetry"]["published"], r["telemetry"]["dropped"]))
     row("simulated (s)", lambda r: "%.3g" % r["simulated_seconds"])
     for name in ("M_x", "B_x", "K_x", "M_z", "B_z", "K_z"):
         row("soil estimate %s (true)" % name,
