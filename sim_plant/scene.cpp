@@ -250,7 +250,7 @@ Scene parse(const YAML::Node& root, const std::string& file, const std::string& 
   i.implicit_max_iterations = static_cast<int>(integ.number("implicit_max_iterations", 1, 100, i.implicit_max_iterations));
   i.implicit_tolerance = integ.number("implicit_tolerance", 1e-14, 1e-3, i.implicit_tolerance);
 
-  s.duration = top.number("duration", 1e-3, 3600, 10.0, true);
+  s.duration = top.number("duration", 1e-3, 28800, 10.0, true);  // up to a working shift (8 h)
 
   // Sensors.
   const Section sens = top.sub("sensors");

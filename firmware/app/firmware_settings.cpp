@@ -77,7 +77,7 @@ FirmwareSettings parse_firmware_settings(const YAML::Node& root, const std::stri
   s.terrain_height = s.machine.terrain_flat_height;
   if (const YAML::Node terrain = root["terrain"]; terrain && terrain["height"])
     s.terrain_height = control::read_number(terrain["height"], file, "terrain.height", -20, 20, "m");
-  s.duration = control::read_number(root["duration"], file, "duration", 1e-3, 3600, "s");
+  s.duration = control::read_number(root["duration"], file, "duration", 1e-3, 28800, "s");  // a working shift
   s.controller = control::parse_controller_config(root["controller"], file);
   if (!root["task"]) throw ConfigError(file, "task", "missing: the firmware needs a task");
   s.task = control::parse_task(root["task"], file, s.machine);
