@@ -9,7 +9,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "message_fields.hpp"
+#include "message_fields.hpp"  // generated from the .lcm files by message_fields.cmake
 
 namespace exc::log {
 
