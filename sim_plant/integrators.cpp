@@ -29,6 +29,66 @@ const char* to_string(Formulation f) {
   return "?";
 }
 
+namespace {
+
+// One step of the configured method on one coordinate set: V is Vec4 (the independent formulation,
+// accelerations in Evaluation::qdd_a) or Vec12 (the augmented ones, Evaluation::qdd). The step starts
+// at (q0, v0), where `start` was evaluated, and ends in (q, v). evaluate(q, v) gives the dynamics at
+// a state; correct(e, r, dw) gives the implicit midpoint's update dw of its midpoint velocity from the
+// residual r at evaluation e (false: singular).
+template <class V, class Evaluate, class Correct>
+StepOutcome advance(const IntegratorSettings& settings, double h, const V& q0, const V& v0, const Evaluation& start,
+                    V Evaluation::*acceleration, Evaluate&& evaluate, Correct&& correct, V& q, V& v) {
+  StepOutcome out;
+  switch (settings.method) {
+    case IntegrationMethod::semi_implicit_euler: {
+      v = v0 + h * (start.*acceleration);
+      q = q0 + h * v;
+      break;
+    }
+    case IntegrationMethod::rk4: {
+      const V k1v = start.*acceleration, k1q = v0;
+      Evaluation e = evaluate(q0 + 0.5 * h * k1q, v0 + 0.5 * h * k1v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const V k2v = e.*acceleration, k2q = v0 + 0.5 * h * k1v;
+      e = evaluate(q0 + 0.5 * h * k2q, v0 + 0.5 * h * k2v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const V k3v = e.*acceleration, k3q = v0 + 0.5 * h * k2v;
+      e = evaluate(q0 + h * k3q, v0 + h * k3v);
+      if (!e.report.ok()) return out.report = e.report, out;
+      const V k4v = e.*acceleration, k4q = v0 + h * k3v;
+      q = q0 + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q);
+      v = v0 + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
+      break;
+    }
+    case IntegrationMethod::implicit_midpoint: {
+      // Unknown: the midpoint velocity w, with w = v0 + h/2 a(q0 + h/2 w, w).
+      V w = v0 + 0.5 * h * (start.*acceleration);
+      out.converged = false;
+      for (int it = 0; it < settings.implicit_max_iterations; ++it) {
+        const Evaluation e = evaluate(q0 + 0.5 * h * w, w);
+        if (!e.report.ok()) return out.report = e.report, out;
+        const V r = w - v0 - 0.5 * h * (e.*acceleration);
+        out.iterations = it + 1;
+        V dw;
+        if (!correct(e, r, dw)) return out.report = ModelReport{ModelStatus::singular, -1, 0}, out;
+        w += dw;
+        if (r.template lpNorm<Eigen::Infinity>() <
+            settings.implicit_tolerance * (1.0 + w.template lpNorm<Eigen::Infinity>())) {
+          out.converged = true;
+          break;
+        }
+      }
+      q = q0 + h * w;
+      v = 2.0 * w - v0;
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 Integrator::Integrator(const Model& model, const IntegratorSettings& settings)
     : model_(&model), settings_(settings) {}
 
@@ -143,57 +203,21 @@ StepOutcome Integrator::step_independent(Workspace& ws, const SoilModel& soil, c
   const Vec4 q0 = s.q_a, v0 = s.qd_a;
   start = evaluate_independent(ws, soil, tau, q0, v0);
   if (!start.report.ok()) return out.report = start.report, out;
-  switch (settings_.method) {
-    case IntegrationMethod::semi_implicit_euler: {
-      s.qd_a = v0 + h * start.qdd_a;
-      s.q_a = q0 + h * s.qd_a;
-      break;
+  const auto evaluate = [&](const Vec4& q, const Vec4& v) { return evaluate_independent(ws, soil, tau, q, v); };
+  // Implicit midpoint: Newton with the Jacobian I + h/2 A^-1 J_t^T (B_t + h/2 K_t) J_t, exact for the
+  // soil (the stiff part), the rigid-body terms left to the iteration.
+  const auto newton = [&](const Evaluation& e, const Vec4& r, Vec4& dw) {
+    Mat4 jac = last_effective_mass_;
+    if (e.load.added_mass.any() || e.load.force.any()) {
+      const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
+      jac += 0.5 * h * last_J_t_.transpose() * c.asDiagonal() * last_J_t_;
     }
-    case IntegrationMethod::rk4: {
-      const Vec4 k1v = start.qdd_a, k1q = v0;
-      Evaluation e = evaluate_independent(ws, soil, tau, q0 + 0.5 * h * k1q, v0 + 0.5 * h * k1v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const Vec4 k2v = e.qdd_a, k2q = v0 + 0.5 * h * k1v;
-      e = evaluate_independent(ws, soil, tau, q0 + 0.5 * h * k2q, v0 + 0.5 * h * k2v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const Vec4 k3v = e.qdd_a, k3q = v0 + 0.5 * h * k2v;
-      e = evaluate_independent(ws, soil, tau, q0 + h * k3q, v0 + h * k3v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const Vec4 k4v = e.qdd_a, k4q = v0 + h * k3v;
-      s.q_a = q0 + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q);
-      s.qd_a = v0 + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
-      break;
-    }
-    case IntegrationMethod::implicit_midpoint: {
-      // Unknown: the midpoint velocity w, with w = v0 + h/2 a(q0 + h/2 w, w). Newton with the Jacobian
-      // I + h/2 A^-1 J_t^T (B_t + h/2 K_t) J_t: exact for the soil (the stiff part), the rigid-body
-      // terms left to the iteration.
-      Vec4 w = v0 + 0.5 * h * start.qdd_a;
-      out.converged = false;
-      for (int it = 0; it < settings_.implicit_max_iterations; ++it) {
-        const Evaluation e = evaluate_independent(ws, soil, tau, q0 + 0.5 * h * w, w);
-        if (!e.report.ok()) return out.report = e.report, out;
-        const Vec4 r = w - v0 - 0.5 * h * e.qdd_a;
-        out.iterations = it + 1;
-        Mat4 jac = last_effective_mass_;
-        if (e.load.added_mass.any() || e.load.force.any()) {
-          const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
-          jac += 0.5 * h * last_J_t_.transpose() * c.asDiagonal() * last_J_t_;
-        }
-        const Eigen::LLT<Mat4> llt(jac);
-        const Vec4 dw = -llt.solve(last_effective_mass_ * r);
-        if (!dw.allFinite()) return out.report = ModelReport{ModelStatus::singular, -1, 0}, out;
-        w += dw;
-        if (r.lpNorm<Eigen::Infinity>() < settings_.implicit_tolerance * (1.0 + w.lpNorm<Eigen::Infinity>())) {
-          out.converged = true;
-          break;
-        }
-      }
-      s.q_a = q0 + h * w;
-      s.qd_a = 2.0 * w - v0;
-      break;
-    }
-  }
+    const Eigen::LLT<Mat4> llt(jac);
+    dw = -llt.solve(last_effective_mass_ * r);
+    return dw.allFinite();
+  };
+  out = advance(settings_, h, q0, v0, start, &Evaluation::qdd_a, evaluate, newton, s.q_a, s.qd_a);
+  if (!out.report.ok()) return out;
   if (!s.q_a.allFinite() || !s.qd_a.allFinite()) out.report = ModelReport{ModelStatus::non_finite_input, -1, 0};
   return out;
 }
@@ -204,76 +228,43 @@ StepOutcome Integrator::step_augmented(Workspace& ws, const SoilModel& soil, con
   const Vec12 q0 = s.q, v0 = s.qd;
   start = evaluate_augmented(ws, soil, tau, q0, v0);
   if (!start.report.ok()) return out.report = start.report, out;
-  switch (settings_.method) {
-    case IntegrationMethod::semi_implicit_euler: {
-      s.qd = v0 + h * start.qdd;
-      s.q = q0 + h * s.qd;
-      break;
+  // Implicit midpoint: a chord iteration whose Jacobian is frozen at the step's start: on the
+  // constraint manifold (range of Psi) it is the independent-coordinate one with the soil's stiffness
+  // and damping, A^-1 (A + h/2 J_t^T (B + h/2 K) J_t); off the manifold the identity (plain fixed point).
+  const bool soil_active = settings_.method == IntegrationMethod::implicit_midpoint &&
+                           (start.load.added_mass.any() || start.load.force.any());
+  Mat12x4 Psi = Mat12x4::Zero();
+  Mat4 A = Mat4::Identity();
+  Eigen::LLT<Mat4> llt;
+  if (soil_active) {
+    Vec4 qa0, va0;
+    for (int k = 0; k < kNumActive; ++k) {
+      qa0[k] = q0[kActiveJoints[k]];
+      va0[k] = v0[kActiveJoints[k]];
     }
-    case IntegrationMethod::rk4: {
-      const Vec12 k1v = start.qdd, k1q = v0;
-      Evaluation e = evaluate_augmented(ws, soil, tau, q0 + 0.5 * h * k1q, v0 + 0.5 * h * k1v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const Vec12 k2v = e.qdd, k2q = v0 + 0.5 * h * k1v;
-      e = evaluate_augmented(ws, soil, tau, q0 + 0.5 * h * k2q, v0 + 0.5 * h * k2v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const Vec12 k3v = e.qdd, k3q = v0 + 0.5 * h * k2v;
-      e = evaluate_augmented(ws, soil, tau, q0 + h * k3q, v0 + h * k3v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const Vec12 k4v = e.qdd, k4q = v0 + h * k3v;
-      s.q = q0 + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q);
-      s.qd = v0 + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
-      break;
-    }
-    case IntegrationMethod::implicit_midpoint: {
-      // Chord iteration on the midpoint velocity w = v0 + h/2 a(q0 + h/2 w, w). Its Jacobian is frozen
-      // at the step's start: on the constraint manifold (range of Psi) it is the independent-
-      // coordinate one with the soil's stiffness and damping, A^-1 (A + h/2 J_t^T (B + h/2 K) J_t);
-      // off the manifold the identity (plain fixed point).
-      Vec12 w = v0 + 0.5 * h * start.qdd;
-      const bool soil_active = start.load.added_mass.any() || start.load.force.any();
-      Mat12x4 Psi = Mat12x4::Zero();
-      Mat4 A = Mat4::Identity(), N = Mat4::Identity();
-      if (soil_active) {
-        Vec4 qa0, va0;
-        for (int k = 0; k < kNumActive; ++k) {
-          qa0[k] = q0[kActiveJoints[k]];
-          va0[k] = v0[kActiveJoints[k]];
-        }
-        const ModelReport r = update_closed_chain(*model_, ws, qa0, va0);
-        cache_valid_ = false;
-        if (!r.ok()) return out.report = r, out;
-        mass_matrix(*model_, ws, A);
-        A += ws.J_t.transpose() * start.load.added_mass.asDiagonal() * ws.J_t;
-        const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
-        N = A + 0.5 * h * ws.J_t.transpose() * c.asDiagonal() * ws.J_t;
-        Psi = ws.Psi;
-      }
-      const Eigen::LLT<Mat4> llt(N);
-      out.converged = false;
-      for (int it = 0; it < settings_.implicit_max_iterations; ++it) {
-        const Evaluation e = evaluate_augmented(ws, soil, tau, q0 + 0.5 * h * w, w);
-        if (!e.report.ok()) return out.report = e.report, out;
-        const Vec12 r = w - v0 - 0.5 * h * e.qdd;
-        out.iterations = it + 1;
-        Vec12 dw = -r;
-        if (soil_active) {
-          Vec4 r_a;
-          for (int k = 0; k < kNumActive; ++k) r_a[k] = r[kActiveJoints[k]];
-          const Vec4 dw_a = -llt.solve(A * r_a);
-          dw = -(r - Psi * r_a) + Psi * dw_a;
-        }
-        w += dw;
-        if (r.lpNorm<Eigen::Infinity>() < settings_.implicit_tolerance * (1.0 + w.lpNorm<Eigen::Infinity>())) {
-          out.converged = true;
-          break;
-        }
-      }
-      s.q = q0 + h * w;
-      s.qd = 2.0 * w - v0;
-      break;
-    }
+    const ModelReport r = update_closed_chain(*model_, ws, qa0, va0);
+    cache_valid_ = false;
+    if (!r.ok()) return out.report = r, out;
+    mass_matrix(*model_, ws, A);
+    A += ws.J_t.transpose() * start.load.added_mass.asDiagonal() * ws.J_t;
+    const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
+    const Mat4 N = A + 0.5 * h * ws.J_t.transpose() * c.asDiagonal() * ws.J_t;
+    llt.compute(N);
+    Psi = ws.Psi;
   }
+  const auto evaluate = [&](const Vec12& q, const Vec12& v) { return evaluate_augmented(ws, soil, tau, q, v); };
+  const auto chord = [&](const Evaluation&, const Vec12& r, Vec12& dw) {
+    dw = -r;
+    if (soil_active) {
+      Vec4 r_a;
+      for (int k = 0; k < kNumActive; ++k) r_a[k] = r[kActiveJoints[k]];
+      const Vec4 dw_a = -llt.solve(A * r_a);
+      dw = -(r - Psi * r_a) + Psi * dw_a;
+    }
+    return true;
+  };
+  out = advance(settings_, h, q0, v0, start, &Evaluation::qdd, evaluate, chord, s.q, s.qd);
+  if (!out.report.ok()) return out;
   if (!s.q.allFinite() || !s.qd.allFinite()) return out.report = ModelReport{ModelStatus::non_finite_input, -1, 0}, out;
   for (int k = 0; k < kNumActive; ++k) {
     s.q_a[k] = s.q[kActiveJoints[k]];
