@@ -27,6 +27,23 @@ def num(x):
     return v
 
 
+def decorate(ax, xlabel, ylabel, title=None, legend=None):
+    """A panel's axis labels, title, a grid on major and minor ticks and (a font size) its legend."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    if title:
+        ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    if legend:
+        ax.legend(fontsize=legend)
+
+
+def save(fig, out, name):
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, name), dpi=110)
+    plt.close(fig)
+
+
 def work_precision(out):
     data = rows(os.path.join(out, "work_precision.csv"))
     scenes = sorted({r["scene"] for r in data})
@@ -34,7 +51,7 @@ def work_precision(out):
                ("energy_drift_J", "energy drift max (J)")]
     fig, axes = plt.subplots(len(scenes), len(metrics), figsize=(6 * len(metrics), 4.8 * len(scenes)), squeeze=False)
     for i, scene in enumerate(scenes):
-        for j, (key, label) in enumerate(metrics):
+        for j, (key, name) in enumerate(metrics):
             ax = axes[i][j]
             for method in sorted({r["method"] for r in data if r["scene"] == scene}):
                 pts = [(num(r["cpu_s_per_sim_s"]), num(r[key])) for r in data
@@ -46,14 +63,9 @@ def work_precision(out):
                            if r["scene"] == scene and r["pareto"] == "1" and key == "tip_rms_m")
             if front:
                 ax.loglog(*zip(*front), "k--", lw=1.5, label="Pareto front")
-            ax.set_xlabel("CPU time per simulated second (s)")
-            ax.set_ylabel(label)
-            ax.set_title(f"{scene}: {label}")
-            ax.grid(True, which="both", alpha=0.3)
+            decorate(ax, "CPU time per simulated second (s)", name, f"{scene}: {name}")
         axes[i][0].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "work_precision.png"), dpi=110)
-    plt.close(fig)
+    save(fig, out, "work_precision.png")
 
 
 def fidelity(out):
@@ -68,21 +80,16 @@ def fidelity(out):
             ax.loglog([x], [y], style, ms=12 if style == "*" else 7,
                       label=r["fidelity"] + (" (recommended)" if r["recommended"] == "1" else ""))
         ax.axhline(0.01, color="grey", ls="--", lw=1, label="tolerance 10 mm")
-        ax.set_xlabel("CPU time per simulated second (s)")
-        ax.set_ylabel("tip path RMS against the most complete model (m)")
-        ax.set_title(f"fidelity: {scene}")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "fidelity.png"), dpi=110)
-    plt.close(fig)
+        decorate(ax, "CPU time per simulated second (s)", "tip path RMS against the most complete model (m)",
+                 f"fidelity: {scene}", legend=7)
+    save(fig, out, "fidelity.png")
 
 
 def stability(out):
     data = rows(os.path.join(out, "stability_step.csv"))
     axes_names = [("soil_stiffness_N_per_m", "soil stiffness K_t (N/m)"), ("joint_speed_factor", "joint speed factor")]
     fig, axes = plt.subplots(1, 2, figsize=(14, 5))
-    for ax, (axis, label) in zip(axes, axes_names):
+    for ax, (axis, name) in zip(axes, axes_names):
         for method in sorted({r["method"] for r in data}):
             pts = [(num(r["value"]), num(r["largest_stable_step_s"])) for r in data
                    if r["method"] == method and r["axis"] == axis]
@@ -91,14 +98,9 @@ def stability(out):
                 ax.semilogy(*zip(*pts), marker="o", ms=4, label=method)
         if axis == "soil_stiffness_N_per_m":
             ax.set_xscale("log")
-        ax.set_xlabel(label)
-        ax.set_ylabel("largest stable step (s); 1e-6 = none")
-        ax.set_title(f"largest stable step against {label}")
-        ax.grid(True, which="both", alpha=0.3)
+        decorate(ax, name, "largest stable step (s); 1e-6 = none", f"largest stable step against {name}")
     axes[0].legend(fontsize=6)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "stability_step.png"), dpi=110)
-    plt.close(fig)
+    save(fig, out, "stability_step.png")
 
     data = rows(os.path.join(out, "stability_control.csv"))
     axis_list = sorted({r["axis"] for r in data})
@@ -120,13 +122,8 @@ def stability(out):
         ax.set_yscale("log")
         if axis in ("gain_scale", "adaptation_scale"):
             ax.set_xscale("log")
-        ax.set_xlabel(axis)
-        ax.set_ylabel("worst joint tracking RMS (m / rad); x = failed")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "stability_control.png"), dpi=110)
-    plt.close(fig)
+        decorate(ax, axis, "worst joint tracking RMS (m / rad); x = failed", legend=7)
+    save(fig, out, "stability_control.png")
 
 
 def peer(out):
@@ -135,21 +132,16 @@ def peer(out):
     fig, axes = plt.subplots(1, max(1, len(scenes)), figsize=(7 * max(1, len(scenes)), 5), squeeze=False)
     for ax, scene in zip(axes[0], scenes):
         sel = [r for r in data if r["scene"] == scene]
-        for key, label, style in (("reference", "fine-step reference", "k-"), ("plant", "plant, Euler 1 ms", "b--"),
-                                  ("mujoco", "MuJoCo, Euler 1 ms", "r:")):
+        for key, name, style in (("reference", "fine-step reference", "k-"), ("plant", "plant, Euler 1 ms", "b--"),
+                                 ("mujoco", "MuJoCo, Euler 1 ms", "r:")):
             xs = [num(r[key + "_x"]) for r in sel]
             zs = [num(r[key + "_z"]) for r in sel]
             if any(not math.isnan(v) for v in xs):
-                ax.plot(xs, zs, style, label=label)
-        ax.set_xlabel("tip radius from the swing axis (m)")
-        ax.set_ylabel("tip height (m)")
-        ax.set_title(f"tip path, same efforts: {scene}")
+                ax.plot(xs, zs, style, label=name)
         ax.axis("equal")
-        ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "peer.png"), dpi=110)
-    plt.close(fig)
+        decorate(ax, "tip radius from the swing axis (m)", "tip height (m)", f"tip path, same efforts: {scene}",
+                 legend=8)
+    save(fig, out, "peer.png")
 
 
 def main():
