@@ -42,12 +42,31 @@ def new_figure(plt, rows, cols, title):
     return fig, axes
 
 
-def save(fig, out_dir, name, written):
-    path = os.path.join(out_dir, name)
+def save(plt, fig, out_dir, name, written):
     fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(path, dpi=FIG_DPI)  # no bbox_inches: keep the exact pixel size
+    fig.savefig(os.path.join(out_dir, name), dpi=FIG_DPI)  # no bbox_inches: keep the exact pixel size
     written.append(name)
-    return path
+    plt.close(fig)
+
+
+def decorate(ax, xlabel, ylabel=None, title=None, legend=True, **legend_options):
+    """A panel's labels and title, a light grid and (legend=True) its legend."""
+    if title is not None:
+        ax.set_title(title)
+    ax.set_xlabel(xlabel)
+    if ylabel is not None:
+        ax.set_ylabel(ylabel)
+    ax.grid(True, alpha=0.3)
+    if legend:
+        ax.legend(loc="best", **legend_options)
+
+
+def plot_runs(ax, runs, channel, values):
+    """One line per run that logged `channel`: values(its columns) against time, labelled by the run."""
+    for label, channels in runs.items():
+        columns = channels.get(channel, {})
+        if columns:
+            ax.plot(seconds(columns), values(columns), label=label)
 
 
 def plot_tracking(plt, runs, out_dir, written):
@@ -62,46 +81,26 @@ def plot_tracking(plt, runs, out_dir, written):
                         label="desired")
             if state:
                 ax.plot(seconds(state), state["q_active_%d" % j], color="tab:blue", label="actual")
-            ax.set_title(label)
-            ax.set_xlabel("time [s]")
-            ax.set_ylabel("%s %s" % (joint, unit))
-            ax.grid(True, alpha=0.3)
-            ax.legend(loc="best")
-        save(fig, out_dir, "tracking_%s.png" % joint, written)
-        plt.close(fig)
+            decorate(ax, "time [s]", "%s %s" % (joint, unit), title=label)
+        save(plt, fig, out_dir, "tracking_%s.png" % joint, written)
 
 
 def plot_errors(plt, runs, out_dir, written):
     fig, axes = new_figure(plt, 2, 2, "Tracking error e = q - q_d")
     for j, (joint, unit) in enumerate(JOINTS):
         ax = axes[j // 2][j % 2]
-        for label, channels in runs.items():
-            ctrl = channels.get("EXC_CONTROLLER", {})
-            if ctrl:
-                ax.plot(seconds(ctrl), ctrl["error_%d" % j], label=label)
-        ax.set_title(joint)
-        ax.set_xlabel("time [s]")
-        ax.set_ylabel("error, %s" % unit)
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best")
-    save(fig, out_dir, "tracking_error.png", written)
-    plt.close(fig)
+        plot_runs(ax, runs, "EXC_CONTROLLER", lambda ctrl: ctrl["error_%d" % j])
+        decorate(ax, "time [s]", "error, %s" % unit, title=joint)
+    save(plt, fig, out_dir, "tracking_error.png", written)
 
 
 def plot_soil_force(plt, runs, out_dir, written):
     fig, axes = new_figure(plt, 2, 1, "Soil force at the bucket tip (swing plane)")
     for a, axis_name in enumerate(("x", "z")):
         ax = axes[a][0]
-        for label, channels in runs.items():
-            state = channels.get("EXC_STATE", {})
-            if state:
-                ax.plot(seconds(state), [f * 1e-3 for f in state["soil_force_%d" % a]], label=label)
-        ax.set_ylabel("F_soil %s [kN]" % axis_name)
-        ax.set_xlabel("time [s]")
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best")
-    save(fig, out_dir, "soil_force.png", written)
-    plt.close(fig)
+        plot_runs(ax, runs, "EXC_STATE", lambda state: [f * 1e-3 for f in state["soil_force_%d" % a]])
+        decorate(ax, "time [s]", "F_soil %s [kN]" % axis_name)
+    save(plt, fig, out_dir, "soil_force.png", written)
 
 
 def plot_soil_estimates(plt, runs, out_dir, written):
@@ -120,12 +119,8 @@ def plot_soil_estimates(plt, runs, out_dir, written):
             truth = ctrl["theta_true_%d" % i]
             if any(not math.isnan(v) for v in truth):
                 ax.plot(t, truth, "--", color=line.get_color(), alpha=0.7)
-        ax.set_title(name)
-        ax.set_xlabel("time [s]")
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best", fontsize="small")
-    save(fig, out_dir, "soil_estimates.png", written)
-    plt.close(fig)
+        decorate(ax, "time [s]", title=name, fontsize="small")
+    save(plt, fig, out_dir, "soil_estimates.png", written)
 
 
 def plot_timing(plt, runs, out_dir, written):
@@ -154,14 +149,9 @@ def plot_timing(plt, runs, out_dir, written):
             intervals = [b - a for a, b in zip(stamps, stamps[1:])]
             ax.hist(intervals, bins=64, alpha=0.5, label="%s: logged state interval" % label)
             drawn = True
-    ax.set_xlabel("duration [us]")
-    ax.set_ylabel("cycles")
     ax.set_yscale("log")
-    ax.grid(True, alpha=0.3)
-    if drawn:
-        ax.legend(loc="best")
-    save(fig, out_dir, "loop_timing.png", written)
-    plt.close(fig)
+    decorate(ax, "duration [us]", "cycles", legend=drawn)
+    save(plt, fig, out_dir, "loop_timing.png", written)
 
 
 def plot_robustness(plt, path, out_dir):
@@ -196,7 +186,7 @@ def plot_robustness(plt, path, out_dir):
         ax.grid(True, axis="y", which="both", alpha=0.3)
         ax.legend(fontsize=8)
     written = []
-    save(fig, out_dir, "robustness.png", written)
+    save(plt, fig, out_dir, "robustness.png", written)
     return written
 
 
@@ -224,10 +214,6 @@ def plot_work_cycles(plt, summary, out_dir, written):
             xs = list(range(1, len(rows) + 1))
             ys = [1e3 * r["rms_error"][joint] if joint else 1e-3 * r["peak_soil_force"] for r in rows]
             ax.plot(xs, ys, "o-", label=controller)
-        ax.set_xlabel("cycle")
-        ax.set_ylabel(label)
         ax.set_xticks(range(1, max(len(r) for r in cycles.values()) + 1))
-        ax.grid(True, alpha=0.3)
-        ax.legend(loc="best")
-    save(fig, out_dir, "work_cycles.png", written)
-    plt.close(fig)
+        decorate(ax, "cycle", label)
+    save(plt, fig, out_dir, "work_cycles.png", written)
