@@ -9,6 +9,7 @@
 #include "control/state_estimator.hpp"
 #include "control/task.hpp"
 #include "scenes.hpp"
+#include "tracking_run.hpp"
 
 using namespace exc;
 using namespace exc::control;
@@ -145,13 +146,7 @@ TEST_CASE("firmware/adaptive: the projection keeps every soil estimate inside it
       noise_q[j] = pos_noise(rng);
       noise_v[j] = vel_noise(rng);
     }
-    est.update(plant.q() + noise_q, plant.qd() + noise_v);
-    ControlInput in;
-    in.t = t;
-    in.q = est.position();
-    in.qd = est.velocity();
-    in.qdd = est.acceleration();
-    task.trajectory.evaluate(t, in.q_d, in.qd_d, in.qdd_d);
+    const ControlInput in = sim::estimated_input(est, plant.q() + noise_q, plant.qd() + noise_v, task, t);
     const TipLoad load = plant.soil_load();
     const ControlOutput out = ctrl.update(in);
     const Vec6& th = ctrl.theta_hat();

@@ -17,6 +17,19 @@ struct TrackingResult {
   bool ok = true;
 };
 
+// The law's input at time t as the firmware builds it (app/firmware_node.cpp): the estimator updated
+// with the measured q, qd, and the task's desired motion at t.
+inline ControlInput estimated_input(StateEstimator& est, const Vec4& q, const Vec4& qd, const Task& task, double t) {
+  est.update(q, qd);
+  ControlInput in;
+  in.t = t;
+  in.q = est.position();
+  in.qd = est.velocity();
+  in.qdd = est.acceleration();
+  task.trajectory.evaluate(t, in.q_d, in.qd_d, in.qdd_d);
+  return in;
+}
+
 inline TrackingResult run_tracking(const Model& model, const Task& task, ControllerKind kind,
                                    const ControllerConfig& cfg, const SoilTruth& soil) {
   auto ctrl = make_controller(kind, model, cfg);
@@ -30,13 +43,7 @@ inline TrackingResult run_tracking(const Model& model, const Task& task, Control
   const int steps = static_cast<int>((task.end_time() + 1.0) / cfg.period);
   for (int k = 0; k < steps; ++k) {
     const double t = task.start_time() + k * cfg.period;
-    est.update(plant.q(), plant.qd());
-    ControlInput in;
-    in.t = t;
-    in.q = est.position();
-    in.qd = est.velocity();
-    in.qdd = est.acceleration();
-    task.trajectory.evaluate(t, in.q_d, in.qd_d, in.qdd_d);
+    ControlInput in = estimated_input(est, plant.q(), plant.qd(), task, t);
     in.soil.terrain_height = soil.terrain_height;
     const TipLoad load = plant.soil_load();
     const ControlOutput out = ctrl->update(in);
