@@ -30,12 +30,16 @@ usage() {
 Usage: two_process.sh --vcan-vm PATH --plant PATH --firmware PATH --sim PATH --capture-check PATH
                       --scene FILE --work DIR [--duration S] [--watchdog-cycles N]
                       [--scenario all|run|kill-plant|kill-firmware|realtime] [--timeout S]
+                      [--decode-check COMMAND]
 Runs the two-process scenarios (see the head of this file) inside vcan-vm, in one VM.
   --work DIR          output directory (made writable in the VM): captures, program output, JSON
   --duration S        simulated seconds of the run scenario (default 3)
   --watchdog-cycles N the firmware's watchdog in cycles (default 20: 20 ms at 1 kHz); the safe
                       stop must come within N + 2 cycles of the plant's last frame
   --timeout S         wall-clock limit for the whole VM run (default 280)
+  --decode-check CMD  after the VM, on the host: run CMD (split into words) with each scenario's
+                      capture.log as its last argument; a non-zero exit fails the run (used with
+                      tests/vcan/canmatrix_decode.py, an independent DBC decoder)
   realtime            (not in all) excavator-firmware --realtime at a period the VM holds (10 ms:
                       exit 0, ok, tracked, no overrun) and at one it cannot (0.25 ms: exit 1, ok false,
                       the missed deadlines named); the real programs only
@@ -44,7 +48,7 @@ arguments; otherwise vcan-vm's (124 timeout, 125 VM failure).
 EOF
 }
 
-vcan_vm="" plant="" firmware="" sim="" capture_check="" scene="" work=""
+vcan_vm="" plant="" firmware="" sim="" capture_check="" scene="" work="" decode_check=""
 duration=3 watchdog_cycles=20 scenario=all timeout_s=280 inside=0
 while [ $# -gt 0 ]; do
   case $1 in
@@ -54,6 +58,7 @@ while [ $# -gt 0 ]; do
     --firmware) firmware=$2; shift 2 ;;
     --sim) sim=$2; shift 2 ;;
     --capture-check) capture_check=$2; shift 2 ;;
+    --decode-check) decode_check=$2; shift 2 ;;
     --scene) scene=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
     --duration) duration=$2; shift 2 ;;
@@ -82,9 +87,26 @@ if [ "$inside" = 0 ]; then
   # Absolute paths: the scenarios run in the work directory.
   plant=$(realpath "$plant") firmware=$(realpath "$firmware") sim=$(realpath "$sim")
   capture_check=$(realpath "$capture_check") scene=$(realpath "$scene")
-  exec "$vcan_vm" --timeout "$timeout_s" --share "$work" -- "$self" --inside \
+  "$vcan_vm" --timeout "$timeout_s" --share "$work" -- "$self" --inside \
     --plant "$plant" --firmware "$firmware" --sim "$sim" --capture-check "$capture_check" \
     --scene "$scene" --work "$work" --duration "$duration" --watchdog-cycles "$watchdog_cycles" --scenario "$scenario"
+  rc=$?
+  [ -n "$decode_check" ] && [ $rc -le 1 ] || exit $rc
+  # The second decoder, on the host (fast there, slow in the emulated VM), on every capture this run
+  # wrote: it must read every frame as the DBC defines it.
+  current=decode
+  case $scenario in all) dirs="run kill_plant kill_firmware" ;; realtime) dirs="" ;; *) dirs=${scenario/-/_} ;; esac
+  for d in $dirs; do
+    log=$work/$d/capture.log
+    [ -f "$log" ] || { echo "FAIL [decode]: no capture $log"; rc=1; continue; }
+    # shellcheck disable=SC2086  # the command line is split into words on purpose
+    if $decode_check "$log" > "$work/$d/decode_check.out" 2>&1; then
+      echo "[decode] $(grep -m1 'frames decoded' "$work/$d/decode_check.out")"
+    else
+      echo "FAIL [decode]: $log does not decode against the DBC:"; sed -n '1,20p' "$work/$d/decode_check.out"; rc=1
+    fi
+  done
+  exit $rc
 fi
 
 # ---- inside the VM (or on a host with vcan) -----------------------------------------------------
