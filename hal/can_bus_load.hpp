@@ -14,7 +14,8 @@
 // (17 bits up to 16 data bytes, 21 above) with a fixed stuff bit before the stuff count and after every
 // 4 bits: 27 or 32 bits whatever the content. Then CRC delimiter, ACK, ACK delimiter, EOF 7 and the
 // intermission 3. With the worst-case stuffing this is the kernel's can_frame_bits(fd, sff, worst,
-// intermission, n) (include/linux/can/length.h, Linux 6.6): 67 bits for n = 0, 712 for n = 64.
+// intermission, n) (include/linux/can/length.h as reworked in 2023): 67 bits for n = 0, 712 for
+// n = 64.
 //
 // With bit-rate switch the bits from ESI to the end of the CRC run at the data rate, the rest at the
 // nominal (arbitration) rate. The switch really happens at the sample points of BRS and of the CRC

@@ -58,7 +58,7 @@ CycleTime worst_cycle(const std::vector<exc::test::DbcMessage>& dbc, int command
 }
 
 // The kernel's worst-case length of a standard CAN FD frame with intermission, written out from
-// include/linux/can/length.h (Linux 6.6): can_bitstuffing_len(22 + 8 n) + CRC field with delimiter
+// include/linux/can/length.h (as reworked in 2023): can_bitstuffing_len(22 + 8 n) + CRC field with delimiter
 // (28 bits up to 16 bytes, else 33) + ACK, ACK delimiter, EOF (9) + intermission (3).
 int kernel_canfd_frame_bits(int n) {
   const int destuffed = 22 + 8 * n;
