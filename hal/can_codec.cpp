@@ -20,19 +20,6 @@ struct Crc8Table {
 };
 constexpr Crc8Table kCrc8Table;
 
-std::uint64_t load_le64(const CanFrame& frame) {
-  std::uint64_t word = 0;
-  for (int i = 7; i >= 0; --i) word = (word << 8) | frame.data[i];
-  return word;
-}
-
-void store_le64(CanFrame& frame, std::uint64_t word) {
-  for (int i = 0; i < 8; ++i) {
-    frame.data[i] = static_cast<std::uint8_t>(word & 0xFF);
-    word >>= 8;
-  }
-}
-
 std::uint64_t mask_of(unsigned length) { return length >= 64 ? ~0ULL : ((1ULL << length) - 1); }
 
 }  // namespace
@@ -52,14 +39,33 @@ std::uint8_t frame_checksum(std::uint32_t id, const std::uint8_t* payload, std::
 }
 
 std::uint64_t read_raw_bits(const CanFrame& frame, unsigned start, unsigned length) {
-  return (load_le64(frame) >> start) & mask_of(length);
+  if (length == 0 || length > 64 || start + length > 8u * kCanFdMaxLength) return 0;
+  std::uint64_t raw = 0;
+  unsigned got = 0;
+  while (got < length) {
+    const unsigned bit = start + got;
+    const unsigned offset = bit % 8;
+    const unsigned take = (8 - offset) < (length - got) ? (8 - offset) : (length - got);
+    const std::uint64_t chunk = (frame.data[bit / 8] >> offset) & mask_of(take);
+    raw |= chunk << got;
+    got += take;
+  }
+  return raw;
 }
 
 void write_raw_bits(CanFrame& frame, unsigned start, unsigned length, std::uint64_t raw) {
-  const std::uint64_t mask = mask_of(length) << start;
-  std::uint64_t word = load_le64(frame);
-  word = (word & ~mask) | ((raw << start) & mask);
-  store_le64(frame, word);
+  if (length == 0 || length > 64 || start + length > 8u * kCanFdMaxLength) return;
+  unsigned put = 0;
+  while (put < length) {
+    const unsigned bit = start + put;
+    const unsigned offset = bit % 8;
+    const unsigned take = (8 - offset) < (length - put) ? (8 - offset) : (length - put);
+    const auto field = static_cast<std::uint8_t>(mask_of(take) << offset);
+    const auto value = static_cast<std::uint8_t>(((raw >> put) & mask_of(take)) << offset);
+    std::uint8_t& byte = frame.data[bit / 8];
+    byte = static_cast<std::uint8_t>((byte & ~field) | value);
+    put += take;
+  }
 }
 
 EncodeReport encode_signal(CanFrame& frame, const SignalSpec& signal, double value) {
@@ -97,7 +103,9 @@ double decode_signal(const CanFrame& frame, const SignalSpec& signal) {
 
 EncodeReport encode_message(const MessageSpec& message, std::uint8_t counter, const double* values, CanFrame& out) {
   out.id = message.id;
-  out.dlc = message.dlc;
+  out.len = message.length;
+  out.fd = message.fd;
+  out.brs = message.brs;
   for (auto& byte : out.data) byte = 0;
   out.timestamp_ns = 0;
   EncodeReport report;
@@ -107,7 +115,7 @@ EncodeReport encode_message(const MessageSpec& message, std::uint8_t counter, co
     report.saturated = static_cast<std::uint8_t>(report.saturated + one.saturated);
     report.non_finite = static_cast<std::uint8_t>(report.non_finite + one.non_finite);
   }
-  out.data[message.dlc - 1] = frame_checksum(out.id, out.data, message.dlc - 1u);
+  out.data[message.length - 1] = frame_checksum(out.id, out.data, message.length - 1u);
   return report;
 }
 
@@ -121,7 +129,7 @@ const char* to_string(RxVerdict verdict) {
   switch (verdict) {
     case RxVerdict::ok: return "ok";
     case RxVerdict::unknown_id: return "unknown_id";
-    case RxVerdict::wrong_dlc: return "wrong_dlc";
+    case RxVerdict::wrong_format: return "wrong_format";
     case RxVerdict::corrupt: return "corrupt";
     case RxVerdict::repeated: return "repeated";
     case RxVerdict::stale: return "stale";
@@ -133,7 +141,7 @@ void RxStats::record(RxVerdict verdict) {
   switch (verdict) {
     case RxVerdict::ok: ++ok; break;
     case RxVerdict::unknown_id: ++unknown_id; break;
-    case RxVerdict::wrong_dlc: ++wrong_dlc; break;
+    case RxVerdict::wrong_format: ++wrong_format; break;
     case RxVerdict::corrupt: ++corrupt; break;
     case RxVerdict::repeated: ++repeated; break;
     case RxVerdict::stale: ++stale; break;
@@ -153,9 +161,9 @@ RxVerdict CanFrameCodec::accept(const CanFrame& frame, const MessageSpec*& messa
     verdict = RxVerdict::unknown_id;
   } else {
     const MessageSpec& spec = protocol_messages()[static_cast<std::size_t>(index)];
-    if (frame.dlc != spec.dlc) {
-      verdict = RxVerdict::wrong_dlc;
-    } else if (frame.data[spec.dlc - 1] != frame_checksum(frame.id, frame.data, spec.dlc - 1u)) {
+    if (frame.len != spec.length || frame.fd != spec.fd) {
+      verdict = RxVerdict::wrong_format;
+    } else if (frame.data[spec.length - 1] != frame_checksum(frame.id, frame.data, spec.length - 1u)) {
       verdict = RxVerdict::corrupt;
     } else {
       Sequence& seq = sequences_[static_cast<std::size_t>(index)];

@@ -8,30 +8,20 @@ namespace {
 
 const MessageSpec& spec_of(std::uint32_t id) { return *find_message(id); }  // ids below are all in the table
 
-constexpr std::uint32_t kMotionIds[kAxisCount] = {can_id::sens_swing, can_id::sens_boom, can_id::sens_arm,
-                                                  can_id::sens_bucket};
-constexpr std::uint32_t kPressureIds[kCylinderCount] = {can_id::sens_pressure_boom, can_id::sens_pressure_arm,
-                                                        can_id::sens_pressure_bucket};
-constexpr std::uint8_t kAllAxes = (1u << kAxisCount) - 1;
 constexpr std::uint64_t kSyncCycleMask = (1u << 20) - 1;  // SYNC's Cycle signal: 20 bits
 
-std::uint8_t nibble(std::uint64_t cycle) { return static_cast<std::uint8_t>(cycle & 0x0F); }
+// SENS_MACHINE's data signals, in the order of the DBC (and of can_protocol.cpp's table).
+namespace sens {
+constexpr int kPlantState = 0, kSwingAngle = 1, kSwingRate = 2, kPlantFaults = 3;
+constexpr int kCylinderLength = 4;  // boom, arm, bucket: length at 4 + 2 c, rate at 5 + 2 c
+constexpr int kPressureValid = 10;
+constexpr int kPressures = 11;      // A, B of swing, boom, arm, bucket at 11 + 2 axis (+1)
+constexpr int kPumps = 19;
+constexpr int kCount = 21;
+static_assert(kCount <= static_cast<int>(kMaxDataSignals));
+}  // namespace sens
 
-// Both ends send the same way: encode (counting saturated and non-finite signals), send, count.
-bool encode_and_send(CanBus& bus, TxStats& tx, const MessageSpec& message, std::uint8_t counter,
-                     const double* values) {
-  CanFrame frame;
-  const EncodeReport report = encode_message(message, counter, values, frame);
-  tx.saturated += report.saturated;
-  tx.non_finite += report.non_finite;
-  if (!bus.send(frame)) {
-    ++tx.send_failed;
-    return false;
-  }
-  ++tx.frames_sent;
-  tx.bits += static_cast<std::uint64_t>(classical_frame_bits(frame.id, frame.dlc, frame.data));
-  return true;
-}
+std::uint8_t nibble(std::uint64_t cycle) { return static_cast<std::uint8_t>(cycle & 0x0F); }
 
 }  // namespace
 
@@ -44,99 +34,126 @@ std::size_t receive_ids(Node receiver, std::uint32_t* out, std::size_t capacity)
 }
 
 // ---------------------------------------------------------------------------------------------------
+// Both ends
+
+CanPortEnd::CanPortEnd(CanBus& bus, CanFrameCodec::Config config, std::uint32_t heartbeat_id,
+                       std::uint32_t emergency_id)
+    : bus_(bus), codec_(config), heartbeat_(spec_of(heartbeat_id)), emergency_(spec_of(emergency_id)) {}
+
+bool CanPortEnd::transmit(const MessageSpec& message, std::uint8_t counter, const double* values) {
+  CanFrame frame;
+  const EncodeReport report = encode_message(message, counter, values, frame);
+  tx_.saturated += report.saturated;
+  tx_.non_finite += report.non_finite;
+  if (!bus_.send(frame)) {
+    ++tx_.send_failed;
+    return false;
+  }
+  ++tx_.frames_sent;
+  tx_.bus_ns += static_cast<std::uint64_t>(frame_time_ns(frame));
+  return true;
+}
+
+bool CanPortEnd::receive_valid(CanFrame& frame, const MessageSpec*& message) {
+  while (bus_.receive(frame)) {
+    rx_bus_ns_ += static_cast<std::uint64_t>(frame_time_ns(frame));
+    if (codec_.accept(frame, message) != RxVerdict::ok) continue;
+    last_valid_rx_ns_ = frame.timestamp_ns != 0 ? frame.timestamp_ns : monotonic_now_ns();
+    return true;
+  }
+  return false;
+}
+
+bool CanPortEnd::send_heartbeat(std::uint8_t state) {
+  const double values[] = {static_cast<double>(state & 0x0F)};
+  return transmit(heartbeat_, heartbeat_counter_++, values);
+}
+
+bool CanPortEnd::send_fault(bool emergency_stop, std::uint16_t fault_code) {
+  const double values[] = {emergency_stop ? 1.0 : 0.0, static_cast<double>(fault_code)};
+  return transmit(emergency_, emergency_counter_++, values);
+}
+
+// ---------------------------------------------------------------------------------------------------
 // Firmware side
 
-FirmwareCanPort::FirmwareCanPort(CanBus& bus, CanFrameCodec::Config config) : bus_(bus), codec_(config) {}
-
-bool FirmwareCanPort::transmit(const MessageSpec& message, std::uint8_t counter, const double* values) {
-  return encode_and_send(bus_, tx_, message, counter, values);
-}
+FirmwareCanPort::FirmwareCanPort(CanBus& bus, CanFrameCodec::Config config)
+    : CanPortEnd(bus, config, can_id::fw_heartbeat, can_id::fw_emergency) {}
 
 bool FirmwareCanPort::send_sync(std::uint64_t cycle) {
   cycle_ = cycle;
-  motion_mask_ = 0;
+  have_sensors_ = false;
   const double values[] = {static_cast<double>(cycle & kSyncCycleMask)};
   return transmit(spec_of(can_id::sync), nibble(cycle), values);
 }
 
 bool FirmwareCanPort::write(const CommandState& command) {
   const std::uint8_t counter = nibble(command.cycle);
-  if (command.mode == CommandMode::valve) {
-    return transmit(spec_of(can_id::cmd_valve), counter, command.value.data());
+  switch (command.mode) {
+    case CommandMode::valve:
+      return transmit(spec_of(can_id::cmd_valve), counter, command.value.data());
+    case CommandMode::pilot: {
+      double pilots[2 * kAxisCount];  // A and B end per axis, the DBC's order
+      for (int axis = 0; axis < kAxisCount; ++axis) {
+        pilots[2 * axis] = command.pilot_a[axis];
+        pilots[2 * axis + 1] = command.pilot_b[axis];
+      }
+      return transmit(spec_of(can_id::cmd_pilot), counter, pilots);
+    }
+    case CommandMode::effort:
+      break;
   }
-  const double a[] = {command.value[kSwing], command.value[kBoom]};
-  const double b[] = {command.value[kArm], command.value[kBucket]};
-  const bool sent_a = transmit(spec_of(can_id::cmd_effort_a), counter, a);
-  const bool sent_b = transmit(spec_of(can_id::cmd_effort_b), counter, b);
-  return sent_a && sent_b;
-}
-
-bool FirmwareCanPort::send_heartbeat(std::uint8_t firmware_mode) {
-  const double values[] = {static_cast<double>(firmware_mode & 0x0F)};
-  return transmit(spec_of(can_id::fw_heartbeat), heartbeat_counter_++, values);
-}
-
-bool FirmwareCanPort::send_fault(bool emergency_stop, std::uint16_t fault_code) {
-  const double values[] = {emergency_stop ? 1.0 : 0.0, static_cast<double>(fault_code)};
-  return transmit(spec_of(can_id::fw_emergency), emergency_counter_++, values);
+  return transmit(spec_of(can_id::cmd_effort), counter, command.value.data());
 }
 
 void FirmwareCanPort::apply(const MessageSpec& message, const CanFrame& frame, SensorState& state) {
-  double v[6];
+  double v[kMaxDataSignals];  // any valid frame, also one this end never expects
   decode_message(message, frame, v);
-  for (int axis = 0; axis < kAxisCount; ++axis) {
-    if (message.id != kMotionIds[axis]) continue;
-    if (axis == kSwing) {
-      state.plant_state = static_cast<std::uint8_t>(v[0]);
-      state.position[kSwing] = v[1];
-      state.velocity[kSwing] = v[2];
-      state.plant_faults = static_cast<std::uint8_t>(v[3]);
-    } else {
-      state.position[axis] = v[0];
-      state.velocity[axis] = v[1];
-    }
-    if (frame_counter(frame) == nibble(cycle_)) motion_mask_ |= static_cast<std::uint8_t>(1u << axis);
-    return;
-  }
-  for (int c = 0; c < kCylinderCount; ++c) {
-    if (message.id != kPressureIds[c]) continue;
-    state.pressure_a[c] = v[0];
-    state.pressure_b[c] = v[1];
-    state.pressure_valid[c] = true;
-    return;
-  }
-  if (message.id == can_id::plant_heartbeat) {
-    // Kept apart from SENS_SWING's PlantState: a late heartbeat must not overwrite fresher state.
-    state.plant_heartbeat_state = static_cast<std::uint8_t>(v[0]);
-  } else if (message.id == can_id::plant_emergency) {
-    state.plant_emergency = v[0] != 0.0;
-    state.plant_fault_code = static_cast<std::uint16_t>(v[1]);
+  switch (message.id) {
+    case can_id::sens_machine:
+      state.plant_state = static_cast<std::uint8_t>(v[sens::kPlantState]);
+      state.plant_faults = static_cast<std::uint8_t>(v[sens::kPlantFaults]);
+      state.position[kSwing] = v[sens::kSwingAngle];
+      state.velocity[kSwing] = v[sens::kSwingRate];
+      for (int axis = kBoom; axis <= kBucket; ++axis) {
+        state.position[axis] = v[sens::kCylinderLength + 2 * (axis - kBoom)];
+        state.velocity[axis] = v[sens::kCylinderLength + 2 * (axis - kBoom) + 1];
+      }
+      state.pressure_valid = v[sens::kPressureValid] != 0.0;
+      for (int axis = 0; axis < kAxisCount; ++axis) {
+        state.pressure_a[axis] = v[sens::kPressures + 2 * axis];
+        state.pressure_b[axis] = v[sens::kPressures + 2 * axis + 1];
+      }
+      for (int pump = 0; pump < kPumpCount; ++pump) state.pump_pressure[pump] = v[sens::kPumps + pump];
+      if (frame_counter(frame) == nibble(cycle_)) have_sensors_ = true;
+      break;
+    case can_id::plant_heartbeat:
+      // Kept apart from SENS_MACHINE's PlantState: a late heartbeat must not overwrite fresher state.
+      state.plant_heartbeat_state = static_cast<std::uint8_t>(v[0]);
+      break;
+    case can_id::plant_emergency:
+      state.plant_emergency = v[0] != 0.0;
+      state.plant_fault_code = static_cast<std::uint16_t>(v[1]);
+      break;
+    default:
+      break;
   }
 }
 
 bool FirmwareCanPort::read(SensorState& state) {
   CanFrame frame;
-  while (bus_.receive(frame)) {
-    rx_bits_ += static_cast<std::uint64_t>(classical_frame_bits(frame.id, frame.dlc, frame.data));
-    const MessageSpec* message = nullptr;
-    if (codec_.accept(frame, message) != RxVerdict::ok) continue;
-    last_valid_rx_ns_ = frame.timestamp_ns != 0 ? frame.timestamp_ns : monotonic_now_ns();
-    apply(*message, frame, state);
-  }
-  const bool complete = motion_mask_ == kAllAxes;
-  if (complete) state.cycle = cycle_;
-  state.motion_valid = complete;
-  return complete;
+  const MessageSpec* message = nullptr;
+  while (receive_valid(frame, message)) apply(*message, frame, state);
+  if (have_sensors_) state.cycle = cycle_;
+  state.motion_valid = have_sensors_;
+  return have_sensors_;
 }
 
 // ---------------------------------------------------------------------------------------------------
 // Plant side
 
-PlantCanPort::PlantCanPort(CanBus& bus, CanFrameCodec::Config config) : bus_(bus), codec_(config) {}
-
-bool PlantCanPort::transmit(const MessageSpec& message, std::uint8_t counter, const double* values) {
-  return encode_and_send(bus_, tx_, message, counter, values);
-}
+PlantCanPort::PlantCanPort(CanBus& bus, CanFrameCodec::Config config)
+    : CanPortEnd(bus, config, can_id::plant_heartbeat, can_id::plant_emergency) {}
 
 std::uint64_t PlantCanPort::cycle_of_counter(std::uint8_t counter) const {
   // Commands of cycle k arrive around SYNC(k) (after it, or after a lost SYNC(k) while the plant is
@@ -148,9 +165,8 @@ std::uint64_t PlantCanPort::cycle_of_counter(std::uint8_t counter) const {
 }
 
 bool PlantCanPort::apply(const MessageSpec& message, const CanFrame& frame) {
-  double v[6];
+  double v[kMaxDataSignals];  // any valid frame, also one this end never expects
   decode_message(message, frame, v);
-  const std::uint8_t counter = frame_counter(frame);
   switch (message.id) {
     case can_id::sync: {
       const auto raw = static_cast<std::int64_t>(v[0]);
@@ -167,53 +183,39 @@ bool PlantCanPort::apply(const MessageSpec& message, const CanFrame& frame) {
       }
       return true;
     }
-    case can_id::cmd_effort_a:
-      effort_[kSwing] = v[0];
-      effort_[kBoom] = v[1];
-      effort_a_counter_ = counter;
-      break;
-    case can_id::cmd_effort_b:
-      effort_[kArm] = v[0];
-      effort_[kBucket] = v[1];
-      effort_b_counter_ = counter;
-      break;
+    case can_id::cmd_effort:
     case can_id::cmd_valve:
-      latest_.mode = CommandMode::valve;
-      for (int i = 0; i < kAxisCount; ++i) latest_.value[i] = v[i];
-      latest_.cycle = cycle_of_counter(counter);
-      latest_.valid = true;
-      fresh_ = true;
+      latest_.mode = message.id == can_id::cmd_effort ? CommandMode::effort : CommandMode::valve;
+      for (int axis = 0; axis < kAxisCount; ++axis) latest_.value[axis] = v[axis];
+      break;
+    case can_id::cmd_pilot:
+      latest_.mode = CommandMode::pilot;
+      for (int axis = 0; axis < kAxisCount; ++axis) {
+        latest_.pilot_a[axis] = v[2 * axis];
+        latest_.pilot_b[axis] = v[2 * axis + 1];
+      }
       break;
     case can_id::fw_heartbeat:
       latest_.firmware_mode = static_cast<std::uint8_t>(v[0]);
-      break;
+      return false;
     case can_id::fw_emergency:
       latest_.emergency_stop = v[0] != 0.0;
       latest_.fault_code = static_cast<std::uint16_t>(v[1]);
-      break;
+      return false;
     default:
-      break;
+      return false;
   }
-  if ((message.id == can_id::cmd_effort_a || message.id == can_id::cmd_effort_b) &&
-      effort_a_counter_ == effort_b_counter_) {
-    // Both halves of the same cycle: only then is the effort set consistent.
-    latest_.mode = CommandMode::effort;
-    latest_.value = effort_;
-    latest_.cycle = cycle_of_counter(counter);
-    latest_.valid = true;
-    fresh_ = true;
-    effort_a_counter_ = -1;
-    effort_b_counter_ = -2;
-  }
+  // A command frame: one frame is the whole set of its cycle.
+  latest_.cycle = cycle_of_counter(frame_counter(frame));
+  latest_.valid = true;
+  fresh_ = true;
   return false;
 }
 
 bool PlantCanPort::poll_sync(std::uint64_t& cycle) {
   CanFrame frame;
-  while (bus_.receive(frame)) {
-    const MessageSpec* message = nullptr;
-    if (codec_.accept(frame, message) != RxVerdict::ok) continue;
-    last_valid_rx_ns_ = frame.timestamp_ns != 0 ? frame.timestamp_ns : monotonic_now_ns();
+  const MessageSpec* message = nullptr;
+  while (receive_valid(frame, message)) {
     if (apply(*message, frame)) {
       cycle = sync_cycle_;
       return true;
@@ -228,7 +230,7 @@ bool PlantCanPort::wait_sync(std::uint64_t& cycle, std::int64_t timeout_ns) {
     if (poll_sync(cycle)) return true;
     const std::int64_t remaining = deadline - monotonic_now_ns();
     if (remaining <= 0) return false;
-    bus_.wait_readable(remaining);
+    bus().wait_readable(remaining);
   }
 }
 
@@ -240,33 +242,22 @@ bool PlantCanPort::read(CommandState& command) {
 }
 
 bool PlantCanPort::write(const SensorState& sensor) {
-  const std::uint8_t counter = nibble(sensor.cycle);
-  bool ok = true;
-  const double swing[] = {static_cast<double>(sensor.plant_state & 0x0F), sensor.position[kSwing],
-                          sensor.velocity[kSwing], static_cast<double>(sensor.plant_faults)};
-  ok &= transmit(spec_of(can_id::sens_swing), counter, swing);
+  double v[sens::kCount];
+  v[sens::kPlantState] = static_cast<double>(sensor.plant_state & 0x0F);
+  v[sens::kSwingAngle] = sensor.position[kSwing];
+  v[sens::kSwingRate] = sensor.velocity[kSwing];
+  v[sens::kPlantFaults] = static_cast<double>(sensor.plant_faults);
   for (int axis = kBoom; axis <= kBucket; ++axis) {
-    const double cylinder[] = {sensor.position[axis], sensor.velocity[axis]};
-    ok &= transmit(spec_of(kMotionIds[axis]), counter, cylinder);
+    v[sens::kCylinderLength + 2 * (axis - kBoom)] = sensor.position[axis];
+    v[sens::kCylinderLength + 2 * (axis - kBoom) + 1] = sensor.velocity[axis];
   }
-  const int c = static_cast<int>(sensor.cycle % kPressureRoundRobin);
-  if (sensor.pressure_valid[c]) {
-    // Pressure frames come every third cycle: their counter is the cycle divided by 3, so it still
-    // advances by one per frame of that ID.
-    const double pressures[] = {sensor.pressure_a[c], sensor.pressure_b[c]};
-    ok &= transmit(spec_of(kPressureIds[c]), nibble(sensor.cycle / kPressureRoundRobin), pressures);
+  v[sens::kPressureValid] = sensor.pressure_valid ? 1.0 : 0.0;
+  for (int axis = 0; axis < kAxisCount; ++axis) {
+    v[sens::kPressures + 2 * axis] = sensor.pressure_a[axis];
+    v[sens::kPressures + 2 * axis + 1] = sensor.pressure_b[axis];
   }
-  return ok;
-}
-
-bool PlantCanPort::send_heartbeat(std::uint8_t plant_state) {
-  const double values[] = {static_cast<double>(plant_state & 0x0F)};
-  return transmit(spec_of(can_id::plant_heartbeat), heartbeat_counter_++, values);
-}
-
-bool PlantCanPort::send_fault(bool emergency_stop, std::uint16_t fault_code) {
-  const double values[] = {emergency_stop ? 1.0 : 0.0, static_cast<double>(fault_code)};
-  return transmit(spec_of(can_id::plant_emergency), emergency_counter_++, values);
+  for (int pump = 0; pump < kPumpCount; ++pump) v[sens::kPumps + pump] = sensor.pump_pressure[pump];
+  return transmit(spec_of(can_id::sens_machine), nibble(sensor.cycle), v);
 }
 
 }  // namespace exc::hal

@@ -14,7 +14,7 @@ enum class Node : std::uint8_t { firmware, plant };
 // the frame being bit k % 8 of byte k / 8. physical = raw * factor + offset, allowed in [min, max].
 struct SignalSpec {
   const char* name;
-  std::uint8_t start;
+  std::uint16_t start;
   std::uint8_t length;
   bool is_signed;
   double factor;
@@ -24,15 +24,17 @@ struct SignalSpec {
   const char* unit;
 };
 
-// Which command set a frame belongs to (the DBC attribute ExcCommandSet); the two are exclusive.
-enum class CommandSet : std::uint8_t { none, effort, valve };
+// Which command set a frame belongs to (the DBC attribute ExcCommandSet); the three are exclusive.
+enum class CommandSet : std::uint8_t { none, effort, valve, pilot };
 
 // One DBC message. signals[0] is always Counter (bits 0..3) and signals[signal_count - 1] is always
 // Crc (the last byte); the data signals lie in between.
 struct MessageSpec {
   const char* name;
   std::uint32_t id;
-  std::uint8_t dlc;
+  std::uint8_t length;  // payload bytes (the DBC's message size)
+  bool fd;              // DBC VFrameFormat StandardCAN_FD
+  bool brs;             // DBC CANFD_BRS: data phase at the data bit rate
   Node sender;
   int cycle_ms;  // 0: event-driven
   CommandSet command_set;
@@ -47,25 +49,20 @@ namespace can_id {
 inline constexpr std::uint32_t fw_emergency = 0x010;
 inline constexpr std::uint32_t plant_emergency = 0x011;
 inline constexpr std::uint32_t sync = 0x080;
-inline constexpr std::uint32_t cmd_effort_a = 0x100;
-inline constexpr std::uint32_t cmd_effort_b = 0x101;
+inline constexpr std::uint32_t cmd_effort = 0x100;
 inline constexpr std::uint32_t cmd_valve = 0x102;
-inline constexpr std::uint32_t sens_swing = 0x180;
-inline constexpr std::uint32_t sens_boom = 0x181;
-inline constexpr std::uint32_t sens_arm = 0x182;
-inline constexpr std::uint32_t sens_bucket = 0x183;
-inline constexpr std::uint32_t sens_pressure_boom = 0x184;
-inline constexpr std::uint32_t sens_pressure_arm = 0x185;
-inline constexpr std::uint32_t sens_pressure_bucket = 0x186;
+inline constexpr std::uint32_t cmd_pilot = 0x103;
+inline constexpr std::uint32_t sens_machine = 0x180;
 inline constexpr std::uint32_t fw_heartbeat = 0x701;
 inline constexpr std::uint32_t plant_heartbeat = 0x702;
 }  // namespace can_id
 
-inline constexpr std::size_t kMessageCount = 15;
+inline constexpr std::size_t kMessageCount = 9;
+// The most data signals of any message (SENS_MACHINE): a buffer of this size holds any decoded frame.
+inline constexpr std::size_t kMaxDataSignals = 21;
 inline constexpr std::int64_t kCyclePeriodNs = 1'000'000;  // one SYNC per millisecond
 inline constexpr int kHeartbeatPeriodCycles = 100;
 inline constexpr int kEmergencyRepeatCycles = 10;
-inline constexpr int kPressureRoundRobin = 3;  // one cylinder's pressures per cycle
 
 // All messages, in the order of the DBC.
 const std::array<MessageSpec, kMessageCount>& protocol_messages();

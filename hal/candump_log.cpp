@@ -1,6 +1,7 @@
 #include "hal/candump_log.hpp"
 
 #include <cctype>
+#include <cstdio>
 
 namespace exc::hal {
 namespace {
@@ -72,13 +73,18 @@ bool parse_candump_line(const std::string& line, CandumpLine& out, std::string& 
   out.frame.id = id;
   ++i;  // '#'
   if (i < line.size() && line[i] == '#') {
-    out.fd = true;
-    i += 2;  // '#' and the FD flags nibble
-    if (i > line.size()) return fail(error, "expected CAN FD flags after '##'", i);
+    out.frame.fd = true;
+    ++i;
+    const int flags = i < line.size() ? hex_value(line[i]) : -1;
+    if (flags < 0) return fail(error, "expected a hex digit of CAN FD flags after '##'", i);
+    out.fd_flags = static_cast<std::uint8_t>(flags);
+    out.frame.brs = (flags & 1) != 0;
+    ++i;
   } else if (i < line.size() && (line[i] == 'R' || line[i] == 'r')) {
     out.remote = true;
     return true;
   }
+  const std::size_t data_start = i;
   std::size_t bytes = 0;
   while (i < line.size() && line[i] != ' ' && line[i] != '\r' && line[i] != '\n') {
     if (line[i] == '.') {  // optional byte separator
@@ -88,14 +94,37 @@ bool parse_candump_line(const std::string& line, CandumpLine& out, std::string& 
     const int high = hex_value(line[i]);
     const int low = i + 1 < line.size() ? hex_value(line[i + 1]) : -1;
     if (high < 0 || low < 0) return fail(error, "data must be pairs of hex digits", i);
-    if (bytes >= (out.fd ? 64u : 8u)) return fail(error, "too many data bytes", i);
-    if (bytes < 8) out.frame.data[bytes] = static_cast<std::uint8_t>(high * 16 + low);
-    ++bytes;
+    if (bytes >= static_cast<std::size_t>(out.frame.fd ? kCanFdMaxLength : kCanMaxLength)) {
+      return fail(error, "too many data bytes", i);
+    }
+    out.frame.data[bytes++] = static_cast<std::uint8_t>(high * 16 + low);
     i += 2;
   }
-  out.frame.dlc = static_cast<std::uint8_t>(bytes < 8 ? bytes : 8);
-  if (bytes > 8) out.frame.dlc = 9;  // an FD payload longer than classical: never a valid protocol frame
+  out.frame.len = static_cast<std::uint8_t>(bytes);
+  if (!valid_length(out.frame.len, out.frame.fd)) {
+    return fail(error, std::to_string(bytes) + " data bytes is not a CAN FD length (0..8, 12, 16, 20, 24, 32, 48, 64)",
+                data_start);
+  }
   return true;
+}
+
+std::string candump_line(const CanFrame& frame, const std::string& interface_name, std::int64_t timestamp_ns) {
+  char text[64];
+  std::snprintf(text, sizeof text, "(%lld.%06lld) ", static_cast<long long>(timestamp_ns / 1'000'000'000),
+                static_cast<long long>((timestamp_ns % 1'000'000'000) / 1000));
+  std::string line = text;
+  line += interface_name;
+  if (frame.fd) {
+    std::snprintf(text, sizeof text, " %03X##%X", frame.id, frame.brs ? 1u : 0u);
+  } else {
+    std::snprintf(text, sizeof text, " %03X#", frame.id);
+  }
+  line += text;
+  for (int b = 0; b < frame.len; ++b) {
+    std::snprintf(text, sizeof text, "%02X", frame.data[b]);
+    line += text;
+  }
+  return line;
 }
 
 }  // namespace exc::hal

@@ -1,38 +1,46 @@
 #pragma once
 // What the firmware and the plant exchange, as plain state and command interfaces (ros2_control
 // style): the controllers see these structs, never a CAN frame. Axis order everywhere: swing, boom,
-// arm, bucket; cylinder order: boom, arm, bucket.
+// arm, bucket.
 #include <array>
 #include <cstdint>
 
 namespace exc::hal {
 
 inline constexpr int kAxisCount = 4;
-inline constexpr int kCylinderCount = 3;
+inline constexpr int kPumpCount = 2;
 enum Axis : int { kSwing = 0, kBoom = 1, kArm = 2, kBucket = 3 };
 
 struct SensorState {
   std::array<double, kAxisCount> position{};  // swing angle (rad); cylinder pin-to-pin lengths (m)
   std::array<double, kAxisCount> velocity{};  // swing rate (rad/s); cylinder stroke rates (m/s)
-  std::array<double, kCylinderCount> pressure_a{};  // cap-side chamber pressure (Pa)
-  std::array<double, kCylinderCount> pressure_b{};  // rod-side chamber pressure (Pa)
+  // Chamber pressures (Pa): swing motor port A / B; cylinder cap (bore) side A / rod side B.
+  std::array<double, kAxisCount> pressure_a{};
+  std::array<double, kAxisCount> pressure_b{};
+  std::array<double, kPumpCount> pump_pressure{};  // Pa
+  // The pressures are measured (the hydraulic plant); false for the force-commanded fidelities.
+  // Plant: what it sends; firmware: what the last sensor frame said.
+  bool pressure_valid = false;
   std::uint8_t plant_state = 0;   // plant state machine, 0..15 (meaning owned by the plant)
   std::uint8_t plant_faults = 0;  // plant fault bits
   std::uint8_t plant_heartbeat_state = 0;  // firmware side: PlantState of the last plant heartbeat
   std::uint64_t cycle = 0;        // plant: the SYNC cycle this answers; firmware: cycle of the last complete set
-  bool motion_valid = false;      // position/velocity of all four axes belong to `cycle`
-  // Plant: send this cylinder's pressures (hydraulic fidelity). Firmware: a valid pressure frame arrived.
-  std::array<bool, kCylinderCount> pressure_valid{};
+  bool motion_valid = false;      // firmware side: every value belongs to `cycle`
   bool plant_emergency = false;       // firmware side: the plant latched an emergency stop
   std::uint16_t plant_fault_code = 0;
 };
 
-enum class CommandMode : std::uint8_t { effort, valve };
+// The three exclusive command sets (DBC ExcCommandSet): efforts, signed valve openings, or pilot
+// pressures on both ends of each main-valve spool.
+enum class CommandMode : std::uint8_t { effort, valve, pilot };
 
 struct CommandState {
   CommandMode mode = CommandMode::effort;
   // effort: swing torque (N m), cylinder forces (N, extending positive); valve: openings in -1..1.
   std::array<double, kAxisCount> value{};
+  // pilot: pressure on the spool's A end (opens towards positive motion) and B end, Pa.
+  std::array<double, kAxisCount> pilot_a{};
+  std::array<double, kAxisCount> pilot_b{};
   std::uint8_t firmware_mode = 0;  // firmware state machine, 0..15 (from its heartbeat)
   std::uint64_t cycle = 0;         // the cycle these commands were computed in
   bool valid = false;              // plant side: a complete command set has been received

@@ -39,10 +39,10 @@ bool FaultInjectingBus::send(const CanFrame& frame) {
   bool result = true;
   if (u < config_.drop_fraction) {
     ++stats_.dropped;  // lost on the wire: the sender cannot tell
-  } else if (u < config_.drop_fraction + config_.corrupt_fraction && frame.dlc > 0) {
+  } else if (u < config_.drop_fraction + config_.corrupt_fraction && frame.len > 0) {
     ++stats_.corrupted;
     CanFrame damaged = frame;
-    const auto bit = static_cast<unsigned>(random_() % (8u * damaged.dlc));
+    const auto bit = static_cast<unsigned>(random_() % (8u * damaged.len));
     damaged.data[bit / 8] = static_cast<std::uint8_t>(damaged.data[bit / 8] ^ (1u << (bit % 8)));
     result = inner_.send(damaged);
   } else if (u < config_.drop_fraction + config_.corrupt_fraction + config_.delay_fraction) {

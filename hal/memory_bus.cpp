@@ -8,7 +8,7 @@ MemoryBusNode::MemoryBusNode(MemoryBusHub& hub, std::size_t capacity)
     : hub_(hub), ring_(new CanFrame[capacity > 0 ? capacity : 1]), capacity_(capacity > 0 ? capacity : 1) {}
 
 bool MemoryBusNode::send(const CanFrame& frame) {
-  if (frame.dlc > 8 || frame.id > 0x7FF) return false;  // not a classical 11-bit frame
+  if (!sendable(frame)) return false;  // not an 11-bit frame of a valid length
   ++sent_;
   hub_.broadcast(*this, frame);
   return true;

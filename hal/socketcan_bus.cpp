@@ -4,6 +4,7 @@
 #include <linux/can/raw.h>
 #include <net/if.h>
 #include <poll.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <sys/uio.h>
 #include <unistd.h>
@@ -27,7 +28,7 @@ std::int64_t to_ns(const timespec& ts) { return static_cast<std::int64_t>(ts.tv_
 
 // Sentinel ID for frames this protocol never uses (extended, remote, error): the codec counts them
 // as unknown instead of mistaking their low bits for a standard ID.
-constexpr std::uint32_t kNotClassicalId = 0xFFFFFFFFu;
+constexpr std::uint32_t kNotStandardId = 0xFFFFFFFFu;
 
 }  // namespace
 
@@ -75,7 +76,19 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface_na
     }
   }
   const int on = 1;
+  if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &on, sizeof(on)) < 0) return fail("setsockopt(CAN_RAW_FD_FRAMES)");
   if (::setsockopt(fd, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof(on)) < 0) return fail("setsockopt(SO_TIMESTAMPNS)");
+  // Every frame of the protocol is CAN FD: an interface with the classical MTU would refuse them all.
+  ifreq request{};
+  std::memcpy(request.ifr_name, interface_name.c_str(), interface_name.size() + 1);
+  if (::ioctl(fd, SIOCGIFMTU, &request) < 0) return fail("ioctl(SIOCGIFMTU)");
+  if (request.ifr_mtu != static_cast<int>(CANFD_MTU)) {
+    error = "SocketCAN interface '" + interface_name + "': MTU " + std::to_string(request.ifr_mtu) +
+            " does not carry CAN FD frames (" + std::to_string(CANFD_MTU) + "): `ip link set " + interface_name +
+            " mtu " + std::to_string(CANFD_MTU) + "` (and bitrate/dbitrate on a real controller)";
+    ::close(fd);
+    return nullptr;
+  }
 
   sockaddr_can address{};
   address.can_family = AF_CAN;
@@ -86,8 +99,9 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& interface_na
 }
 
 SocketCanBus::SocketCanBus(int fd, std::string interface_name)
-    : fd_(fd), interface_name_(std::move(interface_name)), control_{} {
+    : fd_(fd), interface_name_(std::move(interface_name)), control_{}, raw_{} {
   static_assert(sizeof(control_) >= CMSG_SPACE(sizeof(timespec)), "control buffer too small");
+  static_assert(sizeof(raw_) == CANFD_MTU && CAN_MTU <= CANFD_MTU, "receive buffer must hold one canfd_frame");
 }
 
 SocketCanBus::~SocketCanBus() {
@@ -95,16 +109,29 @@ SocketCanBus::~SocketCanBus() {
 }
 
 bool SocketCanBus::send(const CanFrame& frame) {
-  if (frame.dlc > CAN_MAX_DLEN || frame.id > CAN_SFF_MASK) {
+  if (!sendable(frame)) {
     ++stats_.send_failed;
     return false;
   }
-  can_frame raw{};
-  raw.can_id = frame.id;
-  raw.len = frame.dlc;
-  std::memcpy(raw.data, frame.data, frame.dlc);
-  const ssize_t n = ::send(fd_, &raw, sizeof(raw), MSG_DONTWAIT);
-  if (n != static_cast<ssize_t>(sizeof(raw))) {
+  ssize_t n = 0;
+  std::size_t size = 0;
+  if (frame.fd) {
+    canfd_frame raw{};
+    raw.can_id = frame.id;
+    raw.len = frame.len;
+    raw.flags = frame.brs ? CANFD_BRS : 0;
+    std::memcpy(raw.data, frame.data, frame.len);
+    size = CANFD_MTU;
+    n = ::send(fd_, &raw, size, MSG_DONTWAIT);
+  } else {
+    can_frame raw{};
+    raw.can_id = frame.id;
+    raw.len = frame.len;
+    std::memcpy(raw.data, frame.data, frame.len);
+    size = CAN_MTU;
+    n = ::send(fd_, &raw, size, MSG_DONTWAIT);
+  }
+  if (n != static_cast<ssize_t>(size)) {
     ++stats_.send_failed;
     stats_.last_errno = n < 0 ? errno : EIO;
     return false;
@@ -114,8 +141,8 @@ bool SocketCanBus::send(const CanFrame& frame) {
 }
 
 bool SocketCanBus::receive(CanFrame& frame) {
-  can_frame raw{};
-  iovec iov{&raw, sizeof(raw)};
+  // canfd_frame and can_frame share the layout of id, length and data; CAN_MTU bytes: classical.
+  iovec iov{raw_, sizeof(raw_)};
   msghdr message{};
   message.msg_iov = &iov;
   message.msg_iovlen = 1;
@@ -129,20 +156,25 @@ bool SocketCanBus::receive(CanFrame& frame) {
     }
     return false;
   }
-  if (n != static_cast<ssize_t>(sizeof(raw))) {  // a CAN FD frame would be larger; we never enable them
+  if (n != static_cast<ssize_t>(CAN_MTU) && n != static_cast<ssize_t>(CANFD_MTU)) {
     ++stats_.receive_errors;
     return false;
   }
+  canfd_frame raw;
+  std::memcpy(&raw, raw_, sizeof(raw));
   ++stats_.received;
   if ((raw.can_id & (CAN_EFF_FLAG | CAN_RTR_FLAG | CAN_ERR_FLAG)) != 0) {
-    ++stats_.not_classical;
-    frame.id = kNotClassicalId;
+    ++stats_.not_standard;
+    frame.id = kNotStandardId;
   } else {
     frame.id = raw.can_id & CAN_SFF_MASK;
   }
-  frame.dlc = raw.len <= CAN_MAX_DLEN ? raw.len : CAN_MAX_DLEN;
+  frame.fd = n == static_cast<ssize_t>(CANFD_MTU);
+  frame.brs = frame.fd && (raw.flags & CANFD_BRS) != 0;
+  const std::uint8_t max_len = frame.fd ? CANFD_MAX_DLEN : CAN_MAX_DLEN;
+  frame.len = raw.len <= max_len ? raw.len : max_len;
   std::memset(frame.data, 0, sizeof(frame.data));
-  std::memcpy(frame.data, raw.data, frame.dlc);
+  std::memcpy(frame.data, raw.data, frame.len);
 
   // SO_TIMESTAMPNS stamps with CLOCK_REALTIME; shift it onto CLOCK_MONOTONIC with the current offset
   // between the two clocks (exact unless the wall clock is stepped between reception and now).

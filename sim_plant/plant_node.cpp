@@ -67,16 +67,23 @@ void PlantNode::step(std::uint64_t cycle) {
   holding_ = hold;
 
   // Any other command goes to the plant as the kind it is: a kind the actuators cannot use (efforts
-  // for valves, openings for force actuators) stops the plant with its message, so a mismatched
-  // setup fails at once instead of running on with the commands ignored.
+  // for valves, openings or pilots for force actuators) stops the plant with its message, so a
+  // mismatched setup fails at once instead of running on with the commands ignored.
   plant::ActuatorCommand actuator;
-  const bool valve = command_.mode == hal::CommandMode::valve;
-  actuator.mode = valve ? plant::ActuatorCommand::valve : plant::ActuatorCommand::effort;
   if (hold) {
     actuator.mode = hydraulic ? plant::ActuatorCommand::valve : plant::ActuatorCommand::effort;
     if (!hydraulic) actuator.value = hold_effort();  // valves: centred (zeros)
   } else {
-    for (int j = 0; j < 4; ++j) actuator.value[j] = command_.value[j];
+    switch (command_.mode) {
+      case hal::CommandMode::effort: actuator.mode = plant::ActuatorCommand::effort; break;
+      case hal::CommandMode::valve: actuator.mode = plant::ActuatorCommand::valve; break;
+      case hal::CommandMode::pilot: actuator.mode = plant::ActuatorCommand::pilot; break;
+    }
+    for (int j = 0; j < 4; ++j) {
+      actuator.value[j] = command_.value[j];
+      actuator.pilot_a[j] = command_.pilot_a[j];
+      actuator.pilot_b[j] = command_.pilot_b[j];
+    }
   }
   apply_actuator_fault(actuator);
   const std::int64_t step_start = hal::monotonic_now_ns();
@@ -90,11 +97,16 @@ void PlantNode::step(std::uint64_t cycle) {
     sensors_.position[j] = r.position[j];
     sensors_.velocity[j] = r.velocity[j];
   }
+  // Every chamber (swing motor ports first, then the cylinders' cap and rod sides) and both pumps;
+  // measured only by the hydraulic plant.
+  sensors_.pressure_a[hal::kSwing] = r.swing_pressure[0];
+  sensors_.pressure_b[hal::kSwing] = r.swing_pressure[1];
   for (int c = 0; c < 3; ++c) {
-    sensors_.pressure_a[c] = r.pressure_a[c];
-    sensors_.pressure_b[c] = r.pressure_b[c];
-    sensors_.pressure_valid[c] = hydraulic;
+    sensors_.pressure_a[c + 1] = r.pressure_a[c];
+    sensors_.pressure_b[c + 1] = r.pressure_b[c];
   }
+  for (int p = 0; p < hal::kPumpCount; ++p) sensors_.pump_pressure[p] = r.pump_pressure[p];
+  sensors_.pressure_valid = hydraulic;
   apply_sensor_fault();
   sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
   sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
@@ -145,6 +157,8 @@ void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
   const int j = fault_.joint;
   if (fault_.kind == InjectedFault::Kind::actuator_loss) {
     actuator.value[j] *= 1 - fault_.magnitude;
+    actuator.pilot_a[j] *= 1 - fault_.magnitude;  // the spool's travel scales with its pilot difference
+    actuator.pilot_b[j] *= 1 - fault_.magnitude;
   } else if (fault_.kind == InjectedFault::Kind::actuator_jam) {
     // A stuck actuator keeps what it applied when it stuck, whatever is commanded.
     if (!fault_started_) jammed_effort_ = plant_.state().effort[j];

@@ -1,9 +1,10 @@
 #pragma once
 // The simulated machine's end of the bus: on each SYNC(k) it takes the latest valid command set,
-// steps the plant exactly once and answers with the sensor frames of cycle k. It holds the machine
-// (valves centred; for force-commanded fidelities a model-based brake, see hold_effort()) when the
-// firmware asks for it, when commands stop for longer than the command timeout, or on an emergency
-// stop. Nothing allocates after construction.
+// steps the plant exactly once (CMD_EFFORT, CMD_VALVE or CMD_PILOT applied as the kind it is) and
+// answers with SENS_MACHINE of cycle k (every chamber and pump pressure when hydraulic). It holds
+// the machine (valves centred; for force-commanded fidelities a model-based brake, see
+// hold_effort()) when the firmware asks for it, when commands stop for longer than the command
+// timeout, or on an emergency stop. Nothing allocates after construction.
 #include <cstdint>
 
 #include "control/perf_counter.hpp"

@@ -4,7 +4,6 @@
 #include <cstdint>
 
 #include "exlcm/can_stats_t.hpp"
-#include "hal/can_bus_load.hpp"
 #include "hal/can_ports.hpp"
 
 namespace exc::app {
@@ -21,27 +20,28 @@ inline exlcm::can_stats_t can_stats_message(const hal::RxStats& rx, const hal::T
   cs.stale = static_cast<std::int64_t>(rx.stale);
   cs.repeated = static_cast<std::int64_t>(rx.repeated);
   cs.corrupt = static_cast<std::int64_t>(rx.corrupt);
-  cs.wrong_dlc = static_cast<std::int64_t>(rx.wrong_dlc);
+  cs.wrong_dlc = static_cast<std::int64_t>(rx.wrong_format);  // the field keeps its name in the logs
   cs.unknown = static_cast<std::int64_t>(rx.unknown_id);
   cs.dropped = static_cast<std::int64_t>(tx.send_failed);
   cs.bus_load = bus_load;
   return cs;
 }
 
-// Bus load over a window: on-wire bits counted by the port since the last call over what the bus
-// carries at 1 Mbit/s in the window's (simulated or real) time.
+// Bus load over a window: the on-wire time of the frames the port counted since the last call (each
+// frame's exact length at the nominal and data bit rates, hal/can_bus_load.hpp) over the window's
+// (simulated or real) time: the fraction of bus time used.
 class BusLoadWindow {
  public:
-  double update(std::uint64_t total_bits, double now_s) {
+  double update(std::uint64_t total_bus_ns, double now_s) {
     const double span = now_s - last_time_;
-    const double load = span > 0 ? static_cast<double>(total_bits - last_bits_) / (hal::kClassicalBitRate * span) : 0;
-    last_bits_ = total_bits;
+    const double load = span > 0 ? static_cast<double>(total_bus_ns - last_bus_ns_) * 1e-9 / span : 0;
+    last_bus_ns_ = total_bus_ns;
     last_time_ = now_s;
     return load;
   }
 
  private:
-  std::uint64_t last_bits_ = 0;
+  std::uint64_t last_bus_ns_ = 0;
   double last_time_ = 0;
 };
 

@@ -294,7 +294,7 @@ void FirmwareNode::publish_counters() {
   }
 
   // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
-  const double load = bus_load_.update(port_.tx_stats().bits + port_.rx_bits(), time());
+  const double load = bus_load_.update(port_.tx_stats().bus_ns + port_.rx_bus_ns(), time());
   const exlcm::can_stats_t cs = can_stats_message(port_.rx_stats(), port_.tx_stats(), 0, utime, load);
   telemetry_->publish(telemetry::Channel::can_stats, cs);
 }

@@ -242,7 +242,8 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
       // The last repeat can fall on the first answered cycle: its SYNC goes out before the answer.
       CHECK(at.size() == static_cast<std::size_t>((silent_to - first) / m.cycle_fast_ms + 1));
       ++checked;
-    } else if (m.cycle_ms > 0 && m.command_set != 2) {  // the effort set is sent; valves only in the safe state
+    } else if (m.cycle_ms > 0 && m.command_set <= 1) {
+      // The effort set is sent; valves only in the safe state, pilots not yet (the valve inner loop).
       REQUIRE(at.size() >= 2);
       int largest_gap = 0;
       for (std::size_t i = 1; i < at.size(); ++i) largest_gap = std::max(largest_gap, at[i] - at[i - 1]);
@@ -255,7 +256,7 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
       ++checked;
     }
   }
-  CHECK(checked >= 4);  // SYNC, the effort pair, FW_HEARTBEAT, FW_EMERGENCY
+  CHECK(checked == 4);  // SYNC, CMD_EFFORT, FW_HEARTBEAT, FW_EMERGENCY
 }
 
 TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated) trips the tracking-error fault within one cycle's motion past the limit") {
@@ -304,29 +305,35 @@ TEST_CASE("firmware/node: the shipped tasks never trip the tracking-error fault 
   }
 }
 
-TEST_CASE("firmware/node: the port counts every frame on the bus once, at its exact length, between the unstuffed and the worst-case length") {
+TEST_CASE("firmware/node: the port counts every frame on the bus once, at its exact on-wire time, between the unstuffed and the worst-case frame") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   Loop loop(model, sim::kFreeMotionTask, cfg);
   hal::MemoryBusNode* listener = loop.hub.attach(4096);
-  std::uint64_t frames = 0, unstuffed = 0, worst = 0;
+  std::uint64_t frames = 0, unstuffed_ns = 0, worst_ns = 0;
   constexpr int cycles = 2000;
   for (int k = 0; k < cycles; ++k) {
     loop.cycle();
     hal::CanFrame f;
     while (listener->receive(f)) {
       ++frames;
-      unstuffed += 47 + 8 * f.dlc;
-      worst += static_cast<std::uint64_t>(hal::classical_frame_bits_worst(f.dlc));
+      REQUIRE(f.fd);
+      REQUIRE(f.brs);
+      // No stuff bits: 17 + 13 nominal bits, ESI, DLC, data and the fixed-stuffed CRC field fast.
+      unstuffed_ns += 30 * hal::kNominalBitNs + (5 + 8 * f.len + hal::canfd_crc_field_bits(f.len)) * hal::kDataBitNs;
+      worst_ns += static_cast<std::uint64_t>(hal::canfd_frame_bits_worst(f.len).duration_ns());
     }
   }
-  const std::uint64_t counted = loop.fw_port.tx_stats().bits + loop.fw_port.rx_bits();
-  const double load = static_cast<double>(counted) / (hal::kClassicalBitRate * cycles * 1e-3);
-  MESSAGE(frames << " frames, " << counted << " bits counted (unstuffed " << unstuffed << ", worst case " << worst
-                 << "): bus load " << load * 100 << " %");
+  const std::uint64_t counted = loop.fw_port.tx_stats().bus_ns + loop.fw_port.rx_bus_ns();
+  const double load = static_cast<double>(counted) * 1e-9 / (cycles * 1e-3);
+  MESSAGE(frames << " frames, " << counted / 1000 << " us on the bus (unstuffed " << unstuffed_ns / 1000 << ", worst case "
+                 << worst_ns / 1000 << "): bus load " << load * 100 << " %");
   CHECK(loop.fw_port.tx_stats().frames_sent + loop.fw_port.rx_stats().ok == frames);
-  CHECK(counted > unstuffed);
-  CHECK(counted < worst);
+  CHECK(counted > unstuffed_ns);
+  CHECK(counted < worst_ns);
+  // SYNC, CMD_EFFORT and SENS_MACHINE every cycle, a heartbeat every 50: 21-26 % of the bus.
+  CHECK(load > 0.21);
+  CHECK(load < 0.26);
   app::BusLoadWindow window;
   CHECK(window.update(counted, cycles * 1e-3) == doctest::Approx(load));
 }

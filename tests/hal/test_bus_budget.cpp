@@ -1,128 +1,118 @@
-// The bus budget, computed from the DBC: worst-case bits (with stuffing) in one 1 ms cycle at
-// 1 Mbit/s classical CAN, and what CAN FD would take for the same signals.
+// The bus budget, computed from the DBC: the worst-case time (stuffing included) of every frame at
+// 1 Mbit/s arbitration and 5 Mbit/s data phase (CAN FD with bit-rate switch), summed over the worst
+// 1 ms cycle of each command set; and the exact frame lengths the bus load is measured with.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "dbc_reader.hpp"
 #include "hal/can_bus_load.hpp"
 
+using exc::hal::canfd_frame_bits;
 using exc::hal::canfd_frame_bits_worst;
 using exc::hal::canfd_payload_bytes;
 using exc::hal::classical_frame_bits_worst;
 
 namespace {
 
-struct CycleLoad {
-  int cyclic_bits = 0;     // frames sent every cycle (one command set) + the slower frames of that cycle
-  int emergency_bits = 0;  // both event-driven emergency frames on top
+struct CycleTime {
+  std::int64_t cyclic_ns = 0;     // the 1 ms frames of one command set
+  std::int64_t worst_ns = 0;      // ... plus a heartbeat and both emergency frames in the same cycle
 };
 
-// Worst cycle of the DBC's schedule for one command set (1 effort, 2 valve). Frames with a cycle
-// time of N > 1 ms are spread over the N cycles (round robin / offsets, as the ports send them), so
-// a cycle carries at most ceil(group / N) of a group of frames sharing that cycle time: count the
-// largest ones.
-CycleLoad worst_cycle(const std::vector<exc::test::DbcMessage>& dbc, int command_set) {
-  CycleLoad load;
-  std::map<int, std::vector<int>> slow_groups;
-  for (const auto& m : dbc) {
-    if (m.command_set != 0 && m.command_set != command_set) continue;
-    const int bits = classical_frame_bits_worst(m.dlc);
-    if (m.cycle_ms == 0) {
-      load.emergency_bits += bits;
-    } else if (m.cycle_ms == 1) {
-      load.cyclic_bits += bits;
-    } else {
-      slow_groups[m.cycle_ms].push_back(bits);
-    }
-  }
-  for (auto& [period, bits] : slow_groups) {
-    std::sort(bits.rbegin(), bits.rend());
-    const std::size_t per_cycle = (bits.size() + static_cast<std::size_t>(period) - 1) / static_cast<std::size_t>(period);
-    for (std::size_t i = 0; i < per_cycle && i < bits.size(); ++i) load.cyclic_bits += bits[i];
-  }
-  return load;
+std::int64_t worst_ns(const exc::test::DbcMessage& m) {
+  REQUIRE(m.fd);
+  REQUIRE(m.brs);
+  return canfd_frame_bits_worst(m.length).duration_ns();
 }
 
-int data_bits(const exc::test::DbcMessage& m) {
-  int bits = 0;
-  for (std::size_t i = 1; i + 1 < m.signals.size(); ++i) bits += m.signals[i].length;  // without Counter and Crc
-  return bits;
+// The worst cycle of the DBC's schedule for one command set (1 effort, 2 valve, 3 pilot; the sets are
+// exclusive). Frames with a cycle time of N > 1 ms are spread over the N cycles (the heartbeats at
+// cycle mod 100 = 0 and 50), so a cycle carries at most ceil(group / N) of a group sharing that cycle
+// time: count the longest ones. Event frames (the two emergencies) may all come in one cycle.
+CycleTime worst_cycle(const std::vector<exc::test::DbcMessage>& dbc, int command_set) {
+  CycleTime t;
+  std::map<int, std::vector<std::int64_t>> slow_groups;
+  std::int64_t events = 0;
+  for (const auto& m : dbc) {
+    if (m.command_set != 0 && m.command_set != command_set) continue;
+    if (m.cycle_ms == 0) {
+      events += worst_ns(m);
+    } else if (m.cycle_ms == 1) {
+      t.cyclic_ns += worst_ns(m);
+    } else {
+      slow_groups[m.cycle_ms].push_back(worst_ns(m));
+    }
+  }
+  t.worst_ns = t.cyclic_ns + events;
+  for (auto& [period, times] : slow_groups) {
+    std::sort(times.rbegin(), times.rend());
+    const std::size_t per_cycle = (times.size() + static_cast<std::size_t>(period) - 1) / static_cast<std::size_t>(period);
+    for (std::size_t i = 0; i < per_cycle && i < times.size(); ++i) t.worst_ns += times[i];
+  }
+  return t;
+}
+
+// The kernel's worst-case length of a standard CAN FD frame with intermission, written out from
+// include/linux/can/length.h (as reworked in 2023): can_bitstuffing_len(22 + 8 n) + CRC field with delimiter
+// (28 bits up to 16 bytes, else 33) + ACK, ACK delimiter, EOF (9) + intermission (3).
+int kernel_canfd_frame_bits(int n) {
+  const int destuffed = 22 + 8 * n;
+  return destuffed + (destuffed - 1) / 4 + (n <= 16 ? 28 : 33) + 9 + 3;
 }
 
 }  // namespace
 
-TEST_CASE("hal/bus budget frame length formula matches the published worst cases") {
-  // Independent figures: a standard 8-byte frame is at most 135 bits with stuffing (Davis et al.,
-  // "CAN schedulability analysis refuted, revisited and revised", 2007; can-utils 55 + 10 n), an
-  // empty one 55 bits.
+TEST_CASE("hal/bus budget frame length formulas match the published worst cases") {
+  // Classical: a standard 8-byte frame is at most 135 bits with stuffing (Davis et al., "CAN
+  // schedulability analysis refuted, revisited and revised", 2007; can-utils 55 + 10 n).
   CHECK(classical_frame_bits_worst(8) == 135);
   CHECK(classical_frame_bits_worst(0) == 55);
   for (int n = 0; n <= 8; ++n) CHECK(classical_frame_bits_worst(n) == 55 + 10 * n);
+  // CAN FD: the same total as the kernel's can_frame_bits(), at every FD length; 67 bits empty,
+  // 712 bits for 64 bytes.
+  CHECK(canfd_frame_bits_worst(0).total() == 67);
+  CHECK(canfd_frame_bits_worst(8).total() == 147);
+  CHECK(canfd_frame_bits_worst(48).total() == 552);
+  CHECK(canfd_frame_bits_worst(64).total() == 712);
+  for (int n : {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64}) {
+    CAPTURE(n);
+    CHECK(canfd_frame_bits_worst(n).total() == kernel_canfd_frame_bits(n));
+    // At the nominal rate: SOF to BRS (17) with at most 4 stuff bits, CRC delimiter to intermission (13).
+    CHECK(canfd_frame_bits_worst(n).nominal == 34);
+  }
   CHECK(canfd_payload_bytes(9) == 12);
   CHECK(canfd_payload_bytes(33) == 48);
+  CHECK(canfd_payload_bytes(65) == -1);
+  // At 1 and 5 Mbit/s: 34 us + 200 ns per data-phase bit.
+  CHECK(canfd_frame_bits_worst(4).duration_ns() == 48'600);
+  CHECK(canfd_frame_bits_worst(48).duration_ns() == 137'600);
 }
 
-TEST_CASE("hal/bus budget of the DBC schedule at 1 Mbit/s classical CAN, and the CAN FD alternative") {
-  const auto dbc = exc::test::read_dbc(EXC_CAN_DBC_FILE);
-  const CycleLoad effort = worst_cycle(dbc, 1);
-  const CycleLoad valve = worst_cycle(dbc, 2);
-  const int cyclic = std::max(effort.cyclic_bits, valve.cyclic_bits);
-  const int with_emergency = std::max(effort.cyclic_bits + effort.emergency_bits, valve.cyclic_bits + valve.emergency_bits);
-  MESSAGE("classical CAN, worst cycle: effort ", effort.cyclic_bits, " bits, valve ", valve.cyclic_bits,
-          " bits; with both emergency frames ", with_emergency, " bits; budget 500 bits (50% of 1 ms at 1 Mbit/s)");
-  // The figures docs/can-protocol.md and the README state (counted from the DBC with the published
-  // worst-case frame length): 985 bits in the worst effort cycle, 98.5 % of the bus. It fits the
-  // 1 ms cycle, so the SYNC-driven loop runs on a real bus, but not the 50 % budget: issue 14 moves
-  // the interface to CAN FD for that.
-  CHECK(effort.cyclic_bits == 985);
-  CHECK(valve.cyclic_bits == 890);
-  CHECK(with_emergency == 1175);
-  CHECK(cyclic <= 1000);
-  if (cyclic > 500) MESSAGE("classical CAN does NOT meet the 50% budget: ", cyclic / 10.0, "% of the bus");
-
-  // CAN FD with bit-rate switch: every frame becomes an FD frame; the command frames merge into one
-  // (both effort halves), the sensor frames into one carrying all pressures every cycle.
-  int sensor_bits = 12;   // one Counter + Crc for the merged sensor frame
-  int command_bits = 12;  // likewise for the merged command frame
-  int effort_bits = 0;
-  int valve_bits = 0;
-  std::vector<int> other_frames;      // SYNC and the heavier heartbeat: unchanged payloads
-  std::vector<int> emergency_frames;  // both emergency frames
-  int heartbeat_bytes = 0;
-  for (const auto& m : dbc) {
-    if (m.name.rfind("SENS_", 0) == 0) {
-      sensor_bits += data_bits(m);
-    } else if (m.command_set == 1) {
-      effort_bits += data_bits(m);
-    } else if (m.command_set == 2) {
-      valve_bits += data_bits(m);
-    } else if (m.cycle_ms == 100) {
-      heartbeat_bytes = std::max(heartbeat_bytes, m.dlc);
-    } else if (m.cycle_ms == 0) {
-      emergency_frames.push_back(m.dlc);
-    } else {
-      other_frames.push_back(m.dlc);
-    }
-  }
-  other_frames.push_back(heartbeat_bytes);
-  command_bits += std::max(effort_bits, valve_bits);
-  const int sensor_bytes = canfd_payload_bytes((sensor_bits + 7) / 8);
-  const int command_bytes = canfd_payload_bytes((command_bits + 7) / 8);
-  for (double data_rate : {2e6, 5e6}) {
-    double ns = canfd_frame_bits_worst(sensor_bytes).duration_ns(1e6, data_rate) +
-                canfd_frame_bits_worst(command_bytes).duration_ns(1e6, data_rate);
-    for (int bytes : other_frames) ns += canfd_frame_bits_worst(bytes).duration_ns(1e6, data_rate);
-    double emergency_ns = 0;
-    for (int bytes : emergency_frames) emergency_ns += canfd_frame_bits_worst(bytes).duration_ns(1e6, data_rate);
-    ns += emergency_ns;
-    MESSAGE("CAN FD 1/", data_rate / 1e6, " Mbit/s: sensor frame ", sensor_bytes, " B, command frame ", command_bytes,
-            " B; worst cycle ", (ns - emergency_ns) / 1000.0, " us, with both emergency frames ", ns / 1000.0,
-            " us (", ns / 1e4, "% of 1 ms)");
-    if (data_rate == 5e6) CHECK(ns <= 500'000.0);
+TEST_CASE("hal/bus budget of the DBC schedule: every command set's worst cycle at or under 50% of 1 ms on CAN FD 1/5 Mbit/s") {
+  exc::test::DbcNetwork network;
+  const auto dbc = exc::test::read_dbc(EXC_CAN_DBC_FILE, &network);
+  REQUIRE(network.baudrate == exc::hal::kNominalBitRate);       // the rates the times are computed at
+  REQUIRE(network.baudrate_canfd == exc::hal::kDataBitRate);
+  const std::string names[] = {"", "effort", "valve", "pilot"};
+  // The figures docs/can-protocol.md states, from the DBC with the worst-case frame lengths:
+  //   cyclic: SYNC (4 B) + the command frame + SENS_MACHINE (48 B)
+  //   worst:  cyclic + a heartbeat (2 B) + both emergency frames (4 B each)
+  const std::int64_t cyclic[] = {0, 250'800, 242'800, 258'800};
+  const std::int64_t worst[] = {0, 392'600, 384'600, 400'600};
+  for (int set = 1; set <= 3; ++set) {
+    CAPTURE(names[set]);
+    const CycleTime t = worst_cycle(dbc, set);
+    MESSAGE(names[set], " commands: cyclic frames ", t.cyclic_ns / 1000.0, " us (", t.cyclic_ns / 1e4,
+            " % of 1 ms), worst cycle with a heartbeat and both emergency frames ", t.worst_ns / 1000.0, " us (",
+            t.worst_ns / 1e4, " %)");
+    CHECK(t.cyclic_ns == cyclic[set]);
+    CHECK(t.worst_ns == worst[set]);
+    CHECK(t.worst_ns <= 500'000);  // the budget: half of the 1 ms cycle
   }
 }
 
@@ -138,13 +128,13 @@ TEST_CASE("hal/exact frame length: CRC-15 check value, no-stuff and worst-case f
   const auto next = [&state] { return state = state * 1664525u + 1013904223u; };
   int longest[9] = {};
   for (int trial = 0; trial < 20000; ++trial) {
-    const std::uint8_t dlc = static_cast<std::uint8_t>(next() % 9);
+    const std::uint8_t len = static_cast<std::uint8_t>(next() % 9);
     std::uint8_t data[8] = {};
-    for (int i = 0; i < dlc; ++i) data[i] = static_cast<std::uint8_t>(next() >> 24);
-    const int n = exc::hal::classical_frame_bits(next() & 0x7FF, dlc, data);
-    CHECK(n >= 47 + 8 * dlc);
-    CHECK(n <= classical_frame_bits_worst(dlc));
-    longest[dlc] = std::max(longest[dlc], n);
+    for (int i = 0; i < len; ++i) data[i] = static_cast<std::uint8_t>(next() >> 24);
+    const int n = exc::hal::classical_frame_bits(next() & 0x7FF, len, data);
+    CHECK(n >= 47 + 8 * len);
+    CHECK(n <= classical_frame_bits_worst(len));
+    longest[len] = std::max(longest[len], n);
   }
   // All-zero content stuffs every fifth bit from SOF on: far more than random data, and never more
   // than the worst case.
@@ -154,4 +144,56 @@ TEST_CASE("hal/exact frame length: CRC-15 check value, no-stuff and worst-case f
                                      << ", worst case " << classical_frame_bits_worst(8));
   CHECK(zero_frame > 47 + 64 + 15);
   CHECK(zero_frame <= classical_frame_bits_worst(8));
+}
+
+TEST_CASE("hal/exact CAN FD frame length: worked frames bit by bit, and every content between the unstuffed and the worst case") {
+  // ID 0x000, no data, BRS. Bits: SOF 0, ID 00000000000, RRS 0, IDE 0, FDF 1, res 0, BRS 1, ESI 0,
+  // DLC 0000. Five zeros (SOF and 4 ID bits) -> stuff 1; five more ID zeros -> stuff 1; then
+  // 0 0 | 0 0 1 0 1 (RRS IDE FDF res BRS) and ESI + DLC, five zeros -> stuff 1 after the last DLC bit.
+  // Nominal: 17 + 2 stuff + 13 (CRC delimiter .. intermission) = 32; data: ESI + DLC 5 + 1 stuff +
+  // 27 (stuff count and CRC-17 with fixed stuff bits) = 33.
+  const exc::hal::CanFdFrameBits empty = canfd_frame_bits(0x000, 0, nullptr, true);
+  CHECK(empty.nominal == 32);
+  CHECK(empty.data == 33);
+  CHECK(empty.duration_ns() == 32 * 1000 + 33 * 200);
+  // ID 0x555 (10101010101) and eight bytes 0x55: never five equal bits, no stuff bit at all.
+  std::uint8_t alternating[8];
+  std::fill(std::begin(alternating), std::end(alternating), 0x55);
+  const exc::hal::CanFdFrameBits none = canfd_frame_bits(0x555, 8, alternating, true);
+  CHECK(none.nominal == 30);
+  CHECK(none.data == 5 + 64 + 27);
+  // Without the bit-rate switch every bit is nominal.
+  const exc::hal::CanFdFrameBits slow = canfd_frame_bits(0x555, 8, alternating, false);
+  CHECK(slow.data == 0);
+  CHECK(slow.nominal == none.total());
+
+  std::mt19937 random(99);
+  const int lengths[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
+  for (int n : lengths) {
+    CAPTURE(n);
+    const exc::hal::CanFdFrameBits worst = canfd_frame_bits_worst(n);
+    const int unstuffed_data = 5 + 8 * n + exc::hal::canfd_crc_field_bits(n);
+    for (int trial = 0; trial < 2000; ++trial) {
+      std::uint8_t data[64];
+      // Random bytes, and runs of equal bytes that stuff heavily.
+      const bool runs = trial % 2 == 0;
+      for (int i = 0; i < n; ++i) data[i] = runs ? static_cast<std::uint8_t>((random() % 2) ? 0xFF : 0x00) : static_cast<std::uint8_t>(random());
+      const exc::hal::CanFdFrameBits b = canfd_frame_bits(random() & 0x7FF, static_cast<std::uint8_t>(n), data, true);
+      CHECK(b.nominal >= 30);
+      CHECK(b.nominal <= worst.nominal);
+      CHECK(b.data >= unstuffed_data);
+      CHECK(b.total() <= worst.total());
+      CHECK(b.duration_ns() <= worst.duration_ns());
+    }
+  }
+  // frame_time_ns: classical frames at the nominal rate, FD frames at both.
+  exc::hal::CanFrame f;
+  f.id = 0x555;
+  f.len = 8;
+  std::copy(std::begin(alternating), std::end(alternating), f.data);
+  CHECK(exc::hal::frame_time_ns(f) == exc::hal::classical_frame_bits(0x555, 8, alternating) * 1000);
+  f.fd = true;
+  CHECK(exc::hal::frame_time_ns(f) == none.total() * 1000);
+  f.brs = true;
+  CHECK(exc::hal::frame_time_ns(f) == 30 * 1000 + 96 * 200);
 }

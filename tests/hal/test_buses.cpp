@@ -64,12 +64,36 @@ TEST_CASE("hal/memory bus counts overflow of a full receive ring and keeps the o
     CHECK(f.data[0] == i);
     CHECK(f.timestamp_ns == i + 1);  // stamped by the hub's clock at send
   }
-  // Invalid frames are refused at send.
+  // Invalid frames are refused at send: an ID above 11 bits, 9 bytes (neither classical nor an FD
+  // length), more than 8 bytes classical, a bit-rate switch on a classical frame.
   CanFrame bad = frame_with(0x800, 0);
   CHECK_FALSE(tx->send(bad));
-  bad = frame_with(0x100, 0);
-  bad.dlc = 9;
+  bad = frame_with(0x100, 0, true);
+  bad.len = 9;
   CHECK_FALSE(tx->send(bad));
+  bad = frame_with(0x100, 0, false, 12);
+  CHECK_FALSE(tx->send(bad));
+  bad = frame_with(0x100, 0);
+  bad.brs = true;
+  CHECK_FALSE(tx->send(bad));
+  CHECK(rx->pending() == 0);
+}
+
+TEST_CASE("hal/memory bus carries CAN FD frames of every length whole") {
+  MemoryBusHub hub;
+  MemoryBusNode* tx = hub.attach(32);
+  MemoryBusNode* rx = hub.attach(32);
+  const std::uint8_t lengths[] = {0, 1, 8, 12, 16, 20, 24, 32, 48, 64};
+  for (std::uint8_t len : lengths) REQUIRE(tx->send(frame_with(0x180, len, true, len)));
+  CanFrame f;
+  for (std::uint8_t len : lengths) {
+    REQUIRE(rx->receive(f));
+    const CanFrame sent = frame_with(0x180, len, true, len);
+    CHECK(f.fd);
+    CHECK(f.brs);
+    CHECK(f.len == len);
+    for (int i = 0; i < kCanFdMaxLength; ++i) CHECK(f.data[i] == sent.data[i]);
+  }
 }
 
 TEST_CASE("hal/memory bus refuses more than kMaxNodes nodes") {
@@ -96,7 +120,7 @@ TEST_CASE("hal/fault injection drops, corrupts and delays the configured fractio
   for (int i = 0; i < kFrames; ++i) {
     CanFrame f;
     f.id = 0x200;
-    f.dlc = 8;
+    f.len = 8;
     const auto seq = static_cast<std::uint32_t>(i + 1);
     for (int k = 0; k < 4; ++k) f.data[k] = static_cast<std::uint8_t>(seq >> (8 * k));
     for (int k = 4; k < 8; ++k) f.data[k] = static_cast<std::uint8_t>(~f.data[k - 4]);  // check bytes

@@ -1,6 +1,7 @@
-// Randomized decoder fuzz: millions of random and half-valid frames through CanFrameCodec::accept,
-// each verdict compared with a reference check written here from the DBC (its own CRC, bit by bit,
-// and its own counter model). Nothing the reference rejects may be accepted, and vice versa.
+// Randomized decoder fuzz: millions of random and half-valid frames (classical and CAN FD, every
+// length up to 64 bytes) through CanFrameCodec::accept, each verdict compared with a reference check
+// written here from the DBC (its own CRC, bit by bit, and its own counter model). Nothing the
+// reference rejects may be accepted, and vice versa.
 #include <doctest/doctest.h>
 
 #include <array>
@@ -16,7 +17,7 @@ namespace {
 
 // CRC-8, polynomial 0x1D, init 0xFF, xor 0xFF, computed bit by bit (no table).
 std::uint8_t reference_crc(std::uint32_t id, const std::uint8_t* data, int n) {
-  std::uint8_t bytes[10] = {static_cast<std::uint8_t>(id & 0xFF), static_cast<std::uint8_t>(id >> 8)};
+  std::uint8_t bytes[2 + 64] = {static_cast<std::uint8_t>(id & 0xFF), static_cast<std::uint8_t>(id >> 8)};
   for (int i = 0; i < n; ++i) bytes[2 + i] = data[i];
   std::uint8_t crc = 0xFF;
   for (int i = 0; i < n + 2; ++i) {
@@ -36,12 +37,15 @@ struct ReferenceSequence {
 
 TEST_CASE("hal/codec fuzz: 2 million random frames, verdicts equal a reference check") {
   const auto dbc = exc::test::read_dbc(EXC_CAN_DBC_FILE);
-  std::map<std::uint32_t, int> dlc_of;
+  std::map<std::uint32_t, int> length_of;
+  std::map<std::uint32_t, bool> fd_of;
   std::vector<std::uint32_t> ids;
   for (const auto& m : dbc) {
-    dlc_of[m.id] = m.dlc;
+    length_of[m.id] = m.length;
+    fd_of[m.id] = m.fd;
     ids.push_back(m.id);
   }
+  constexpr std::uint8_t kLengths[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
   CanFrameCodec codec;  // gap 3, resync after 3; timestamps stay 0 so the pause rule is off
   std::map<std::uint32_t, ReferenceSequence> reference;
   std::mt19937_64 random(20240611);
@@ -55,22 +59,29 @@ TEST_CASE("hal/codec fuzz: 2 million random frames, verdicts equal a reference c
     const int kind = static_cast<int>(r % 16);
     frame.id = kind < 13 ? ids[(r >> 8) % ids.size()] : (kind < 15 ? static_cast<std::uint32_t>((r >> 8) & 0x7FF)
                                                                     : static_cast<std::uint32_t>(r >> 32));
-    const auto known = dlc_of.find(frame.id);
-    frame.dlc = (known != dlc_of.end() && ((r >> 20) % 8) != 0) ? static_cast<std::uint8_t>(known->second)
-                                                                : static_cast<std::uint8_t>((r >> 24) % 16);
-    const std::uint64_t payload = random();
-    for (int i = 0; i < 8; ++i) frame.data[i] = static_cast<std::uint8_t>(payload >> (8 * i));
-    // Half of the right-length frames get a valid checksum, so the counter logic is fuzzed too.
-    if (known != dlc_of.end() && frame.dlc == known->second && ((r >> 40) & 1)) {
-      frame.data[frame.dlc - 1] = reference_crc(frame.id, frame.data, frame.dlc - 1);
+    const auto known = length_of.find(frame.id);
+    frame.len = (known != length_of.end() && ((r >> 20) % 8) != 0) ? static_cast<std::uint8_t>(known->second)
+                                                                    : kLengths[(r >> 24) % 16];
+    // Mostly the DBC's format; one in 16 the other one (a classical frame from a foreign node).
+    frame.fd = (known != length_of.end() ? fd_of[frame.id] : true) != (((r >> 44) % 16) == 0);
+    if (!frame.fd && frame.len > 8) frame.len = 8;
+    frame.brs = frame.fd && ((r >> 48) & 1);
+    for (int i = 0; i < frame.len; i += 8) {
+      const std::uint64_t payload = random();
+      for (int b = 0; b < 8 && i + b < frame.len; ++b) frame.data[i + b] = static_cast<std::uint8_t>(payload >> (8 * b));
+    }
+    const bool right_format = known != length_of.end() && frame.len == known->second && frame.fd == fd_of[frame.id];
+    // Half of the right-format frames get a valid checksum, so the counter logic is fuzzed too.
+    if (right_format && ((r >> 40) & 1)) {
+      frame.data[frame.len - 1] = reference_crc(frame.id, frame.data, frame.len - 1);
     }
 
     RxVerdict expected = RxVerdict::ok;
-    if (known == dlc_of.end()) {
+    if (known == length_of.end()) {
       expected = RxVerdict::unknown_id;
-    } else if (frame.dlc != known->second) {
-      expected = RxVerdict::wrong_dlc;
-    } else if (frame.data[frame.dlc - 1] != reference_crc(frame.id, frame.data, frame.dlc - 1)) {
+    } else if (!right_format) {
+      expected = RxVerdict::wrong_format;
+    } else if (frame.data[frame.len - 1] != reference_crc(frame.id, frame.data, frame.len - 1)) {
       expected = RxVerdict::corrupt;
     } else {
       ReferenceSequence& seq = reference[frame.id];
@@ -95,15 +106,16 @@ TEST_CASE("hal/codec fuzz: 2 million random frames, verdicts equal a reference c
     ++verdicts[static_cast<std::size_t>(got)];
     if (got != expected || (got == RxVerdict::ok) != (message != nullptr)) {
       if (++mismatches <= 5) {
-        MESSAGE("mismatch: id ", frame.id, " dlc ", int(frame.dlc), " got ", to_string(got), " expected ", to_string(expected));
+        MESSAGE("mismatch: id ", frame.id, " len ", int(frame.len), " fd ", frame.fd, " got ", to_string(got), " expected ",
+                to_string(expected));
       }
     }
     if (message != nullptr) {
-      double values[8];
+      double values[kMaxDataSignals];
       decode_message(*message, frame, values);  // must not crash on any accepted payload
     }
   }
-  MESSAGE("verdicts: ok ", verdicts[0], ", unknown ", verdicts[1], ", wrong_dlc ", verdicts[2], ", corrupt ", verdicts[3],
+  MESSAGE("verdicts: ok ", verdicts[0], ", unknown ", verdicts[1], ", wrong_format ", verdicts[2], ", corrupt ", verdicts[3],
           ", repeated ", verdicts[4], ", stale ", verdicts[5]);
   CHECK(mismatches == 0);
   // The fuzz reached every branch.

@@ -1,6 +1,7 @@
 // docs/can-protocol.md's frame and signal tables against the DBC, so the page cannot drift.
 #include <doctest/doctest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -43,12 +44,16 @@ TEST_CASE("hal/protocol page lists every DBC frame and signal exactly as the DBC
     CAPTURE(line);
     REQUIRE(message != nullptr);
     CHECK(cells[1] == message->name);
-    if (cells.size() == 6) {  // frame table: ID, frame, sender, DLC, period, worst-case bits
+    if (cells.size() == 7) {  // frame table: ID, frame, sender, bytes, period, worst-case bits, worst-case time
       ++frame_rows;
       CHECK(cells[2] == message->sender);
-      CHECK(std::stoi(cells[3]) == message->dlc);
+      CHECK(std::stoi(cells[3]) == message->length);
       CHECK(cells[4] == (message->cycle_ms == 0 ? std::string("event") : std::to_string(message->cycle_ms) + " ms"));
-      CHECK(std::stoi(cells[5]) == exc::hal::classical_frame_bits_worst(message->dlc));
+      const exc::hal::CanFdFrameBits worst = exc::hal::canfd_frame_bits_worst(message->length);
+      CHECK(cells[5] == std::to_string(worst.nominal) + " + " + std::to_string(worst.data));
+      char time[32];
+      std::snprintf(time, sizeof time, "%.1f us", static_cast<double>(worst.duration_ns()) / 1000.0);
+      CHECK(cells[6] == time);
     } else {
       REQUIRE(cells.size() == 11);  // signal table
       ++signal_rows;

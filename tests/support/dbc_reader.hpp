@@ -1,7 +1,8 @@
 #pragma once
-// A small reader for the parts of a DBC file the tests check against: BO_ (messages), SG_ (signals)
-// and BA_ "GenMsgCycleTime" / "ExcCommandSet" attributes. Written independently of hal/ so the test
-// compares the codec's tables with the file, not with themselves.
+// A small reader for the parts of a DBC file the tests check against: BO_ (messages), SG_ (signals),
+// the message attributes GenMsgCycleTime, GenMsgSendType, GenMsgCycleTimeFast, ExcCommandSet,
+// VFrameFormat and CANFD_BRS, and the network's Baudrate and BaudrateCANFD. Written independently of
+// hal/ so the test compares the codec's tables with the file, not with themselves.
 #include <cstdint>
 #include <fstream>
 #include <map>
@@ -28,22 +29,30 @@ struct DbcSignal {
 struct DbcMessage {
   std::uint32_t id = 0;
   std::string name;
-  int dlc = 0;
+  int length = 0;  // payload bytes (BO_ size)
   std::string sender;
   std::vector<DbcSignal> signals;
   int cycle_ms = 0;
   bool if_active = false;  // GenMsgSendType IfActive: sent on entry, then every cycle_fast_ms while active
   int cycle_fast_ms = 0;
-  int command_set = 0;  // index into ExcCommandSet's enum: 0 none, 1 effort, 2 valve
+  int command_set = 0;  // index into ExcCommandSet's enum: 0 none, 1 effort, 2 valve, 3 pilot
+  bool fd = false;       // VFrameFormat 14: StandardCAN_FD
+  bool brs = false;      // CANFD_BRS 1
 };
 
-inline std::vector<DbcMessage> read_dbc(const std::string& path) {
+struct DbcNetwork {
+  long baudrate = 0;        // BA_ "Baudrate": the nominal (arbitration) bit rate, bit/s
+  long baudrate_canfd = 0;  // BA_ "BaudrateCANFD": the CAN FD data-phase bit rate, bit/s
+};
+
+inline std::vector<DbcMessage> read_dbc(const std::string& path, DbcNetwork* network = nullptr) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error("cannot open DBC file " + path);
   const std::regex bo(R"(^BO_\s+(\d+)\s+(\w+)\s*:\s*(\d+)\s+(\w+))");
   const std::regex sg(
       R"(^\s+SG_\s+(\w+)\s*:\s*(\d+)\|(\d+)@([01])([+-])\s*\(([^,]+),([^)]+)\)\s*\[([^|]+)\|([^\]]+)\]\s*\"([^\"]*)\")");
   const std::regex ba(R"(^BA_\s+\"(\w+)\"\s+BO_\s+(\d+)\s+(\d+)\s*;)");
+  const std::regex ba_network(R"(^BA_\s+\"(\w+)\"\s+(\d+)\s*;)");
   std::vector<DbcMessage> messages;
   std::map<std::uint32_t, std::size_t> by_id;
   std::string line;
@@ -55,7 +64,7 @@ inline std::vector<DbcMessage> read_dbc(const std::string& path) {
       DbcMessage message;
       message.id = static_cast<std::uint32_t>(std::stoul(m[1]));
       message.name = m[2];
-      message.dlc = std::stoi(m[3]);
+      message.length = std::stoi(m[3]);
       message.sender = m[4];
       by_id[message.id] = messages.size();
       messages.push_back(message);
@@ -80,6 +89,11 @@ inline std::vector<DbcMessage> read_dbc(const std::string& path) {
       if (m[1] == "GenMsgCycleTimeFast") messages[it->second].cycle_fast_ms = std::stoi(m[3]);
       if (m[1] == "GenMsgSendType") messages[it->second].if_active = std::stoi(m[3]) == 1;
       if (m[1] == "ExcCommandSet") messages[it->second].command_set = std::stoi(m[3]);
+      if (m[1] == "VFrameFormat") messages[it->second].fd = std::stoi(m[3]) == 14;
+      if (m[1] == "CANFD_BRS") messages[it->second].brs = std::stoi(m[3]) == 1;
+    } else if (std::regex_search(line, m, ba_network) && network != nullptr) {
+      if (m[1] == "Baudrate") network->baudrate = std::stol(m[2]);
+      if (m[1] == "BaudrateCANFD") network->baudrate_canfd = std::stol(m[2]);
     }
   }
   return messages;

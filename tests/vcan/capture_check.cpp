@@ -17,10 +17,10 @@ std::string hex(std::uint32_t v) {
 }
 
 std::string decoded_signals(const exc::hal::MessageSpec& spec, const exc::hal::CanFrame& frame) {
-  double values[16] = {};
+  double values[exc::hal::kMaxDataSignals] = {};
   exc::hal::decode_message(spec, frame, values);
   std::string text;
-  for (std::size_t i = 0; i < spec.data_signal_count() && i < 16; ++i) {
+  for (std::size_t i = 0; i < spec.data_signal_count(); ++i) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "%s%s=%g", text.empty() ? "" : " ", spec.data_signal(i).name, values[i]);
     text += buf;
@@ -60,8 +60,8 @@ CaptureReport check_capture(std::istream& in, const std::string& interface_name)
       report.errors.push_back(where + "interface " + line.interface_name + ", expected " + interface_name);
       continue;
     }
-    if (line.extended || line.remote || line.fd) {
-      report.errors.push_back(where + "not a classical 11-bit data frame");
+    if (line.extended || line.remote) {
+      report.errors.push_back(where + "not an 11-bit data frame");
       continue;
     }
     const CanFrame& frame = line.frame;
@@ -70,14 +70,22 @@ CaptureReport check_capture(std::istream& in, const std::string& interface_name)
       report.errors.push_back(where + "identifier " + hex(frame.id) + " is not in the DBC");
       continue;
     }
-    if (frame.dlc != spec->dlc) {
-      report.errors.push_back(where + spec->name + " has DLC " + std::to_string(frame.dlc) + ", the DBC says " +
-                              std::to_string(spec->dlc));
+    if (frame.fd != spec->fd || frame.brs != spec->brs) {
+      const auto format = [](bool fd, bool brs) {
+        return std::string(fd ? (brs ? "CAN FD with bit-rate switch" : "CAN FD without bit-rate switch") : "classical CAN");
+      };
+      report.errors.push_back(where + spec->name + " is " + format(frame.fd, frame.brs) + ", the DBC says " +
+                              format(spec->fd, spec->brs));
       continue;
     }
-    const std::uint8_t crc = frame_checksum(frame.id, frame.data, static_cast<std::size_t>(frame.dlc - 1));
-    if (crc != frame.data[frame.dlc - 1]) {
-      report.errors.push_back(where + spec->name + " checksum " + hex(frame.data[frame.dlc - 1]) + ", expected " + hex(crc));
+    if (frame.len != spec->length) {
+      report.errors.push_back(where + spec->name + " has " + std::to_string(frame.len) + " bytes, the DBC says " +
+                              std::to_string(spec->length));
+      continue;
+    }
+    const std::uint8_t crc = frame_checksum(frame.id, frame.data, static_cast<std::size_t>(frame.len - 1));
+    if (crc != frame.data[frame.len - 1]) {
+      report.errors.push_back(where + spec->name + " checksum " + hex(frame.data[frame.len - 1]) + ", expected " + hex(crc));
       continue;
     }
     const std::uint8_t counter = frame_counter(frame);

@@ -1,11 +1,12 @@
 #pragma once
 // Checks a `candump -L` capture of the excavator bus frame by frame against the protocol
-// (hal/excavator.dbc): known 11-bit data frames on the expected interface, the DBC's DLC, a valid
-// checksum, and counters in sequence with nothing lost. Stricter than the receivers' codec, which
-// tolerates lost frames: on vcan nothing may be lost.
+// (hal/excavator.dbc): known 11-bit data frames on the expected interface, the DBC's frame format
+// (CAN FD with bit-rate switch) and length, a valid checksum, and counters in sequence with nothing
+// lost. Stricter than the receivers' codec, which tolerates lost frames and does not look at BRS: on
+// vcan nothing may be lost.
 //   - Cyclic (1 ms) frames carry the cycle mod 16: SYNC's counter steps by exactly one from SYNC to
 //     SYNC, and every other cyclic frame carries the counter of the last SYNC before it.
-//   - The others (pressures, heartbeats, emergencies) count their own sends: +1 per frame of an ID.
+//   - The others (heartbeats, emergencies) count their own sends: +1 per frame of an ID.
 // It also measures how each side reacted when the other fell silent (the kill tests), in cycles
 // (SYNC frames), so the figure does not depend on how fast the machine running the test is.
 #include <cstddef>

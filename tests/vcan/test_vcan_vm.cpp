@@ -98,10 +98,15 @@ TEST_CASE("vcan/vcan-vm rejects bad options, naming the option and its range") {
 // One VM boot for everything that needs a running vcan0 (each boot costs 12-40 s of CI time).
 TEST_CASE("vcan/vcan-vm passes output and status and directory and environment and its vcan0 carries frames and the HAL test") {
   const fs::path dir = make_work_dir("one_vm");
-  // Edge IDs and lengths: DLC 0..8, 11-bit extremes, one 29-bit ID.
+  // Edge IDs and lengths: classical 0..8 bytes, 11-bit extremes, one 29-bit ID; CAN FD with and
+  // without the bit-rate switch at 0, 12 and 64 bytes, and the protocol's 48-byte sensor frame.
+  std::string fd64 = "7FF##1", fd48 = "180##1";
+  for (int i = 0; i < 64; ++i) fd64 += "0123456789ABCDEF"[i % 16] + std::string(1, "FEDCBA9876543210"[i % 16]);
+  for (int i = 0; i < 48; ++i) fd48 += i % 2 ? "5A" : "C3";
   const std::vector<std::string> sent = {"123#DEADBEEF", "000#",           "7FF#0102030405060708",
                                          "080#00",       "1ABCDEF0#11",    "456#A1B2C3",
-                                         "001#FFFFFFFFFFFFFFFF", "7FE#0A0B0C0D0E", "234#1122"};
+                                         "001#FFFFFFFFFFFFFFFF", "7FE#0A0B0C0D0E", "234#1122",
+                                         "080##1",       "103##0112233445566778899AABBCC", fd48, fd64};
   std::string frames;
   for (const std::string& f : sent) frames += " " + f;
   // candump is started first; the probe sends only once the kernel lists candump's receiver on
@@ -134,6 +139,7 @@ TEST_CASE("vcan/vcan-vm passes output and status and directory and environment a
   CHECK(link.find("vcan0") != std::string::npos);
   CHECK(link.find("UP") != std::string::npos);
   CHECK(link.find("link/can") != std::string::npos);
+  CHECK(link.find("mtu 72") != std::string::npos);  // CANFD_MTU: vcan0 carries CAN FD frames
 
   // What the probe's second raw socket received, in order.
   INFO("probe stderr: ", read_text_file(dir / "probe.err"));
@@ -153,16 +159,27 @@ TEST_CASE("vcan/vcan-vm passes output and status and directory and environment a
     CHECK(line.interface_name == "vcan0");
     CHECK(line.frame.timestamp_ns >= last_ns);
     last_ns = line.frame.timestamp_ns;
-    // The frame text after "vcan0 " is candump's own rendering: compare it with what was sent,
-    // and the parsed fields with the bytes of the sent text.
-    CHECK(captured[i].substr(captured[i].find(' ', captured[i].find(' ') + 1) + 1) == sent[i]);
+    // The frame text after "vcan0 " is candump's own rendering: compare it with what was sent (an
+    // FD frame's flags digit without CANFD_FDF, 4, which the kernel adds to every FD frame it
+    // delivers), and the parsed fields with the bytes of the sent text.
+    std::string rendered = captured[i].substr(captured[i].find(' ', captured[i].find(' ') + 1) + 1);
+    const std::size_t flags_at = rendered.find("##");
+    if (flags_at != std::string::npos && flags_at + 2 < rendered.size()) {
+      const int flags = std::stoi(rendered.substr(flags_at + 2, 1), nullptr, 16);
+      rendered[flags_at + 2] = "0123456789ABCDEF"[flags & ~4];
+    }
+    CHECK(rendered == sent[i]);
     const std::string& s = sent[i];
     const std::size_t hash = s.find('#');
+    const bool fd = s.compare(hash, 2, "##") == 0;
+    const std::size_t data_at = hash + (fd ? 3 : 1);
     CHECK(line.extended == (hash == 8));
+    CHECK(line.frame.fd == fd);
+    CHECK(line.frame.brs == (fd && s[hash + 2] == '1'));
     CHECK(line.frame.id == std::stoul(s.substr(0, hash), nullptr, 16));
-    CHECK(line.frame.dlc == (s.size() - hash - 1) / 2);
-    for (std::size_t b = 0; b < line.frame.dlc; ++b)
-      CHECK(line.frame.data[b] == std::stoul(s.substr(hash + 1 + 2 * b, 2), nullptr, 16));
+    CHECK(line.frame.len == (s.size() - data_at) / 2);
+    for (std::size_t b = 0; b < line.frame.len; ++b)
+      CHECK(line.frame.data[b] == std::stoul(s.substr(data_at + 2 * b, 2), nullptr, 16));
   }
 
 #ifdef EXC_HAL_TESTS
@@ -171,7 +188,7 @@ TEST_CASE("vcan/vcan-vm passes output and status and directory and environment a
   INFO("hal test output: ", hal);
   CHECK(read_text_file(dir / "hal.status") == "0\n");
   CHECK(hal.find("SKIPPED") == std::string::npos);
-  CHECK(std::regex_search(hal, std::regex("test cases: +2 \\| +2 passed \\| +0 failed")));
+  CHECK(std::regex_search(hal, std::regex("test cases: +3 \\| +3 passed \\| +0 failed")));
 #endif
 }
 

@@ -29,7 +29,7 @@ struct Options {
 };
 
 // The figures both the two-process run and the reference compute. Positions go through the CAN
-// encoding in the two-process run, so the reference quantizes them the same way (SENS_* scaling).
+// encoding in the two-process run, so the reference quantizes them the same way (SENS_MACHINE scaling).
 struct Figures {
   double sum_sq[kAxisCount] = {};
   long samples = 0;
@@ -135,13 +135,12 @@ int run_reference(const Options& o) {
   for (long k = 0; k < o.cycles; ++k) {
     double q[kAxisCount];
     for (int j = 0; j < kAxisCount; ++j) {
-      // The SENS_* position signal's quantization, as the frames carry it.
+      // The SENS_MACHINE position signal's quantization, as the frame carries it.
+      static constexpr const char* kPositionSignal[kAxisCount] = {"SwingAngle", "BoomLength", "ArmLength", "BucketLength"};
       CanFrame frame;
-      const MessageSpec& spec = *find_message(can_id::sens_swing + static_cast<std::uint32_t>(j));
+      const MessageSpec& spec = *find_message(can_id::sens_machine);
       std::size_t i = 0;
-      while (i + 1 < spec.data_signal_count() && !std::strstr(spec.data_signal(i).name, "Angle") &&
-             !std::strstr(spec.data_signal(i).name, "Length"))
-        ++i;
+      while (i + 1 < spec.data_signal_count() && std::strcmp(spec.data_signal(i).name, kPositionSignal[j]) != 0) ++i;
       encode_signal(frame, spec.data_signal(i), position_at(static_cast<std::uint64_t>(k), j));
       q[j] = decode_signal(frame, spec.data_signal(i));
     }

@@ -19,9 +19,10 @@ int main(int argc, char** argv) {
       std::puts(
           "Usage: vcan-capture-check [--interface NAME] CAPTURE\n"
           "Checks every line of CAPTURE (written by `candump -L`) against hal/excavator.dbc: known\n"
-          "identifier, the DBC's DLC, valid CRC-8 checksum, counters in sequence with nothing lost\n"
-          "(cyclic frames carry the last SYNC's counter; SYNC, pressures, heartbeats and emergencies\n"
-          "step by one), all on interface NAME (default vcan0; \"\" for any).\n"
+          "identifier, the DBC's frame format (CAN FD with bit-rate switch) and length, valid CRC-8\n"
+          "checksum, counters in sequence with nothing lost (cyclic frames carry the last SYNC's\n"
+          "counter; SYNC, heartbeats and emergencies step by one), all on interface NAME (default\n"
+          "vcan0; \"\" for any).\n"
           "  --expect-safe-stop-within N  also require an FW_EMERGENCY frame at most N cycles (SYNC\n"
           "                               frames) after the plant's last frame (plant killed)\n"
           "  --expect-plant-hold          also require a PLANT_EMERGENCY frame after the firmware's\n"

@@ -1,0 +1,123 @@
+// PlantNode, the simulated machine's end of the bus, with the firmware's port on the other end of an
+// in-memory bus: what SENS_MACHINE carries of the plant's sensors (every chamber and both pumps when
+// hydraulic, PressureValid), and CMD_PILOT applied to the plant as pilot commands.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "hal/memory_bus.hpp"
+#include "plant_scenes.hpp"
+#include "sim_plant/plant_node.hpp"
+
+using namespace exc;
+using namespace exc::plant;
+
+namespace {
+
+// The firmware's port and a PlantNode on one memory bus.
+struct NodeBench {
+  Plant plant;
+  hal::MemoryBusHub hub;
+  hal::MemoryBusNode* fw_bus = hub.attach();
+  hal::MemoryBusNode* plant_bus = hub.attach();
+  hal::FirmwareCanPort firmware{*fw_bus};
+  hal::PlantCanPort port{*plant_bus};
+  app::PlantNode node{plant, port, nullptr};
+  explicit NodeBench(const Scene& scene) : plant(scene) {}
+  // One cycle: SYNC(k), the plant's step and answer, the firmware's read, then its command.
+  bool cycle(std::uint64_t k, const hal::CommandState& command, hal::SensorState& seen) {
+    firmware.send_sync(k);
+    REQUIRE(node.poll());
+    const bool complete = firmware.read(seen);
+    hal::CommandState c = command;
+    c.cycle = k;
+    firmware.write(c);
+    return complete;
+  }
+};
+
+hal::CommandState boom_pilots(double a, double b) {
+  hal::CommandState c;
+  c.mode = hal::CommandMode::pilot;
+  c.pilot_a[hal::kBoom] = a;
+  c.pilot_b[hal::kBoom] = b;
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("plant/node: CMD_PILOT drives the hydraulic plant as pilot commands, step for step as the plant driven directly") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  const Scene scene = t.scene();
+  NodeBench bench(scene);
+  // The same commands straight into a second plant: cycle 0 holds (no command yet: valves centred),
+  // from cycle 1 on the firmware's pilots of the previous cycle. 3 MPa and 1 MPa are whole steps of
+  // the 2 kPa signal, so the bus carries them exactly.
+  Plant direct(scene);
+  ActuatorCommand centred;
+  centred.mode = ActuatorCommand::valve;
+  ActuatorCommand pilots;
+  pilots.mode = ActuatorCommand::pilot;
+  pilots.pilot_a[1] = 3e6;
+  pilots.pilot_b[1] = 1e6;
+  hal::SensorState seen;
+  const double l0 = scene.q_a0[1];
+  for (std::uint64_t k = 0; k < 600; ++k) {
+    REQUIRE(bench.cycle(k, boom_pilots(3e6, 1e6), seen));
+    REQUIRE(direct.step(k == 0 ? centred : pilots).ok());
+    REQUIRE_FALSE(bench.node.failed());
+    REQUIRE(bench.plant.state().q_a == direct.state().q_a);  // bit for bit
+  }
+  const double full = scene.actuators.hydraulic.pilot_full_stroke;
+  MESSAGE("boom " << l0 << " -> " << bench.plant.state().q_a[1] << " m in 0.6 s; spool " << bench.plant.state().spool[1]
+                  << " (pilot difference / full stroke " << 2e6 / full << ")");
+  CHECK(bench.plant.state().q_a[1] > l0 + 0.01);  // A end above B end: the boom extends
+  CHECK(bench.plant.state().spool[1] == doctest::Approx(2e6 / full).epsilon(1e-3));
+  CHECK(bench.port.rx_stats().rejected() == 0);
+}
+
+TEST_CASE("plant/node: SENS_MACHINE carries every chamber and both pump pressures of the hydraulic plant's sensors, PressureValid 1") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  NodeBench bench(t.scene());
+  hal::SensorState seen;
+  for (std::uint64_t k = 0; k < 300; ++k) {
+    REQUIRE(bench.cycle(k, boom_pilots(4e6, 0), seen));
+    const SensorReading& r = bench.plant.sensors();
+    CHECK(seen.pressure_valid);
+    // 1 kPa per bit: within half of it.
+    CHECK(std::fabs(seen.pressure_a[hal::kSwing] - r.swing_pressure[0]) <= 500);
+    CHECK(std::fabs(seen.pressure_b[hal::kSwing] - r.swing_pressure[1]) <= 500);
+    for (int c = 0; c < 3; ++c) {
+      CHECK(std::fabs(seen.pressure_a[c + 1] - r.pressure_a[c]) <= 500);
+      CHECK(std::fabs(seen.pressure_b[c + 1] - r.pressure_b[c]) <= 500);
+    }
+    for (int p = 0; p < 2; ++p) CHECK(std::fabs(seen.pump_pressure[p] - r.pump_pressure[p]) <= 500);
+    for (int j = 0; j < 4; ++j) CHECK(std::fabs(seen.position[j] - r.position[j]) <= (j == 0 ? 0.5e-6 : 0.5e-5));
+  }
+  // Pressures that mean something: the boom's bore side holds the boom up, the pumps above the load.
+  CHECK(seen.pressure_a[hal::kBoom] > 5e6);
+  CHECK(seen.pump_pressure[0] > seen.pressure_a[hal::kBoom]);
+}
+
+TEST_CASE("plant/node: a force-commanded plant sends PressureValid 0, and stops on pilot commands with the plant's message") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: ideal";
+  NodeBench bench(t.scene());
+  hal::SensorState seen;
+  hal::CommandState effort;
+  effort.mode = hal::CommandMode::effort;
+  REQUIRE(bench.cycle(0, effort, seen));
+  CHECK_FALSE(seen.pressure_valid);
+  REQUIRE(bench.cycle(1, boom_pilots(3e6, 0), seen));
+  // The pilots of cycle 1 reach the plant at SYNC(2): it stops, says why, and goes silent.
+  bench.firmware.send_sync(2);
+  REQUIRE(bench.node.poll());
+  CHECK(bench.node.failed());
+  const std::string why = bench.plant.status().text();
+  MESSAGE(why);
+  CHECK(why.find("pilot commands for actuators.fidelity ideal") != std::string::npos);
+  CHECK_FALSE(bench.firmware.read(seen));
+}
