@@ -3,59 +3,32 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
-#include "sim_plant/actuators.hpp"
 #include "sim_plant/chamber.hpp"
 #include "sim_plant/flow_sharing.hpp"
 #include "sim_plant/spool_valve.hpp"
 
 namespace exc::plant {
 
-namespace {
-
-double orifice_unit_flow(double dp, double laminar) {
-  double f, df;
-  orifice_flow(dp, laminar, f, df);
-  return f;
-}
-
-}  // namespace
-
-HydraulicCircuit::HydraulicCircuit(const Machine& machine, const ActuatorParameters& params) : hp_(params.hydraulic) {
-  const std::string error = hp_.validate();
-  if (!error.empty()) throw std::invalid_argument(error);
-  // At or above the tank pressure the make-up valves could never open before the floor.
-  if (hp_.vapour_pressure > params.tank_pressure)
-    throw std::invalid_argument("hydraulic.vapour_pressure is " + std::to_string(hp_.vapour_pressure) +
-                                " Pa; it must not exceed actuators.tank_pressure (" +
-                                std::to_string(params.tank_pressure) + " Pa)");
-  bulk_ = params.bulk_modulus;
-  dead_volume_ = params.dead_volume;
-  swing_volume_ = params.swing_volume;
-  tank_ = params.tank_pressure;
-  laminar_ = params.laminar_pressure;
-  spool_tau_ = params.valve_time_constant;
-  main_relief_ = params.supply_pressure > 0 ? params.supply_pressure : hp_.main_relief_pressure;
+HydraulicCircuit::HydraulicCircuit(const Machine& machine) : hp_(machine.hydraulics) {
+  validate_hydraulics(machine);
+  bulk_ = hp_.bulk_modulus;
+  dead_volume_ = hp_.dead_volume;
+  swing_volume_ = hp_.swing_volume;
+  tank_ = hp_.tank_pressure;
+  laminar_ = hp_.laminar_pressure;
+  spool_tau_ = hp_.valve_time_constant;
+  main_relief_ = hp_.supply_pressure > 0 ? hp_.supply_pressure : hp_.main_relief_pressure;
   q_min_ = machine.q_min();
   q_max_ = machine.q_max();
-  const Vec4 effort_min = machine.effort_min(), effort_max = machine.effort_max(), speed_max = machine.speed_max();
-  // Push = bore area x relief, pull = annulus area x relief (machine.md); the swing's torque limit
-  // gives its displacement at the swing axis (motor displacement x reduction).
-  const double margin_flow = orifice_unit_flow(hp_.load_sensing_margin, laminar_);
-  const double out_flow = orifice_unit_flow(params.valve_pressure_drop, laminar_);
-  for (int i = 0; i < kNumActive; ++i) {
-    area_a_[i] = effort_max[i] / machine.relief_pressure;
-    area_b_[i] = -effort_min[i] / machine.relief_pressure;
-    // Fully open, the meter-in passes the speed-limit flow at the margin (the machine's speeds are
-    // pump flow over piston area); the meter-out passes the speed-limit return flow at the nominal
-    // valve drop (actuators.valve_pressure_drop).
-    k_in_a_[i] = area_a_[i] * speed_max[i] / margin_flow;
-    k_in_b_[i] = area_b_[i] * speed_max[i] / margin_flow;
-    k_out_a_[i] = area_a_[i] * speed_max[i] / out_flow;
-    k_out_b_[i] = area_b_[i] * speed_max[i] / out_flow;
-    relief_setting_[i] = i == 0 ? hp_.swing_relief_pressure : hp_.port_relief_pressure;
-  }
+  const HydraulicGeometry g = hydraulic_geometry(machine);
+  area_a_ = g.area_a;
+  area_b_ = g.area_b;
+  k_in_a_ = g.meter_in_a;
+  k_in_b_ = g.meter_in_b;
+  k_out_a_ = g.meter_out_a;
+  k_out_b_ = g.meter_out_b;
+  for (int i = 0; i < kNumActive; ++i) relief_setting_[i] = i == 0 ? hp_.swing_relief_pressure : hp_.port_relief_pressure;
   k_relief_ = hp_.pump_flow / hp_.relief_override;
   k_makeup_ = hp_.pump_flow / orifice_unit_flow(hp_.makeup_pressure_drop, laminar_);
   reset(0.5 * (q_min_ + q_max_), Vec4::Zero());
@@ -73,8 +46,8 @@ double HydraulicCircuit::volume_b(int i, const Vec4& q_a) const {
   return dead_volume_ + area_b_[i] * stroke;
 }
 
-double HydraulicCircuit::pressure_ceiling() const {
-  return std::max({main_relief_, hp_.port_relief_pressure, hp_.swing_relief_pressure}) + hp_.pressure_check_margin;
+double HydraulicCircuit::highest_relief() const {
+  return std::max({main_relief_, hp_.port_relief_pressure, hp_.swing_relief_pressure});
 }
 
 double HydraulicCircuit::stored_energy(const Vec4& q_a) const {
