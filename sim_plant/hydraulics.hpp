@@ -82,17 +82,17 @@ class HydraulicCircuit {
   // over the substep (the piston sweeps A qd_a dt).
   void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
 
-  Vec4 effort() const { return area_a_.cwiseProduct(p_a_) - area_b_.cwiseProduct(p_b_); }
+  Vec4 effort() const { return g_.area_a.cwiseProduct(p_a_) - g_.area_b.cwiseProduct(p_b_); }
   const Vec4& spool() const { return spool_; }
   const Vec4& pressure_a() const { return p_a_; }
   const Vec4& pressure_b() const { return p_b_; }
-  const Vec4& area_a() const { return area_a_; }  // m^2; swing: displacement m^3/rad
-  const Vec4& area_b() const { return area_b_; }
-  const Vec4& meter_in_gain() const { return k_in_a_; }  // fully open, m^3/s/sqrt(Pa), into A (extend)
+  const Vec4& area_a() const { return g_.area_a; }  // m^2; swing: displacement m^3/rad
+  const Vec4& area_b() const { return g_.area_b; }
+  const Vec4& meter_in_gain() const { return g_.meter_in_a; }  // fully open, m^3/s/sqrt(Pa), into A (extend)
   const HydraulicReport& report() const { return report_; }
   const HydraulicParameters& parameters() const { return hp_; }
   double main_relief() const { return main_relief_; }
-  double tank_pressure() const { return tank_; }
+  double tank_pressure() const { return hp_.tank_pressure; }
   // The range the plant's check holds the chamber pressures to: from the vapour floor to the highest
   // relief setting (plus the scene's checks.pressure_check_margin).
   double pressure_floor() const { return hp_.vapour_pressure; }
@@ -105,11 +105,9 @@ class HydraulicCircuit {
   void update_pump_report(const Vec4& load_a, const Vec4& load_b);
 
   HydraulicParameters hp_;
-  double bulk_ = 1e9, dead_volume_ = 0, swing_volume_ = 0, tank_ = 0, laminar_ = 0, spool_tau_ = 0;
   double main_relief_ = 0;
   Vec4 q_min_ = Vec4::Zero(), q_max_ = Vec4::Zero();
-  Vec4 area_a_ = Vec4::Zero(), area_b_ = Vec4::Zero();
-  Vec4 k_in_a_ = Vec4::Zero(), k_in_b_ = Vec4::Zero(), k_out_a_ = Vec4::Zero(), k_out_b_ = Vec4::Zero();
+  HydraulicGeometry g_;  // areas and fully open orifice gains (model/hydraulic_geometry.hpp)
   Vec4 relief_setting_ = Vec4::Zero();
   double k_relief_ = 0, k_makeup_ = 0;
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();

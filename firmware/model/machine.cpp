@@ -4,7 +4,9 @@
 #include "machine.hpp"
 
 #include <cmath>
+#include <initializer_list>
 #include <limits>
+#include <utility>
 
 #include "settings/section_reader.hpp"
 
@@ -67,27 +69,20 @@ void read_body(SectionReader& bodies, const char* name, BodyInertia& b) {
   r.finish();
 }
 
+// One section of pins, each read into its place; the reader is returned for the checks below.
+SectionReader read_pin_section(SectionReader& pins, const char* name, std::initializer_list<std::pair<const char*, Vec2*>> named) {
+  SectionReader s = pins.section(name, "pins (x, z) in the section's frame", Need::required);
+  for (const auto& [pin, at] : named) *at = read_pin(s, pin);
+  s.finish();
+  return s;
+}
+
 void read_pins(SectionReader& root, Machine& m) {
   SectionReader pins = root.section("pins", "the planar pins of each section", Need::required);
-  SectionReader ps = pins.section("swing", "pins of the swing frame", Need::required);
-  m.C = read_pin(ps, "C");
-  m.D = read_pin(ps, "D");
-  ps.finish();
-  SectionReader pb = pins.section("boom", "pins of the boom frame", Need::required);
-  m.E = read_pin(pb, "E");
-  m.F = read_pin(pb, "F");
-  m.H = read_pin(pb, "H");
-  pb.finish();
-  SectionReader pa = pins.section("arm", "pins of the arm frame", Need::required);
-  m.G = read_pin(pa, "G");
-  m.I = read_pin(pa, "I");
-  m.K = read_pin(pa, "K");
-  m.M = read_pin(pa, "M");
-  pa.finish();
-  SectionReader pk = pins.section("bucket", "pins of the bucket frame", Need::required);
-  m.L = read_pin(pk, "L");
-  m.T = read_pin(pk, "T");
-  pk.finish();
+  const SectionReader ps = read_pin_section(pins, "swing", {{"C", &m.C}, {"D", &m.D}});
+  const SectionReader pb = read_pin_section(pins, "boom", {{"E", &m.E}, {"F", &m.F}, {"H", &m.H}});
+  const SectionReader pa = read_pin_section(pins, "arm", {{"G", &m.G}, {"I", &m.I}, {"K", &m.K}, {"M", &m.M}});
+  const SectionReader pk = read_pin_section(pins, "bucket", {{"L", &m.L}, {"T", &m.T}});
   SectionReader pl = pins.section("link_lengths", "the bucket linkage's links", Need::required);
   pl.number("JL", m.JL, {0.01, kMaxCoord}, "m", "link 11, J to L", Need::required);
   pl.number("JK", m.JK, {0.01, kMaxCoord}, "m", "link 12, J to K", Need::required);

@@ -29,6 +29,17 @@ std::string with_unit(double v, const char* unit) {
 
 std::string index_field(const std::string& field, std::size_t i) { return field + "[" + std::to_string(i) + "]"; }
 
+// The node's number, if it is a scalar that reads as one.
+bool scalar_number(const YAML::Node& n, double& v) {
+  if (!n.IsScalar()) return false;
+  try {
+    v = n.as<double>();
+  } catch (const YAML::Exception&) {
+    return false;
+  }
+  return true;
+}
+
 YAML::Node flow_sequence() {
   YAML::Node s(YAML::NodeType::Sequence);
   s.SetStyle(YAML::EmitterStyle::Flow);
@@ -143,15 +154,7 @@ void SectionReader::record(const char* key, const std::string& value) { out_[key
 double SectionReader::to_number(const YAML::Node& n, const std::string& name, double lo, double hi,
                                 const char* unit) const {
   double v = 0;
-  bool ok = n.IsScalar();
-  if (ok) {
-    try {
-      v = n.as<double>();
-    } catch (const YAML::Exception&) {
-      ok = false;
-    }
-  }
-  if (!ok)
+  if (!scalar_number(n, v))
     fail_at(n.Mark(), name,
             (n.IsScalar() ? "'" + n.Scalar() + "' is not a number" : std::string("must be a number")) +
                 "; allowed range " + range_text(lo, hi, unit));
@@ -179,15 +182,7 @@ void SectionReader::read_whole(const char* key, double& value, double lo, double
   if (has(key)) {
     const YAML::Node n = get(key);
     double v = 0;
-    bool ok = n.IsScalar();
-    if (ok) {
-      try {
-        v = n.as<double>();
-      } catch (const YAML::Exception&) {
-        ok = false;
-      }
-    }
-    if (!ok || !std::isfinite(v) || v != std::floor(v) || v < lo || v > hi)
+    if (!scalar_number(n, v) || !std::isfinite(v) || v != std::floor(v) || v < lo || v > hi)
       fail(key, "is " + (n.IsScalar() ? n.Scalar() : std::string("not a scalar")) + "; allowed: " + allowed);
     value = v;
   } else if (need == Need::required) {
