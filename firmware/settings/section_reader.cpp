@@ -250,7 +250,7 @@ std::size_t SectionReader::begin_rows(const char* key, std::size_t min, std::siz
   out_[key] = YAML::Node(YAML::NodeType::Sequence);
   if (!has(key)) {
     if (need == Need::required) fail(key, std::string("missing: ") + what + "; " + shape);
-    return static_cast<std::size_t>(-1);
+    return kAbsent;
   }
   const YAML::Node list = get(key);
   if (!list.IsSequence() || list.size() < min || list.size() > max) fail(key, "must be " + shape);

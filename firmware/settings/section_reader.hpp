@@ -86,13 +86,12 @@ class SectionReader {
   template <typename V>
   void rows(const char* key, std::vector<V>& rows, std::size_t min, std::size_t max, const V& lo, const V& hi,
             const char* unit, const char* what, Need need = Need::optional) {
-    const V zero = lo;
-    const std::size_t n = begin_rows(key, min, max, static_cast<int>(zero.size()), unit, what, need);
-    if (n == static_cast<std::size_t>(-1)) {
+    const std::size_t n = begin_rows(key, min, max, static_cast<int>(lo.size()), unit, what, need);
+    if (n == kAbsent) {
       for (V& r : rows) record_row(key, r.data(), static_cast<int>(r.size()));
       return;
     }
-    rows.assign(n, zero);
+    rows.assign(n, lo);
     for (std::size_t i = 0; i < n; ++i) read_row(key, i, rows[i].data(), static_cast<int>(rows[i].size()), lo.data(), hi.data(), unit);
   }
   // One of an enumeration's names; the default is value's.
@@ -168,6 +167,7 @@ class SectionReader {
   void read_whole(const char* key, double& value, double lo, double hi, const char* unit, const char* what, Need need);
   void read_list(const char* key, double* values, int n, const double* lo, const double* hi, int bound_stride,
                  const char* unit, const char* what, Need need);
+  static constexpr std::size_t kAbsent = static_cast<std::size_t>(-1);
   std::size_t begin_rows(const char* key, std::size_t min, std::size_t max, int columns, const char* unit,
                          const char* what, Need need);
   void read_row(const char* key, std::size_t i, double* values, int n, const double* lo, const double* hi, const char* unit);
