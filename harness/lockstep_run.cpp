@@ -3,8 +3,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include <yaml-cpp/yaml.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -19,6 +17,7 @@
 #include "app/tracking_metrics.hpp"
 #include "hal/fault_injecting_bus.hpp"
 #include "hal/memory_bus.hpp"
+#include "settings/section_reader.hpp"
 #include "sim_plant/plant.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "telemetry/lcm_output.hpp"
@@ -81,31 +80,15 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
 
 }  // namespace
 
-const char* to_string(FaultSchedule::Kind kind) {
-  switch (kind) {
-    case FaultSchedule::Kind::none: return "none";
-    case FaultSchedule::Kind::bus_burst: return "bus_burst";
-    case FaultSchedule::Kind::sensor_freeze: return "sensor_freeze";
-    case FaultSchedule::Kind::sensor_jump: return "sensor_jump";
-    case FaultSchedule::Kind::actuator_loss: return "actuator_loss";
-    case FaultSchedule::Kind::actuator_jam: return "actuator_jam";
-    case FaultSchedule::Kind::rock: return "rock";
-  }
-  return "unknown";
-}
-
 SceneBundle load_scene_bundle(const std::string& path) {
-  // The file is opened once; each side parses its own sections from the same text.
-  std::ifstream in(path);
-  if (!in) throw plant::SceneError(path, "", "cannot open the file");
-  std::stringstream text;
-  text << in.rdbuf();
-  const auto slash = path.find_last_of('/');
-  const std::string directory = slash == std::string::npos ? "." : path.substr(0, slash);
+  // The file is opened and parsed once; each side reads its own sections from the same document.
+  const settings::Document scene = settings::Document::load(path);
   SceneBundle b;
-  b.scene = plant::load_scene_from_string(text.str(), path, directory);  // YAML syntax errors named here
-  b.firmware = app::parse_firmware_settings(YAML::Load(text.str()), path, directory);
+  b.scene = plant::read_scene(scene);
+  b.firmware = app::read_firmware_settings(scene);
   b.name = b.scene.name;
+  b.effective = YAML::Clone(b.scene.effective);
+  settings::merge_effective(b.effective, b.firmware.effective);
   return b;
 }
 

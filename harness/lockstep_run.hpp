@@ -12,6 +12,7 @@
 
 #include "app/firmware_settings.hpp"
 #include "control/controller_config.hpp"
+#include "settings/enum_table.hpp"
 #include "sim_plant/scene.hpp"
 
 namespace exc::telemetry {
@@ -32,9 +33,13 @@ struct SceneBundle {
   std::string name;
   plant::Scene scene;
   app::FirmwareSettings firmware;
+  // The scene's effective configuration: both sides' sections, every default filled in, the machine
+  // as an absolute path when the scene names one. Loads back to the same run (settings::emit).
+  YAML::Node effective;
 };
 
-// Loads both sides of one scene file (validated; errors name the file and the field).
+// Loads both sides of one scene file, opened and parsed once (validated; errors name the file, the
+// line and column and the field).
 SceneBundle load_scene_bundle(const std::string& path);
 
 struct Timing {
@@ -97,7 +102,18 @@ struct FaultSchedule {
   double magnitude = 0;
   std::uint64_t seed = 1;
 };
-const char* to_string(FaultSchedule::Kind kind);
+// The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 6> kFaultKinds{{{
+    {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
+    {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
+    {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
+    {FaultSchedule::Kind::actuator_loss, "actuator_loss", "an actuator loses a fraction of its effort"},
+    {FaultSchedule::Kind::actuator_jam, "actuator_jam", "an actuator jams"},
+    {FaultSchedule::Kind::rock, "rock", "the soil 5-50x stiffer"},
+}}};
+inline const char* to_string(FaultSchedule::Kind kind) {
+  return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);
+}
 
 struct LockstepOptions {
   control::ControllerKind controller = control::ControllerKind::adaptive;

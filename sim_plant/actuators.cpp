@@ -5,15 +5,6 @@
 
 namespace exc::plant {
 
-const char* to_string(ActuatorFidelity f) {
-  switch (f) {
-    case ActuatorFidelity::ideal: return "ideal";
-    case ActuatorFidelity::limited: return "limited";
-    case ActuatorFidelity::hydraulic: return "hydraulic";
-  }
-  return "?";
-}
-
 const char* to_string(ActuatorCommand::Mode m) {
   switch (m) {
     case ActuatorCommand::effort: return "effort";
@@ -27,10 +18,14 @@ ActuatorModel::ActuatorModel(const Machine& machine, const ActuatorParameters& p
   effort_min_ = machine.effort_min();
   effort_max_ = machine.effort_max();
   // Only the hydraulic fidelity validates and uses the circuit; the others keep the cylinder areas
-  // (for the sensors' pressure channels) from a default circuit.
-  ActuatorParameters circuit_params = params;
-  if (params.fidelity != ActuatorFidelity::hydraulic) circuit_params.hydraulic = HydraulicParameters{};
-  circuit_ = HydraulicCircuit(machine, circuit_params);
+  // (for the sensors' pressure channels) from a circuit with the default hydraulics.
+  if (params.fidelity == ActuatorFidelity::hydraulic) {
+    circuit_ = HydraulicCircuit(machine);
+  } else {
+    Machine areas_only = machine;
+    areas_only.hydraulics = HydraulicParameters{};
+    circuit_ = HydraulicCircuit(areas_only);
+  }
   reset(0.5 * (machine.q_min() + machine.q_max()), Vec4::Zero());
 }
 

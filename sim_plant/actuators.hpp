@@ -7,32 +7,32 @@
 //              spools with lag and dead zones, chamber pressures, reliefs, make-up valves, the swing
 //              motor; commanded by spool opening or pilot pressures; the effort is p_A A_A - p_B A_B.
 #include "model/machine.hpp"
+#include "settings/enum_table.hpp"
 #include "sim_plant/hydraulics.hpp"
-#include "sim_plant/orifice.hpp"
+#include "model/hydraulic_geometry.hpp"
 
 namespace exc::plant {
 
 enum class ActuatorFidelity { ideal, limited, hydraulic };
-const char* to_string(ActuatorFidelity f);
+// The names a scene's actuators.fidelity takes.
+inline constexpr settings::EnumTable<ActuatorFidelity, 3> kActuatorFidelities{{{
+    {ActuatorFidelity::ideal, "ideal", "the commanded efforts act as given (the paper)"},
+    {ActuatorFidelity::limited, "limited", "efforts clamped to the relief limits, a first-order lag, speed limits, end stops"},
+    {ActuatorFidelity::hydraulic, "hydraulic", "the machine's hydraulics (pumps, spools, chambers, reliefs), valve commands"},
+}}};
+inline const char* to_string(ActuatorFidelity f) { return kActuatorFidelities.name_of(f); }
 
+// The scene's `actuators:` section. The hydraulic machine's numbers are the machine file's
+// (Machine::hydraulics): a scene chooses how the actuators are modelled, the machine what they are.
 struct ActuatorParameters {
   ActuatorFidelity fidelity = ActuatorFidelity::ideal;
   double lag = 0.02;                  // s, limited: effort time constant (0: none)
-  double valve_time_constant = 0.03;  // s, hydraulic: spool lag (pilot-operated mobile valve, 30-100 ms)
-  double bulk_modulus = 1.0e9;        // Pa, effective (oil with hoses)
-  double dead_volume = 0.002;         // m^3, oil in each cylinder chamber's lines at full retraction
-  double swing_volume = 0.01;         // m^3, oil on each side of the swing motor
-  double supply_pressure = 0;         // Pa, the pumps' pressure limit; 0: hydraulic.main_relief_pressure
-  double tank_pressure = 0.3e6;       // Pa, return-line back pressure (the make-up valves draw from it)
-  double valve_pressure_drop = 5e6;   // Pa: a fully open meter-out passes the speed-limit flow at this drop
-  double laminar_pressure = 0.2e6;    // Pa: below this drop the orifice flow is linear in dp
-  HydraulicParameters hydraulic;      // the rest of the hydraulic machine (C++ only for now)
 };
 
 // What the controller sends each cycle:
 //   effort  swing torque (N m) and cylinder forces (N) in 'value', positive pushes longer;
 //   valve   signed spool openings -1..1 in 'value' (positive extends / swings counter-clockwise);
-//   pilot   pilot pressures 0..hydraulic.pilot_full_stroke (Pa) on each spool's A end (opens
+//   pilot   pilot pressures 0..hydraulics.pilot_full_stroke (Pa) on each spool's A end (opens
 //           P->A: extends / swings counter-clockwise) and B end, as a real valve block takes them.
 struct ActuatorCommand {
   enum Mode { effort, valve, pilot } mode = effort;
@@ -44,7 +44,7 @@ const char* to_string(ActuatorCommand::Mode m);
 class ActuatorModel {
  public:
   ActuatorModel() = default;
-  // Throws std::invalid_argument when a hydraulic parameter is outside its range (hydraulic fidelity).
+  // Throws SettingsError when machine.hydraulics is outside its ranges (hydraulic fidelity).
   ActuatorModel(const Machine& machine, const ActuatorParameters& params);
 
   const ActuatorParameters& parameters() const { return params_; }

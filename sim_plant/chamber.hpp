@@ -8,7 +8,7 @@
 // non-increasing in p, so the left side minus the right is strictly increasing in p1: one root,
 // found by Newton's method safeguarded by bisection once bracketed. Unconditionally stable, no
 // overshoot past a relief setting or below the make-up valve's tank pressure.
-#include "sim_plant/orifice.hpp"
+#include "model/hydraulic_geometry.hpp"
 
 namespace exc::plant {
 

@@ -3,99 +3,60 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 
-#include "sim_plant/actuators.hpp"
 #include "sim_plant/chamber.hpp"
 #include "sim_plant/flow_sharing.hpp"
 #include "sim_plant/spool_valve.hpp"
 
 namespace exc::plant {
 
-namespace {
-
-double orifice_unit_flow(double dp, double laminar) {
-  double f, df;
-  orifice_flow(dp, laminar, f, df);
-  return f;
-}
-
-}  // namespace
-
-HydraulicCircuit::HydraulicCircuit(const Machine& machine, const ActuatorParameters& params) : hp_(params.hydraulic) {
-  const std::string error = hp_.validate();
-  if (!error.empty()) throw std::invalid_argument(error);
-  // At or above the tank pressure the make-up valves could never open before the floor.
-  if (hp_.vapour_pressure > params.tank_pressure)
-    throw std::invalid_argument("hydraulic.vapour_pressure is " + std::to_string(hp_.vapour_pressure) +
-                                " Pa; it must not exceed actuators.tank_pressure (" +
-                                std::to_string(params.tank_pressure) + " Pa)");
-  bulk_ = params.bulk_modulus;
-  dead_volume_ = params.dead_volume;
-  swing_volume_ = params.swing_volume;
-  tank_ = params.tank_pressure;
-  laminar_ = params.laminar_pressure;
-  spool_tau_ = params.valve_time_constant;
-  main_relief_ = params.supply_pressure > 0 ? params.supply_pressure : hp_.main_relief_pressure;
+HydraulicCircuit::HydraulicCircuit(const Machine& machine) : hp_(machine.hydraulics) {
+  validate_hydraulics(machine);
+  main_relief_ = hp_.supply_pressure > 0 ? hp_.supply_pressure : hp_.main_relief_pressure;
   q_min_ = machine.q_min();
   q_max_ = machine.q_max();
-  const Vec4 effort_min = machine.effort_min(), effort_max = machine.effort_max(), speed_max = machine.speed_max();
-  // Push = bore area x relief, pull = annulus area x relief (machine.md); the swing's torque limit
-  // gives its displacement at the swing axis (motor displacement x reduction).
-  const double margin_flow = orifice_unit_flow(hp_.load_sensing_margin, laminar_);
-  const double out_flow = orifice_unit_flow(params.valve_pressure_drop, laminar_);
-  for (int i = 0; i < kNumActive; ++i) {
-    area_a_[i] = effort_max[i] / machine.relief_pressure;
-    area_b_[i] = -effort_min[i] / machine.relief_pressure;
-    // Fully open, the meter-in passes the speed-limit flow at the margin (the machine's speeds are
-    // pump flow over piston area); the meter-out passes the speed-limit return flow at the nominal
-    // valve drop (actuators.valve_pressure_drop).
-    k_in_a_[i] = area_a_[i] * speed_max[i] / margin_flow;
-    k_in_b_[i] = area_b_[i] * speed_max[i] / margin_flow;
-    k_out_a_[i] = area_a_[i] * speed_max[i] / out_flow;
-    k_out_b_[i] = area_b_[i] * speed_max[i] / out_flow;
-    relief_setting_[i] = i == 0 ? hp_.swing_relief_pressure : hp_.port_relief_pressure;
-  }
+  g_ = hydraulic_geometry(machine);
+  for (int i = 0; i < kNumActive; ++i) relief_setting_[i] = i == 0 ? hp_.swing_relief_pressure : hp_.port_relief_pressure;
   k_relief_ = hp_.pump_flow / hp_.relief_override;
-  k_makeup_ = hp_.pump_flow / orifice_unit_flow(hp_.makeup_pressure_drop, laminar_);
+  k_makeup_ = hp_.pump_flow / orifice_unit_flow(hp_.makeup_pressure_drop, hp_.laminar_pressure);
   reset(0.5 * (q_min_ + q_max_), Vec4::Zero());
 }
 
 double HydraulicCircuit::volume_a(int i, const Vec4& q_a) const {
-  if (i == 0) return swing_volume_;
+  if (i == 0) return hp_.swing_volume;
   const double stroke = std::clamp(q_a[i] - q_min_[i], 0.0, q_max_[i] - q_min_[i]);
-  return dead_volume_ + area_a_[i] * stroke;
+  return hp_.dead_volume + g_.area_a[i] * stroke;
 }
 
 double HydraulicCircuit::volume_b(int i, const Vec4& q_a) const {
-  if (i == 0) return swing_volume_;
+  if (i == 0) return hp_.swing_volume;
   const double stroke = std::clamp(q_max_[i] - q_a[i], 0.0, q_max_[i] - q_min_[i]);
-  return dead_volume_ + area_b_[i] * stroke;
+  return hp_.dead_volume + g_.area_b[i] * stroke;
 }
 
-double HydraulicCircuit::pressure_ceiling() const {
-  return std::max({main_relief_, hp_.port_relief_pressure, hp_.swing_relief_pressure}) + hp_.pressure_check_margin;
+double HydraulicCircuit::highest_relief() const {
+  return std::max({main_relief_, hp_.port_relief_pressure, hp_.swing_relief_pressure});
 }
 
 double HydraulicCircuit::stored_energy(const Vec4& q_a) const {
   double e = 0;
   for (int i = 0; i < kNumActive; ++i)
-    e += (volume_a(i, q_a) * p_a_[i] * p_a_[i] + volume_b(i, q_a) * p_b_[i] * p_b_[i]) / (2.0 * bulk_);
+    e += (volume_a(i, q_a) * p_a_[i] * p_a_[i] + volume_b(i, q_a) * p_b_[i] * p_b_[i]) / (2.0 * hp_.bulk_modulus);
   return e;
 }
 
 void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
   target_.setZero();
   spool_.setZero();
-  const double low = 2.0 * tank_;
+  const double low = 2.0 * hp_.tank_pressure;
   for (int i = 0; i < kNumActive; ++i) {
     const double f = hold[i];
     if (f >= 0) {
       p_b_[i] = low;
-      p_a_[i] = std::clamp((f + area_b_[i] * low) / area_a_[i], tank_, main_relief_);
+      p_a_[i] = std::clamp((f + g_.area_b[i] * low) / g_.area_a[i], hp_.tank_pressure, main_relief_);
     } else {
       p_a_[i] = low;
-      p_b_[i] = std::clamp((area_a_[i] * low - f) / area_b_[i], tank_, main_relief_);
+      p_b_[i] = std::clamp((g_.area_a[i] * low - f) / g_.area_b[i], hp_.tank_pressure, main_relief_);
     }
     v_a_[i] = volume_a(i, q_a);
     v_b_[i] = volume_b(i, q_a);
@@ -118,7 +79,7 @@ void HydraulicCircuit::command_pilots(const Vec4& pilot_a, const Vec4& pilot_b) 
 // Pump pressures (and, by the flow sharing, the pumps' flows) from the loads of the open functions.
 void HydraulicCircuit::update_pump_report(const Vec4& load_a, const Vec4& load_b) {
   bool open[kNumPumps] = {false, false};
-  double highest[kNumPumps] = {tank_, tank_};
+  double highest[kNumPumps] = {hp_.tank_pressure, hp_.tank_pressure};
   for (int i = 0; i < kNumActive; ++i) {
     const double a = report_.opening[i];
     if (a == 0) continue;
@@ -129,7 +90,7 @@ void HydraulicCircuit::update_pump_report(const Vec4& load_a, const Vec4& load_b
   for (int g = 0; g < kNumPumps; ++g) {
     const int src = hp_.pumps_merged ? 0 : g;
     report_.pump_pressure[g] =
-        load_sensing_pressure(open[src], highest[src], tank_, hp_.load_sensing_margin, main_relief_);
+        load_sensing_pressure(open[src], highest[src], hp_.tank_pressure, hp_.load_sensing_margin, main_relief_);
   }
 }
 
@@ -138,7 +99,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   HydraulicEnergy& e = r.energy;
   // Spools: lag toward the target, then the dead zone of the direction they moved in.
   for (int i = 0; i < kNumActive; ++i) {
-    spool_[i] = spool_lag(spool_[i], target_[i], spool_tau_, dt);
+    spool_[i] = spool_lag(spool_[i], target_[i], hp_.valve_time_constant, dt);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);
     r.opening[i] = spool_[i] >= 0 ? a : -a;
   }
@@ -154,8 +115,8 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     const double load = a > 0 ? p_a_[i] : p_b_[i];
     const double drop = std::min(hp_.load_sensing_margin, main_relief_ - load);
     if (drop <= 0) continue;
-    const double k = a > 0 ? k_in_a_[i] : k_in_b_[i];
-    demand[hp_.pumps_merged ? 0 : hp_.pump_of[i]] += k * std::abs(a) * orifice_unit_flow(drop, laminar_);
+    const double k = a > 0 ? g_.meter_in_a[i] : g_.meter_in_b[i];
+    demand[hp_.pumps_merged ? 0 : hp_.pump_of[i]] += k * std::abs(a) * orifice_unit_flow(drop, hp_.laminar_pressure);
   }
   double scale[kNumPumps] = {1, 1};
   bool saturated = false;
@@ -173,23 +134,23 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     ChamberValves va;
     va.margin = hp_.load_sensing_margin;
     va.supply_limit = main_relief_;
-    va.tank = tank_;
+    va.tank = hp_.tank_pressure;
     va.makeup_gain = k_makeup_;
     va.relief_setting = relief_setting_[i];
     va.relief_gain = k_relief_;
-    va.laminar = laminar_;
+    va.laminar = hp_.laminar_pressure;
     ChamberValves vb = va;
     if (a > 0) {
-      va.meter_in_gain = scale[g] * k_in_a_[i] * a;
-      vb.meter_out_gain = k_out_b_[i] * a;
+      va.meter_in_gain = scale[g] * g_.meter_in_a[i] * a;
+      vb.meter_out_gain = g_.meter_out_b[i] * a;
     } else if (a < 0) {
-      vb.meter_in_gain = scale[g] * k_in_b_[i] * -a;
-      va.meter_out_gain = k_out_a_[i] * -a;
+      vb.meter_in_gain = scale[g] * g_.meter_in_b[i] * -a;
+      va.meter_out_gain = g_.meter_out_a[i] * -a;
     }
     const double va1 = volume_a(i, q_a), vb1 = volume_b(i, q_a);
-    const double swept_a = area_a_[i] * qd_a[i] * dt, swept_b = -area_b_[i] * qd_a[i] * dt;
-    const ChamberStep sa = step_chamber(va, p_a_[i], va1, bulk_, dt, swept_a, hp_.vapour_pressure);
-    const ChamberStep sb = step_chamber(vb, p_b_[i], vb1, bulk_, dt, swept_b, hp_.vapour_pressure);
+    const double swept_a = g_.area_a[i] * qd_a[i] * dt, swept_b = -g_.area_b[i] * qd_a[i] * dt;
+    const ChamberStep sa = step_chamber(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
+    const ChamberStep sb = step_chamber(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);
     r.solver_iterations += sa.iterations + sb.iterations;
     // Energy, with trapezoidal pressures (HydraulicEnergy closes exactly with them).
     const ChamberStep* steps[2] = {&sa, &sb};
@@ -200,12 +161,12 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
       const ChamberStep& s = *steps[c];
       const double pm = 0.5 * (p0[c] + s.pressure);
       mean[c] = pm;
-      e.meter_out_loss += (pm - tank_) * dt * s.flows.meter_out;
-      e.relief_loss += (pm - tank_) * dt * s.flows.relief;
-      e.makeup_loss += (tank_ - pm) * dt * s.flows.makeup;
-      e.tank_work += tank_ * dt * (s.flows.makeup - s.flows.meter_out - s.flows.relief);
+      e.meter_out_loss += (pm - hp_.tank_pressure) * dt * s.flows.meter_out;
+      e.relief_loss += (pm - hp_.tank_pressure) * dt * s.flows.relief;
+      e.makeup_loss += (hp_.tank_pressure - pm) * dt * s.flows.makeup;
+      e.tank_work += hp_.tank_pressure * dt * (s.flows.makeup - s.flows.meter_out - s.flows.relief);
       e.vapour_work += pm * s.void_volume;
-      e.volume_term += (vol1[c] - vol0[c]) * p0[c] * p0[c] / (2.0 * bulk_);
+      e.volume_term += (vol1[c] - vol0[c]) * p0[c] * p0[c] / (2.0 * hp_.bulk_modulus);
       e.piston_work += pm * swept[c];
       relief = relief || s.flows.relief > 0;
       cavitation = cavitation || s.void_volume > 0;
@@ -238,7 +199,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // What the pumps show now, for the sensors.
   update_pump_report(p_a_, p_b_);
   e.stored = 0;
-  for (int i = 0; i < kNumActive; ++i) e.stored += (v_a_[i] * p_a_[i] * p_a_[i] + v_b_[i] * p_b_[i] * p_b_[i]) / (2.0 * bulk_);
+  for (int i = 0; i < kNumActive; ++i) e.stored += (v_a_[i] * p_a_[i] * p_a_[i] + v_b_[i] * p_b_[i] * p_b_[i]) / (2.0 * hp_.bulk_modulus);
   r.relief_substeps += relief ? 1 : 0;
   r.cavitation_substeps += cavitation ? 1 : 0;
   r.saturated_substeps += saturated ? 1 : 0;

@@ -13,70 +13,20 @@
 //   relief    Q_r   = K_r (p - p_setting) above the port relief's setting
 //   chambers  dp_A/dt = beta / V_A (Q_A - A_A v),  dp_B/dt = beta / V_B (Q_B + A_B v)
 //   effort    F = p_A A_A - p_B A_B  (swing: T = D (p_A - p_B), D the displacement at the swing axis)
-// (orifices are linear below the laminar pressure). Cylinder areas and the swing displacement come
-// from the machine file's effort limits at its relief pressure; valve gains from its speed limits.
+// (orifices are linear below the laminar pressure). Cylinder areas, the swing displacement and the
+// valve gains are the machine's hydraulic geometry (model/hydraulic_geometry.hpp: effort limits at
+// the relief pressure, speed limits); every other number is the machine file's `hydraulics:` section
+// (Machine::hydraulics).
 #include <array>
 #include <cstdint>
 #include <string>
 
+#include "model/hydraulic_geometry.hpp"
 #include "model/machine.hpp"
 
 namespace exc::plant {
 
-struct ActuatorParameters;
-
 inline constexpr int kNumPumps = 2;
-
-// Parameters of the hydraulic machine that the scene file does not read yet (they are C++ only
-// until the settings reader takes them). Each: unit, source, allowed range (validate()).
-struct HydraulicParameters {
-  // m^3/s, both pumps together at rated speed: 2 x 112 cm^3/rev, 439 L/min (Komatsu PC200-8,
-  // hydraulics.md). Range [1e-4, 0.05].
-  double pump_flow = 439.0 / 60000.0;
-  // true: both pumps feed one gallery (the PC200-8's CLSS joins them in normal work); false: each
-  // pump feeds its own functions (pump_of) with half the flow.
-  bool pumps_merged = true;
-  // With split pumps, the pump (0 or 1) of swing, boom, arm, bucket (estimate: the usual two-pump
-  // layout, boom and bucket on one, swing and arm on the other).
-  std::array<int, 4> pump_of = {1, 0, 1, 0};
-  // Pa, pump pressure above the highest load (the load-sensing differential; estimate, typical
-  // 1.5-3 MPa, not on the spec page). The meter-in orifices are sized to pass the speed-limit flow
-  // at this drop. Range [0.3e6, 5e6].
-  double load_sensing_margin = 2.0e6;
-  // Pa, main relief: the pumps' pressure limit (34.3 MPa, Cat 320C service data, hydraulics.md).
-  // actuators.supply_pressure, when the scene sets it (> 0), takes its place. Range [5e6, 60e6].
-  double main_relief_pressure = 34.3e6;
-  // Pa, port reliefs on the boom, arm and bucket chambers (36.8 MPa, Cat 320C, hydraulics.md).
-  // Range [5e6, 60e6].
-  double port_relief_pressure = 36.8e6;
-  // Pa, the swing motor's port reliefs (estimate: the spec page gives none; 34.3 MPa is the pressure
-  // at which the machine file's 65 kN m swing torque is stated). Range [5e6, 60e6].
-  double swing_relief_pressure = 34.3e6;
-  // Pa above its setting at which a relief passes pump_flow (linear override; estimate).
-  // Range [1e4, 10e6].
-  double relief_override = 1.5e6;
-  // Pa below tank pressure at which a make-up (anti-cavitation) valve passes pump_flow (estimate).
-  // Range [1e4, 2e6].
-  double makeup_pressure_drop = 0.2e6;
-  // Pa (gauge, like every pressure of the plant): the floor no chamber goes below; below it the
-  // oil would release air and vapour (hydraulics.md: never below zero or vapour pressure).
-  // Range [-0.1e6, 0.1e6], and at most actuators.tank_pressure.
-  double vapour_pressure = 0.0;
-  // Pa, pilot pressure difference for full spool stroke (0-5 MPa pilots, the ZX200's 0.02 MPa/bit
-  // commands, hydraulics.md). Range [1e6, 10e6].
-  double pilot_full_stroke = 5.0e6;
-  // Fraction of the spool stroke before the metering notch opens, per function (swing, boom, arm,
-  // bucket) and direction (estimate: ~0.75 MPa of a 5 MPa pilot; hydraulics.md: calibrated per
-  // machine and direction). Range [0, 0.9].
-  Vec4 dead_zone_extend = Vec4::Constant(0.15);
-  Vec4 dead_zone_retract = Vec4::Constant(0.15);
-  // Pa above the highest relief setting a chamber may reach before the plant's check stops it
-  // (a relief's override at full flow is ~relief_override). Range [0, 50e6].
-  double pressure_check_margin = 5.0e6;
-
-  // "" when every field is inside its range, else the first offending field, its value and range.
-  std::string validate() const;
-};
 
 // Energy bookkeeping of the circuit since reset (J). Pressures are gauge: the tank line at
 // tank_pressure exchanges p_tank Q with the chambers (tank_work). With E_oil the oil's compression
@@ -119,8 +69,8 @@ struct HydraulicReport {
 class HydraulicCircuit {
  public:
   HydraulicCircuit() = default;
-  // Throws std::invalid_argument naming the field when the parameters are outside their ranges.
-  HydraulicCircuit(const Machine& machine, const ActuatorParameters& params);
+  // Throws SettingsError naming the field when machine.hydraulics is outside its ranges.
+  explicit HydraulicCircuit(const Machine& machine);
 
   // Chamber pressures that hold 'hold' (the lower side at twice tank pressure), spools centred.
   void reset(const Vec4& q_a, const Vec4& hold);
@@ -132,20 +82,21 @@ class HydraulicCircuit {
   // over the substep (the piston sweeps A qd_a dt).
   void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
 
-  Vec4 effort() const { return area_a_.cwiseProduct(p_a_) - area_b_.cwiseProduct(p_b_); }
+  Vec4 effort() const { return g_.area_a.cwiseProduct(p_a_) - g_.area_b.cwiseProduct(p_b_); }
   const Vec4& spool() const { return spool_; }
   const Vec4& pressure_a() const { return p_a_; }
   const Vec4& pressure_b() const { return p_b_; }
-  const Vec4& area_a() const { return area_a_; }  // m^2; swing: displacement m^3/rad
-  const Vec4& area_b() const { return area_b_; }
-  const Vec4& meter_in_gain() const { return k_in_a_; }  // fully open, m^3/s/sqrt(Pa), into A (extend)
+  const Vec4& area_a() const { return g_.area_a; }  // m^2; swing: displacement m^3/rad
+  const Vec4& area_b() const { return g_.area_b; }
+  const Vec4& meter_in_gain() const { return g_.meter_in_a; }  // fully open, m^3/s/sqrt(Pa), into A (extend)
   const HydraulicReport& report() const { return report_; }
   const HydraulicParameters& parameters() const { return hp_; }
   double main_relief() const { return main_relief_; }
-  double tank_pressure() const { return tank_; }
-  // The range the plant's check holds the chamber pressures to.
+  double tank_pressure() const { return hp_.tank_pressure; }
+  // The range the plant's check holds the chamber pressures to: from the vapour floor to the highest
+  // relief setting (plus the scene's checks.pressure_check_margin).
   double pressure_floor() const { return hp_.vapour_pressure; }
-  double pressure_ceiling() const;
+  double highest_relief() const;
   double stored_energy(const Vec4& q_a) const;
 
  private:
@@ -154,11 +105,9 @@ class HydraulicCircuit {
   void update_pump_report(const Vec4& load_a, const Vec4& load_b);
 
   HydraulicParameters hp_;
-  double bulk_ = 1e9, dead_volume_ = 0, swing_volume_ = 0, tank_ = 0, laminar_ = 0, spool_tau_ = 0;
   double main_relief_ = 0;
   Vec4 q_min_ = Vec4::Zero(), q_max_ = Vec4::Zero();
-  Vec4 area_a_ = Vec4::Zero(), area_b_ = Vec4::Zero();
-  Vec4 k_in_a_ = Vec4::Zero(), k_in_b_ = Vec4::Zero(), k_out_a_ = Vec4::Zero(), k_out_b_ = Vec4::Zero();
+  HydraulicGeometry g_;  // areas and fully open orifice gains (model/hydraulic_geometry.hpp)
   Vec4 relief_setting_ = Vec4::Zero();
   double k_relief_ = 0, k_makeup_ = 0;
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();

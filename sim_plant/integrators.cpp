@@ -11,24 +11,6 @@
 
 namespace exc::plant {
 
-const char* to_string(IntegrationMethod m) {
-  switch (m) {
-    case IntegrationMethod::semi_implicit_euler: return "semi_implicit_euler";
-    case IntegrationMethod::rk4: return "rk4";
-    case IntegrationMethod::implicit_midpoint: return "implicit_midpoint";
-  }
-  return "?";
-}
-
-const char* to_string(Formulation f) {
-  switch (f) {
-    case Formulation::independent: return "independent";
-    case Formulation::augmented_baumgarte: return "augmented_baumgarte";
-    case Formulation::augmented_projection: return "augmented_projection";
-  }
-  return "?";
-}
-
 namespace {
 
 // One step of the configured method on one coordinate set: V is Vec4 (the independent formulation,

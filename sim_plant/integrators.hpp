@@ -8,6 +8,7 @@
 //                 augmented_projection (all 12, eq. 8 as written, then projected back onto h = 0
 //                 after every step: passive q from the closed form, qd = Psi qd_a)
 // The efforts are held over a step. Nothing here allocates.
+#include "settings/enum_table.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/soil.hpp"
 
@@ -15,8 +16,20 @@ namespace exc::plant {
 
 enum class IntegrationMethod { semi_implicit_euler, rk4, implicit_midpoint };
 enum class Formulation { independent, augmented_baumgarte, augmented_projection };
-const char* to_string(IntegrationMethod m);
-const char* to_string(Formulation f);
+
+// The names a scene's integrator.method and integrator.formulation take (and the benches' options).
+inline constexpr settings::EnumTable<IntegrationMethod, 3> kIntegrationMethods{{{
+    {IntegrationMethod::semi_implicit_euler, "semi_implicit_euler", "symplectic Euler, first order (the default)"},
+    {IntegrationMethod::rk4, "rk4", "classical Runge-Kutta, fourth order"},
+    {IntegrationMethod::implicit_midpoint, "implicit_midpoint", "implicit midpoint, second order, symplectic"},
+}}};
+inline constexpr settings::EnumTable<Formulation, 3> kFormulations{{{
+    {Formulation::independent, "independent", "the active coordinates, loops solved each step (eqs. 14-17)"},
+    {Formulation::augmented_baumgarte, "augmented_baumgarte", "all joints with loop forces, Baumgarte stabilised (eq. 8)"},
+    {Formulation::augmented_projection, "augmented_projection", "all joints with loop forces, projected back on h(q) = 0"},
+}}};
+inline const char* to_string(IntegrationMethod m) { return kIntegrationMethods.name_of(m); }
+inline const char* to_string(Formulation f) { return kFormulations.name_of(f); }
 
 struct IntegratorSettings {
   IntegrationMethod method = IntegrationMethod::semi_implicit_euler;

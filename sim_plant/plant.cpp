@@ -86,7 +86,7 @@ bool Plant::accept_command(const ActuatorCommand& command) {
     return false;
   }
   if (command.mode == ActuatorCommand::pilot) {
-    const double full = scene_.actuators.hydraulic.pilot_full_stroke;
+    const double full = scene_.machine.hydraulics.pilot_full_stroke;
     const double lo = std::min(command.pilot_a.minCoeff(), command.pilot_b.minCoeff());
     const double hi = std::max(command.pilot_a.maxCoeff(), command.pilot_b.maxCoeff());
     if (lo < 0 || hi > full * (1 + 1e-12)) {
@@ -220,7 +220,7 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
         in.pressure_a = &actuators_.pressure_a();
         in.pressure_b = &actuators_.pressure_b();
         in.pressure_min = actuators_.hydraulics().pressure_floor();
-        in.pressure_max = actuators_.hydraulics().pressure_ceiling();
+        in.pressure_max = actuators_.hydraulics().highest_relief() + scene_.checks.pressure_check_margin;
       }
       in.work_exchanged = work_abs_;
       if (augmented) {

@@ -97,9 +97,9 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
         if (p >= in.pressure_min && p <= in.pressure_max) continue;
         set_failure(status, PlantFailure::pressure_range, in.time, in.cycle,
                     "the %s %s pressure is %.6g MPa, outside [%.4g, %.4g] MPa (vapour .. highest relief + "
-                    "hydraulic.pressure_check_margin): a relief passes more than its override allows (a load the "
+                    "checks.pressure_check_margin): a relief passes more than its override allows (a load the "
                     "reliefs cannot hold) or the pressures were integrated wrongly; check the reliefs and "
-                    "actuators.bulk_modulus",
+                    "hydraulics.bulk_modulus",
                     kActiveNames[i], side == 0 ? (i == 0 ? "port A" : "bore-side") : (i == 0 ? "port B" : "rod-side"),
                     p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6);
         return false;

@@ -21,6 +21,9 @@ struct CheckSettings {
   double energy_tolerance = 100.0;         // J, absolute slack of the energy balance
   double energy_relative_tolerance = 0.05; // of the work exchanged with actuators and soil so far
   double end_stop_margin = 0.005;          // m, how far past a stroke limit counts as "through" it
+  // Pa above the highest relief setting a chamber may reach before the check stops the plant (a
+  // relief's override at full flow is ~hydraulics.relief_override).
+  double pressure_check_margin = 5.0e6;
 };
 
 enum class PlantFailure {

@@ -1,12 +1,16 @@
 #pragma once
-// A scene file (YAML, schema in docs/scene-schema.md): machine, terrain and soil, initial state,
-// actuator fidelity, integrator and step, duration, sensors, checks; plus the firmware's
-// 'controller' and 'task' sections, which the plant keeps as text and leaves to the firmware.
-// Loading validates every field; an error names the file, the field and the allowed values.
-#include <stdexcept>
+// The plant's reading of a scene file (YAML, schema in docs/scene-schema.md): the keys both sides
+// read (model/scene_common.hpp: name, machine, terrain, duration) and the simulated machine's own
+// sections: soil, initial state, actuator fidelity, integrator and step, sensors, checks. The
+// firmware's sections (controller, task) are named and left to the firmware's reader. Every field
+// is declared once, with the settings reader; an error (SettingsError) names the file, the line and
+// column, the field and the allowed values.
 #include <string>
 
+#include <yaml-cpp/yaml.h>
+
 #include "model/machine.hpp"
+#include "settings/document.hpp"
 #include "sim_plant/actuators.hpp"
 #include "sim_plant/integrators.hpp"
 #include "sim_plant/plant_checks.hpp"
@@ -15,21 +19,10 @@
 
 namespace exc::plant {
 
-class SceneError : public std::runtime_error {
- public:
-  SceneError(std::string file, std::string field, std::string reason);
-  const std::string& file() const { return file_; }
-  const std::string& field() const { return field_; }
-  const std::string& reason() const { return reason_; }
-
- private:
-  std::string file_, field_, reason_;
-};
-
 struct Scene {
   std::string file;         // the scene file ("<string>" when loaded from text)
   std::string name, description;
-  std::string machine_file; // resolved path, empty for the built-in reference machine
+  std::string machine_file; // absolute path, empty for the built-in reference machine
   Machine machine;
   Terrain terrain;
   SoilPreset soil_preset = SoilPreset::none;  // 'none' also when given explicitly
@@ -42,11 +35,13 @@ struct Scene {
   SensorParameters sensors;
   CheckSettings checks;
   bool has_controller = false, has_task = false;
-  std::string text;         // the whole file, for the firmware's own parser of controller/task
+  // The plant's sections as read, every default filled in (the effective configuration).
+  YAML::Node effective;
 };
 
-// Reads and validates a scene file. Throws SceneError (MachineError from the machine file is
-// rethrown as a SceneError naming the 'machine' field and the machine file's message).
+// Reads the plant's sections of a parsed scene file.
+Scene read_scene(const settings::Document& scene);
+// Reads and validates a scene file (opened and parsed once).
 Scene load_scene(const std::string& path);
 // Same from text; relative machine paths resolve against 'base_directory'.
 Scene load_scene_from_string(const std::string& yaml, const std::string& file_for_errors,

@@ -17,16 +17,6 @@ double Terrain::height_at(double x) const {
   return profile[num_points - 1].y();
 }
 
-const char* to_string(SoilPreset preset) {
-  switch (preset) {
-    case SoilPreset::none: return "none";
-    case SoilPreset::loose_sand: return "loose_sand";
-    case SoilPreset::loam: return "loam";
-    case SoilPreset::stiff_clay: return "stiff_clay";
-  }
-  return "?";
-}
-
 SoilParameters soil_preset(SoilPreset preset) {
   // machine.md, "Soil, for the paper's digging scene": the spring force at the re-anchoring distance
   // equals the Fundamental Earthmoving Equation's failure force. Same numbers on both axes.

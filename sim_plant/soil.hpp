@@ -5,6 +5,7 @@
 // with the shear re-anchoring rho_env = rho when |rho_env - rho| > S_dist(h).
 #include <array>
 
+#include "settings/enum_table.hpp"
 #include "model/closed_chain.hpp"
 
 namespace exc::plant {
@@ -29,7 +30,14 @@ struct SoilParameters {
 };
 
 enum class SoilPreset { none, loose_sand, loam, stiff_clay };
-const char* to_string(SoilPreset preset);
+// The names a scene's soil.preset takes.
+inline constexpr settings::EnumTable<SoilPreset, 4> kSoilPresets{{{
+    {SoilPreset::none, "none", "no soil"},
+    {SoilPreset::loose_sand, "loose_sand", "machine.md's loose sand"},
+    {SoilPreset::loam, "loam", "machine.md's loam (the paper's digging scene)"},
+    {SoilPreset::stiff_clay, "stiff_clay", "machine.md's stiff clay"},
+}}};
+inline const char* to_string(SoilPreset preset) { return kSoilPresets.name_of(preset); }
 // machine.md's table: K_t, B_t, M_t for each preset.
 SoilParameters soil_preset(SoilPreset preset);
 

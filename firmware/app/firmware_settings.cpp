@@ -1,25 +1,13 @@
 #include "app/firmware_settings.hpp"
 
-#include <yaml-cpp/yaml.h>
-
 #include <cmath>
 
-#include "control/config_fields.hpp"
 #include "control/effort_feasibility.hpp"
 #include "model/model.hpp"
+#include "model/scene_common.hpp"
 
 namespace exc::app {
 namespace {
-
-std::string directory_of(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  return slash == std::string::npos ? "." : path.substr(0, slash);
-}
-
-std::string resolve(const std::string& base, const std::string& path) {
-  if (path.empty() || path[0] == '/') return path;
-  return base + "/" + path;
-}
 
 // The task against the actuators' limits before the run: refused with the place, the joint and the
 // effort, or (task.efforts.fit_timing) slowed down until it fits, 2 % beyond the exact fit.
@@ -38,8 +26,8 @@ void check_task_efforts(FirmwareSettings& s) {
   std::vector<double> marks = cycles ? task.cycle_starts : task.waypoint_times;
   if (cycles) marks.push_back(task.end_time());
   if (!task.efforts.fit_timing || std::isinf(r.time_scale))
-    throw control::ConfigError(s.file, field, r.message(marks, field) +
-                                                  (std::isinf(r.time_scale) ? "" : "; or set task.efforts.fit_timing: true"));
+    throw SettingsError(s.file, 0, 0, field, r.message(marks, field) +
+                                             (std::isinf(r.time_scale) ? "" : "; or set task.efforts.fit_timing: true"));
   task.timing_scale = r.time_scale * 1.02;
   task.trajectory = control::scale_timing(task.trajectory, task.timing_scale);
   const double t0 = task.waypoint_times.front();
@@ -50,44 +38,33 @@ void check_task_efforts(FirmwareSettings& s) {
 
 }  // namespace
 
-FirmwareSettings parse_firmware_settings(const YAML::Node& root, const std::string& file,
-                                         const std::string& base_directory) {
-  using control::ConfigError;
-  if (!root || !root.IsMap()) throw ConfigError(file, "", "the scene must be a YAML mapping");
-  // The firmware's sections, then the plant's (read by sim_plant; named here only so that a
-  // misspelt section is refused by the firmware too).
-  control::reject_unknown_keys(root, file, "", {"name", "description", "machine", "terrain", "duration", "controller",
-                                                "task", "soil", "initial_state", "actuators", "integrator",
-                                                "sensors", "checks"});
+FirmwareSettings read_firmware_settings(const settings::Document& scene) {
+  settings::SectionReader top(scene);
   FirmwareSettings s;
-  s.file = file;
-  if (!root["name"] || !root["name"].IsScalar()) throw ConfigError(file, "name", "missing; a string");
-  s.name = root["name"].as<std::string>();
-  if (root["machine"]) {
-    if (!root["machine"].IsScalar()) throw ConfigError(file, "machine", "must be the path of a machine file");
-    s.machine_file = resolve(base_directory, root["machine"].as<std::string>());
-    try {
-      s.machine = load_machine(s.machine_file);
-    } catch (const MachineError& e) {
-      throw ConfigError(file, "machine", std::string("the machine file does not load: ") + e.what());
-    }
-  } else {
-    s.machine = reference_machine();
+  s.file = scene.file();
+  SceneCommon common = read_scene_common(top, scene);
+  s.name = common.name;
+  s.machine_file = common.machine_file;
+  s.machine = std::move(common.machine);
+  s.terrain_height = common.terrain_height;  // a profile's shape is the plant's; the estimator anchors to the flat height
+  s.duration = common.duration;
+  settings::SectionReader controller = top.section("controller", "the control law's settings");
+  control::read_controller_config(controller, s.controller);
+  settings::SectionReader task = top.section("task", "what the machine does");
+  s.task = control::read_task(task, s.machine);
+  top.others(kPlantSceneSections);
+  top.finish();
+  try {
+    check_task_efforts(s);
+  } catch (const SettingsError& e) {
+    top.rethrow_placed(e);
   }
-  s.terrain_height = s.machine.terrain_flat_height;
-  if (const YAML::Node terrain = root["terrain"]; terrain && terrain["height"])
-    s.terrain_height = control::read_number(terrain["height"], file, "terrain.height", -20, 20, "m");
-  s.duration = control::read_number(root["duration"], file, "duration", 1e-3, 28800, "s");  // a working shift
-  s.controller = control::parse_controller_config(root["controller"], file);
-  if (!root["task"]) throw ConfigError(file, "task", "missing: the firmware needs a task");
-  s.task = control::parse_task(root["task"], file, s.machine);
-  check_task_efforts(s);
+  s.effective = top.effective();
   return s;
 }
 
 FirmwareSettings load_firmware_settings(const std::string& path) {
-  const YAML::Node root = control::load_yaml_file(path);
-  return parse_firmware_settings(root, path, directory_of(path));
+  return read_firmware_settings(settings::Document::load(path));
 }
 
 }  // namespace exc::app

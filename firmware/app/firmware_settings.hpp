@@ -4,34 +4,34 @@
 // The simulated machine's sections (soil, actuators, integrator, sensors, initial state, checks)
 // belong to the plant, which reads them with its own loader; the firmware only checks that every
 // top-level key is a known section, so a typo is an error on both sides. Nothing here links plant
-// code. Start-up code: allocates, throws control::ConfigError naming file, field and range.
+// code. Start-up code: allocates, throws SettingsError naming file, line, column, field and range.
 #include <string>
+
+#include <yaml-cpp/yaml.h>
 
 #include "control/controller_config.hpp"
 #include "control/task.hpp"
 #include "model/machine.hpp"
-
-namespace YAML {
-class Node;
-}
+#include "settings/document.hpp"
 
 namespace exc::app {
 
 struct FirmwareSettings {
   std::string file;          // the scene file
   std::string name;          // scene name
-  std::string machine_file;  // resolved path of the nominal machine, empty for the built-in one
+  std::string machine_file;  // absolute path of the nominal machine, empty for the built-in one
   Machine machine;           // the controller's model of the machine (nominal parameters)
   control::ControllerConfig controller;
   control::Task task;
   double terrain_height = 0;  // m, world z of the flat ground the soil estimator anchors to
   double duration = 10;       // s, how long the run lasts
+  // The firmware's sections as read, every default filled in (the effective configuration).
+  YAML::Node effective;
 };
 
 // Opens and parses the file once.
 FirmwareSettings load_firmware_settings(const std::string& path);
-// From an already parsed document; relative machine paths resolve against base_directory.
-FirmwareSettings parse_firmware_settings(const YAML::Node& root, const std::string& file,
-                                         const std::string& base_directory);
+// From an already parsed scene file (the one the plant's reader reads too).
+FirmwareSettings read_firmware_settings(const settings::Document& scene);
 
 }  // namespace exc::app

@@ -35,7 +35,7 @@ namespace exc::control {
 class AdaptiveComputedTorque final : public Controller {
  public:
   // The model must outlive the controller. Start-up: allocates (the Workspace, the Lyapunov solve).
-  // Throws ConfigError if the gains give no SPD P.
+  // Throws SettingsError if the gains give no SPD P.
   AdaptiveComputedTorque(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;

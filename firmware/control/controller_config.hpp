@@ -1,23 +1,26 @@
 #pragma once
 // The scene's `controller:` section (gains, Lyapunov weights, adaptation rates, soil-parameter
 // bounds, filter cut-offs, watchdog), parsed and validated at start-up. Every field is optional:
-// a scene without `controller:` gets the embedded defaults below (docs/control.md lists them).
-// Errors (ConfigError) name the file, the field and the allowed range. Start-up code: allocates.
+// a scene without `controller:` gets the embedded defaults below (docs/control.md lists them); the
+// reader (controller_config.cpp) declares each field's unit and range once. Errors (SettingsError)
+// name the file, the line and column, the field and the allowed range. Start-up code: allocates.
 #include <string>
 
-#include "control/config_error.hpp"
+#include <yaml-cpp/yaml.h>
+
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
 #include "control/state_estimator.hpp"
-
-namespace YAML {
-class Node;
-}
+#include "settings/section_reader.hpp"
 
 namespace exc::control {
 
 // Where the adaptive law's regressor takes the joint acceleration for the soil's M_t rhodd term.
 enum class RegressorAcceleration : std::uint8_t { filtered = 0, desired = 1 };
+inline constexpr settings::EnumTable<RegressorAcceleration, 2> kRegressorAccelerations{{{
+    {RegressorAcceleration::filtered, "filtered", "the estimator's filtered joint acceleration"},
+    {RegressorAcceleration::desired, "desired", "the trajectory's desired acceleration"},
+}}};
 
 struct ControllerConfig {
   ControllerKind kind = ControllerKind::adaptive;
@@ -79,11 +82,13 @@ struct ControllerConfig {
   }
 };
 
-// Parses the `controller:` node (which may be null/undefined: defaults). 'file' is named in errors.
+// Reads the `controller:` section into c (a field the section does not give keeps c's value, which
+// is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
+// Hurwitz gains, ...).
+void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
+// The same from a node (which may be null/undefined: defaults). 'file' is named in errors.
 ControllerConfig parse_controller_config(const YAML::Node& controller, const std::string& file);
-// Reads a scene (or controller) file and parses its `controller:` section.
-ControllerConfig load_controller_config(const std::string& path);
-// Checks cross-field rules (min < initial < max, Hurwitz gains, ...); throws ConfigError.
+// Checks a configuration built in C++ with the same declarations; throws SettingsError.
 void validate(const ControllerConfig& c, const std::string& file);
 
 }  // namespace exc::control

@@ -55,13 +55,13 @@ void check_joint_trajectory(const Machine& machine, const JointTrajectory& traje
     for (int j = 0; j < kNumActive; ++j) {
       const double margin = j == 0 ? 0.0 : options.length_margin;
       if (q[j] < lo[j] + margin || q[j] > hi[j] - margin)
-        throw ConfigError(file, waypoint_place(waypoint_times, t, field),
+        throw SettingsError(file, 0, 0, waypoint_place(waypoint_times, t, field),
                           std::string("at t = ") + fmt(t) + " s the " + kActiveNames[j] +
                               (j == 0 ? " angle is " : " cylinder length is ") + fmt(q[j], 6) +
                               (j == 0 ? " rad" : " m") + ", outside the allowed " + fmt(lo[j] + margin, 6) +
                               " .. " + fmt(hi[j] - margin, 6));
       if (options.check_speed && std::abs(qd[j]) > vmax[j])
-        throw ConfigError(file, waypoint_place(waypoint_times, t, field),
+        throw SettingsError(file, 0, 0, waypoint_place(waypoint_times, t, field),
                           std::string("at t = ") + fmt(t) + " s the " + kActiveNames[j] + " speed is " +
                               fmt(qd[j], 4) + (j == 0 ? " rad/s" : " m/s") + ", above the limit " +
                               fmt(vmax[j], 4) + " (slow the path down)");
@@ -72,12 +72,12 @@ void check_joint_trajectory(const Machine& machine, const JointTrajectory& traje
 JointTrajectory dig_trajectory(const Machine& machine, double swing, const std::vector<DigWaypoint>& path,
                                const TrajectoryCheckOptions& options, const std::string& file,
                                const std::string& field) {
-  if (path.size() < 2) throw ConfigError(file, field, "needs at least 2 tip waypoints");
+  if (path.size() < 2) throw SettingsError(file, 0, 0, field, "needs at least 2 tip waypoints");
   std::vector<double> times;
   std::vector<Vec3> poses;
   for (std::size_t i = 0; i < path.size(); ++i) {
     if (i > 0 && !(path[i].t > path[i - 1].t))
-      throw ConfigError(file, field + "[" + std::to_string(i) + "].t",
+      throw SettingsError(file, 0, 0, field + "[" + std::to_string(i) + "].t",
                         fmt(path[i].t) + " s must be later than the previous waypoint's " + fmt(path[i - 1].t) + " s");
     times.push_back(path[i].t);
     poses.emplace_back(path[i].pose.x, path[i].pose.z, path[i].pose.pitch);
@@ -88,10 +88,10 @@ JointTrajectory dig_trajectory(const Machine& machine, double swing, const std::
     const std::string f = field + "[" + std::to_string(i) + "]";
     Vec4 q;
     const IkStatus st = inverse_kinematics(machine, swing, path[i].pose, q);
-    if (st != IkStatus::ok) throw ConfigError(file, f, std::string("tip pose: ") + to_string(st));
+    if (st != IkStatus::ok) throw SettingsError(file, 0, 0, f, std::string("tip pose: ") + to_string(st));
     for (int j = 1; j < kNumActive; ++j)
       if (q[j] < lo[j] + options.length_margin || q[j] > hi[j] - options.length_margin)
-        throw ConfigError(file, f, std::string("the ") + kActiveNames[j] + " cylinder length would be " + fmt(q[j], 6) +
+        throw SettingsError(file, 0, 0, f, std::string("the ") + kActiveNames[j] + " cylinder length would be " + fmt(q[j], 6) +
                                        " m, outside the allowed " + fmt(lo[j] + options.length_margin, 6) + " .. " +
                                        fmt(hi[j] - options.length_margin, 6) + " (change x, z or pitch_deg)");
   }
@@ -105,7 +105,7 @@ JointTrajectory dig_trajectory(const Machine& machine, double swing, const std::
     Vec4 q;
     const IkStatus s = inverse_kinematics(machine, swing, pose, q);
     if (s != IkStatus::ok)
-      throw ConfigError(file, waypoint_place(times, t, field),
+      throw SettingsError(file, 0, 0, waypoint_place(times, t, field),
                         std::string("at t = ") + fmt(t) + " s the tip (x " + fmt(pose.x) + " m, z " + fmt(pose.z) +
                             " m, pitch " + fmt(pose.pitch * 180 / 3.14159265358979323846) + " deg): " + to_string(s));
     qs.push_back(q);

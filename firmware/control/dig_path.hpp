@@ -7,11 +7,11 @@
 // Before the run starts every sample is checked: reachable, bucket linkage closes, cylinder lengths
 // inside the stroke (with a margin), cylinder speeds below the machine's limits. An error names the
 // waypoint (task.path[i]) or the segment between two, the time, the value and the allowed range.
-// Start-up code: allocates, throws ConfigError.
+// Start-up code: allocates, throws SettingsError.
 #include <string>
 #include <vector>
 
-#include "control/config_error.hpp"
+#include "settings/settings_error.hpp"
 #include "control/inverse_kinematics.hpp"
 #include "control/trajectory.hpp"
 
@@ -28,7 +28,7 @@ struct TrajectoryCheckOptions {
   bool check_speed = true;      // cylinder and swing speeds against the machine's limits
 };
 
-// Throws ConfigError naming 'field' (e.g. "task.path") with the index of the offending waypoint.
+// Throws SettingsError naming 'field' (e.g. "task.path") with the index of the offending waypoint.
 JointTrajectory dig_trajectory(const Machine& machine, double swing, const std::vector<DigWaypoint>& path,
                                const TrajectoryCheckOptions& options, const std::string& file,
                                const std::string& field = "task.path");

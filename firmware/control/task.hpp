@@ -17,20 +17,25 @@
 //     dump: {swing_deg: 90, x: 6.0, z: 3.5, pitch_deg: -40, open_pitch_deg: 45}
 //     times: {to_dump: 6, dump: 2, back: 6}
 //     repeat: 5
-// Errors (ConfigError) name the file, the field (task.waypoints[2].q[1]) and the allowed values;
-// limits (stroke, speed, reach) are checked here, before the run starts.
+// Every field is declared once, in task.cpp, with the settings reader. Errors (SettingsError) name
+// the file, the line and column, the field (task.waypoints[2].q[1]) and the allowed values; limits
+// (stroke, speed, reach) are checked here, before the run starts, and named at the waypoint's line.
 #include <string>
 #include <vector>
 
-#include "control/dig_path.hpp"
+#include <yaml-cpp/yaml.h>
 
-namespace YAML {
-class Node;
-}
+#include "control/dig_path.hpp"
+#include "settings/section_reader.hpp"
 
 namespace exc::control {
 
 enum class TaskType { joint_waypoints, dig, truck_loading };
+inline constexpr settings::EnumTable<TaskType, 3> kTaskTypes{{{
+    {TaskType::joint_waypoints, "joint_waypoints", "paper 5.1: q_a waypoints, a C2 spline through them"},
+    {TaskType::dig, "dig", "paper 5.2: a bucket-tip path in the swing plane"},
+    {TaskType::truck_loading, "truck_loading", "dig pass, lift and swing to the truck, dump, swing back"},
+}}};
 
 // The effort check before the run (effort_feasibility.hpp), from the task's `efforts:` mapping.
 struct TaskEffortCheck {
@@ -55,9 +60,12 @@ struct Task {
   double timing_scale = 1;             // > 1 when fit_timing slowed the path down (times multiplied)
 };
 
+// Reads the `task:` section (required: an absent one is an error).
+Task read_task(settings::SectionReader& task, const Machine& machine, const TrajectoryCheckOptions& options = {});
+// The `task:` section of a parsed scene file (the rest of the file left to its readers).
+Task read_task(const settings::Document& scene, const Machine& machine, const TrajectoryCheckOptions& options = {});
+// The same from a node; 'file' is named in errors.
 Task parse_task(const YAML::Node& task, const std::string& file, const Machine& machine,
                 const TrajectoryCheckOptions& options = {});
-// Reads a scene file and parses its `task:` section (required).
-Task load_task(const std::string& scene_path, const Machine& machine, const TrajectoryCheckOptions& options = {});
 
 }  // namespace exc::control

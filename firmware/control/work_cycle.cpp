@@ -71,7 +71,7 @@ CycleKnots truck_loading_cycle(const Machine& machine, double dig_swing, const s
   const auto pose_at = [&](const TipPose& tip, const std::string& where) {
     Vec4 q;
     const IkStatus st = inverse_kinematics(machine, dump.swing, tip, q);
-    if (st != IkStatus::ok) throw ConfigError(file, field + ".dump" + where, std::string("tip pose: ") + to_string(st));
+    if (st != IkStatus::ok) throw SettingsError(file, 0, 0, field + ".dump" + where, std::string("tip pose: ") + to_string(st));
     return q;
   };
   const Vec4 curled = pose_at(dump.curled, "");

@@ -4,7 +4,7 @@
 // time), so position, velocity and acceleration are continuous everywhere, including the joins.
 // The truck-loading cycle (the job of an automated 20 t machine): the dig pass, then lift and swing
 // to the dump angle, open the bucket over the truck, swing back to where the next pass starts.
-// Start-up code: allocates, throws ConfigError through the checks of dig_path.hpp.
+// Start-up code: allocates, throws SettingsError through the checks of dig_path.hpp.
 #include <string>
 #include <vector>
 

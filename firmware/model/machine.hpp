@@ -1,26 +1,16 @@
 #pragma once
-// The machine description (pins, bodies, limits) as read from a machine file such as
-// machines/reference-20t.yaml. Loading validates every field; errors name file, field and reason.
-// This is start-up code: it may allocate. Nothing built from it allocates afterwards.
-#include <stdexcept>
+// The machine description (pins, bodies, limits, hydraulics) as read from a machine file such as
+// machines/reference-20t.yaml. Loading validates every field; errors (SettingsError) name file,
+// line, column, field and reason. This is start-up code: it may allocate. Nothing built from it
+// allocates afterwards.
+#include <array>
 #include <string>
 #include <vector>
 
+#include "settings/settings_error.hpp"
 #include "types.hpp"
 
 namespace exc {
-
-// A load-time error: which file, which field (dotted path, e.g. "bodies.boom.mass") and why.
-class MachineError : public std::runtime_error {
- public:
-  MachineError(std::string file, std::string field, std::string reason);
-  const std::string& file() const { return file_; }
-  const std::string& field() const { return field_; }
-  const std::string& reason() const { return reason_; }
-
- private:
-  std::string file_, field_, reason_;
-};
 
 struct BodyInertia {
   double mass = 0;             // kg
@@ -46,6 +36,71 @@ struct ReferencePose {
   std::vector<std::pair<std::string, Vec3>> pins_world;
 };
 
+// The machine's hydraulics (docs/plant.md, "The hydraulic machine"; the machine file's
+// `hydraulics:` section, optional: a file without it gets these defaults). The plant runs the
+// circuit with its true machine's numbers; the firmware reads its nominal machine's (for a valve
+// loop). Plain numbers: unit, source and allowed range with each; the ranges are declared once, by
+// the reader in machine.cpp, which also checks a struct built in C++ (validate_hydraulics).
+struct HydraulicParameters {
+  // s, spool lag of the pilot-operated main valves (mobile valves: 30-100 ms). Range [0, 1].
+  double valve_time_constant = 0.03;
+  // Pa, effective bulk modulus of the oil with its hoses. Range [1e7, 5e9].
+  double bulk_modulus = 1.0e9;
+  // m^3, oil in each cylinder chamber's lines at full retraction. Range [1e-5, 0.1].
+  double dead_volume = 0.002;
+  // m^3, oil on each side of the swing motor. Range [1e-4, 1].
+  double swing_volume = 0.01;
+  // Pa, the pumps' pressure limit; 0: main_relief_pressure. Range [0, 1e8], at most the
+  // actuators' relief_pressure.
+  double supply_pressure = 0;
+  // Pa, return-line back pressure (the make-up valves draw from it). Range [0, 5e6].
+  double tank_pressure = 0.3e6;
+  // Pa: a fully open meter-out passes the speed-limit flow at this drop. Range [1e5, 3e7].
+  double valve_pressure_drop = 5e6;
+  // Pa: below this drop the orifice flow is linear in dp. Range [1e3, 5e6].
+  double laminar_pressure = 0.2e6;
+  // m^3/s, both pumps together at rated speed: 2 x 112 cm^3/rev, 439 L/min (Komatsu PC200-8,
+  // hydraulics.md). Range [1e-4, 0.05].
+  double pump_flow = 439.0 / 60000.0;
+  // true: both pumps feed one gallery (the PC200-8's CLSS joins them in normal work); false: each
+  // pump feeds its own functions (pump_of) with half the flow.
+  bool pumps_merged = true;
+  // With split pumps, the pump (0 or 1) of swing, boom, arm, bucket (estimate: the usual two-pump
+  // layout, boom and bucket on one, swing and arm on the other).
+  std::array<int, 4> pump_of = {1, 0, 1, 0};
+  // Pa, pump pressure above the highest load (the load-sensing differential; estimate, typical
+  // 1.5-3 MPa, not on the spec page). The meter-in orifices are sized to pass the speed-limit flow
+  // at this drop. Range [0.3e6, 5e6].
+  double load_sensing_margin = 2.0e6;
+  // Pa, main relief: the pumps' pressure limit (34.3 MPa, Cat 320C service data, hydraulics.md).
+  // supply_pressure, when set (> 0), takes its place. Range [5e6, 60e6].
+  double main_relief_pressure = 34.3e6;
+  // Pa, port reliefs on the boom, arm and bucket chambers (36.8 MPa, Cat 320C, hydraulics.md).
+  // Range [5e6, 60e6].
+  double port_relief_pressure = 36.8e6;
+  // Pa, the swing motor's port reliefs (estimate: the spec page gives none; 34.3 MPa is the pressure
+  // at which the machine file's 65 kN m swing torque is stated). Range [5e6, 60e6].
+  double swing_relief_pressure = 34.3e6;
+  // Pa above its setting at which a relief passes pump_flow (linear override; estimate).
+  // Range [1e4, 10e6].
+  double relief_override = 1.5e6;
+  // Pa below tank pressure at which a make-up (anti-cavitation) valve passes pump_flow (estimate).
+  // Range [1e4, 2e6].
+  double makeup_pressure_drop = 0.2e6;
+  // Pa (gauge, like every pressure of the plant): the floor no chamber goes below; below it the
+  // oil would release air and vapour (hydraulics.md: never below zero or vapour pressure).
+  // Range [-0.1e6, 0.1e6], and at most tank_pressure.
+  double vapour_pressure = 0.0;
+  // Pa, pilot pressure difference for full spool stroke (0-5 MPa pilots, the ZX200's 0.02 MPa/bit
+  // commands, hydraulics.md). Range [1e6, 10e6].
+  double pilot_full_stroke = 5.0e6;
+  // Fraction of the spool stroke before the metering notch opens, per function (swing, boom, arm,
+  // bucket) and direction (estimate: ~0.75 MPa of a 5 MPa pilot; hydraulics.md: calibrated per
+  // machine and direction). Range [0, 0.9].
+  Vec4 dead_zone_extend = Vec4::Constant(0.15);
+  Vec4 dead_zone_retract = Vec4::Constant(0.15);
+};
+
 struct Machine {
   std::string name;
   std::string source;    // file the machine was loaded from ("<embedded>" for the built-in one)
@@ -64,6 +119,7 @@ struct Machine {
   SwingLimits swing;
   CylinderLimits boom, arm, bucket;
   double relief_pressure = 0;  // Pa
+  HydraulicParameters hydraulics;
 
   std::vector<ReferencePose> reference_poses;
   double terrain_flat_height = 0;
@@ -76,11 +132,14 @@ struct Machine {
   Vec4 speed_max() const;
 };
 
-// Reads and validates a machine file. Throws MachineError.
+// Reads and validates a machine file (read and parsed once). Throws SettingsError.
 Machine load_machine(const std::string& path);
 // Same, from YAML text; 'file_for_errors' is what errors name as the file.
 Machine load_machine_from_string(const std::string& yaml, const std::string& file_for_errors);
 // The reference machine compiled into the binary (same numbers as machines/reference-20t.yaml).
 Machine reference_machine();
+// Checks hydraulics built or changed in C++ against the ranges the machine file's reader declares
+// (SettingsError naming machine.source and the field, e.g. "hydraulics.pump_flow").
+void validate_hydraulics(const Machine& machine);
 
 }  // namespace exc

@@ -2,19 +2,22 @@
 #include <yaml-cpp/yaml.h>
 
 #include "control/controller_config.hpp"
+#include "settings_error_check.hpp"
 
 using namespace exc;
 using namespace exc::control;
 
 namespace {
 
-std::string error_of(const std::string& yaml) {
+// A bad controller section's error: scene.yaml, the field, the place where `at` begins, the reason.
+void check_error(const std::string& yaml, const std::string& field, const std::string& at, const std::string& reason) {
+  CAPTURE(yaml);
   try {
     parse_controller_config(YAML::Load(yaml)["controller"], "scene.yaml");
-  } catch (const ConfigError& e) {
-    return e.field() + " | " + e.reason();
+    FAIL("no error");
+  } catch (const SettingsError& e) {
+    exc::test::check_settings_error(e, "scene.yaml", yaml, field, at, reason);
   }
-  return "no error";
 }
 
 }  // namespace
@@ -70,23 +73,43 @@ controller:
   CHECK(c.lyapunov_q_integral[3] == 4);
 }
 
-TEST_CASE("firmware/controller config errors name the field and the allowed range") {
-  CHECK(error_of("controller: {type: lqr}") == "controller.type | 'lqr' (allowed: pid, adaptive, slotine_li)");
-  CHECK(error_of("controller: {kp: [1, 2, 3]}").find("controller.kp | must be a list of 4 numbers") == 0);
-  CHECK(error_of("controller: {kp: [1, 2, -3, 4]}").find("controller.kp[2] | -3 outside the allowed range") == 0);
-  CHECK(error_of("controller: {gain: 3}").find("controller.gain | unknown key (allowed: ") == 0);
-  CHECK(error_of("controller: {theta_initial: [600, 2000, 30000, 100, 2000, 30000]}")
-            .find("controller.theta_initial[0] | 600 outside the bounds 50 .. 500") == 0);
-  CHECK(error_of("controller: {theta_min: [50, 1000, 10000, 50, 1000, 2000000]}")
-            .find("controller.theta_min[5] | 2e+06 must be below theta_max[5]") == 0);
-  CHECK(error_of("controller: {kp: [100, 100, 100, 100], kv: [10, 10, 10, 10], ki: [2000, 0, 0, 0]}")
-            .find("controller.ki[0] | 2000 makes the PID loop unstable") == 0);
-  CHECK(error_of("controller: {filters: {velocity_cutoff_hz: 800}}").find("controller.filters.velocity_cutoff_hz | 800 Hz must be below 500 Hz") == 0);
-  CHECK(error_of("controller: {actuator_lag: 0.02, actuator_lag_target: 0.03}")
-            .find("controller.actuator_lag_target | 0.03 s must lie in actuator_lag / 20 .. actuator_lag = 0.001 .. 0.02 s") == 0);
-  CHECK(error_of("controller: {actuator_lag: 0.1, actuator_lag_target: 0.001}").find("controller.actuator_lag_target | ") == 0);
-  CHECK(error_of("controller: {actuator_lag: -0.01}").find("controller.actuator_lag | -0.01 outside the allowed range 0 .. 1") == 0);
-  CHECK(error_of("controller: {integral_action: maybe}") == "controller.integral_action | 'maybe' (allowed: true, false)");
-  CHECK(error_of("controller: {lyapunov_q_integral: [1, 0, 1, 1]}").find("controller.lyapunov_q_integral[1] | 0 outside the allowed range") == 0);
-  CHECK(error_of("controller: {period: nan}").find("controller.period | ") == 0);
+TEST_CASE("firmware/controller config errors name the field, its line and column and the allowed range") {
+  check_error("controller: {type: lqr}", "controller.type", "lqr", "is 'lqr'; allowed values: pid, adaptive, slotine_li");
+  check_error("controller: {kp: [1, 2, 3]}", "controller.kp", "[1, 2, 3]", "must be a list of 4 numbers in [0.001, 1000000] 1/s^2");
+  check_error("controller: {kp: [1, 2, -3, 4]}", "controller.kp[2]", "-3", "is -3 1/s^2; allowed range [0.001, 1000000] 1/s^2");
+  check_error("controller: {gain: 3}", "controller.gain", "gain", "unknown key; allowed keys: type, period, kp, kv, ki");
+  check_error("controller: {theta_initial: [600, 2000, 30000, 100, 2000, 30000]}", "controller.theta_initial[0]", "600",
+              "600 outside the bounds 50 .. 500");
+  check_error("controller: {theta_min: [50, 1000, 10000, 50, 1000, 2000000]}", "controller.theta_min[5]", "2000000",
+              "2000000 must be below theta_max[5] = 1000000");
+  check_error("controller: {kp: [100, 100, 100, 100], kv: [10, 10, 10, 10], ki: [2000, 0, 0, 0]}", "controller.ki[0]",
+              "2000", "2000 makes the PID loop unstable: must be below kv*kp = 1000");
+  check_error("controller: {filters: {velocity_cutoff_hz: 800}}", "controller.filters.velocity_cutoff_hz", "800",
+              "800 Hz must be below 500 Hz (Nyquist)");
+  check_error("controller: {actuator_lag: 0.02, actuator_lag_target: 0.03}", "controller.actuator_lag_target", "0.03",
+              "0.03 s must lie in actuator_lag / 20 .. actuator_lag = 0.001 .. 0.02 s");
+  check_error("controller: {actuator_lag: 0.1, actuator_lag_target: 0.001}", "controller.actuator_lag_target", "0.001",
+              "0.001 s must lie in actuator_lag / 20 .. actuator_lag = 0.005 .. 0.1 s");
+  check_error("controller: {actuator_lag: -0.01}", "controller.actuator_lag", "-0.01", "is -0.01 s; allowed range [0, 1] s");
+  check_error("controller: {integral_action: maybe}", "controller.integral_action", "maybe", "is 'maybe'; allowed values: true, false");
+  check_error("controller: {lyapunov_q_integral: [1, 0, 1, 1]}", "controller.lyapunov_q_integral[1]", "0, 1, 1]",
+              "is 0; allowed range [1e-09, 1e+09]");
+  check_error("controller: {period: nan}", "controller.period", "nan", "'nan' is not a number; allowed range [0.00001, 0.1] s");
+  check_error("controller: {regressor_acceleration: measured}", "controller.regressor_acceleration", "measured",
+              "is 'measured'; allowed values: filtered, desired");
+  check_error("controller: [1, 2]", "controller", "[1, 2]", "must be a mapping");
+}
+
+TEST_CASE("firmware/controller config: a configuration built in C++ is checked by the same declarations") {
+  ControllerConfig c;
+  c.gains.ki[3] = 1e4;  // above kv kp = 1024
+  try {
+    validate(c, "<defaults>");
+    FAIL("no error");
+  } catch (const SettingsError& e) {
+    CHECK(e.file() == "<defaults>");
+    CHECK(e.line() == 0);
+    CHECK(e.field() == "controller.ki[3]");
+    CHECK(e.reason() == "10000 makes the PID loop unstable: must be below kv*kp = 1024");
+  }
 }

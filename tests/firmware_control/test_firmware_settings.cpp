@@ -7,6 +7,7 @@
 #include "app/firmware_settings.hpp"
 #include "control/effort_feasibility.hpp"
 #include "scenes.hpp"
+#include "settings_error_check.hpp"
 
 using namespace exc;
 
@@ -14,13 +15,19 @@ namespace {
 
 const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
 
-std::string error_of(const std::string& yaml) {
+app::FirmwareSettings read(const std::string& yaml) {
+  return app::read_firmware_settings(settings::Document::parse(yaml, "scene.yaml"));
+}
+
+// A bad scene's error: scene.yaml, the field, the place where `at` begins, the reason part.
+void check_error(const std::string& yaml, const std::string& field, const std::string& at, const std::string& reason) {
+  CAPTURE(yaml);
   try {
-    app::parse_firmware_settings(YAML::Load(yaml), "scene.yaml", ".");
-  } catch (const control::ConfigError& e) {
-    return e.field() + " | " + e.reason();
+    read(yaml);
+    FAIL("no error");
+  } catch (const SettingsError& e) {
+    exc::test::check_settings_error(e, "scene.yaml", yaml, field, at, reason);
   }
-  return "no error";
 }
 
 const char* const kTask = R"(
@@ -50,22 +57,27 @@ TEST_CASE("firmware/settings accept the plant's sections without reading them an
   const std::string plant_sections =
       "name: x\nduration: 2\nsoil: {preset: loam}\nactuators: {fidelity: limited, lag: 0.02}\n"
       "integrator: {method: rk4}\nsensors: {seed: 3}\ninitial_state: {q_a: [0, 2.4, 2.5, 1.9]}\nchecks: {}\n";
-  CHECK(error_of(plant_sections + kTask) == "no error");
-  CHECK(error_of("name: x\nduration: 2\nsoyl: {preset: loam}\n" + std::string(kTask))
-            .rfind("soyl | unknown key (allowed: ", 0) == 0);
-  CHECK(error_of("name: x\nduration: 2\n") == "task | missing: the firmware needs a task");
-  CHECK(error_of("name: x\n" + std::string(kTask)) .rfind("duration | missing", 0) == 0);
-  CHECK(error_of("name: x\nduration: 2\nterrain: {height: 50}\n" + std::string(kTask)).rfind("terrain.height | ", 0) == 0);
-  CHECK(error_of("name: x\nduration: 2\ncontroller: {kp: 3}\n" + std::string(kTask)).rfind("controller.kp | ", 0) == 0);
-  CHECK(error_of("name: x\nduration: 2\nmachine: /nonexistent.yaml\n" + std::string(kTask)).rfind("machine | the machine file does not load", 0) == 0);
+  CHECK_NOTHROW(read(plant_sections + kTask));
+  check_error("name: x\nduration: 2\nsoyl: {preset: loam}\n" + std::string(kTask), "soyl", "soyl",
+              "unknown key; allowed keys: name, description, machine, terrain, duration, controller, task, soil, "
+              "initial_state, actuators, integrator, sensors, checks");
+  check_error("name: x\nduration: 2\n", "task", "name: x", "missing: the firmware needs a task (type: joint_waypoints, dig, truck_loading)");
+  check_error("name: x\n" + std::string(kTask), "duration", "name: x", "missing: how long the run lasts");
+  check_error("name: x\nduration: 2\nterrain: {height: 50}\n" + std::string(kTask), "terrain.height", "50",
+              "is 50 m; allowed range [-20, 20] m");
+  check_error("name: x\nduration: 2\ncontroller: {kp: 3}\n" + std::string(kTask), "controller.kp", "3}",
+              "must be a list of 4 numbers");
+  check_error("name: x\nduration: 2\nmachine: /nonexistent.yaml\n" + std::string(kTask), "machine", "/nonexistent",
+              "the machine file does not load: /nonexistent.yaml: cannot open the file");
 }
 
 TEST_CASE("firmware/settings name the file when it is missing or not YAML") {
   try {
     app::load_firmware_settings("/nonexistent/scene.yaml");
     FAIL("no error");
-  } catch (const control::ConfigError& e) {
+  } catch (const SettingsError& e) {
     CHECK(e.file() == "/nonexistent/scene.yaml");
+    CHECK(e.line() == 0);
     CHECK(e.reason() == "cannot open the file");
   }
 }
@@ -83,18 +95,26 @@ std::string fast_swing_scene(const std::string& efforts) {
 }  // namespace
 
 TEST_CASE("firmware/settings refuse a task the actuators cannot drive, naming the place, the joint, the torque and the timing that fits") {
-  const std::string e = error_of(fast_swing_scene(""));
-  MESSAGE(e);
-  CHECK(e.rfind("task.waypoints | task.waypoints[0] -> task.waypoints[1] at t = ", 0) == 0);
-  CHECK(e.find("the swing needs ") != std::string::npos);
-  CHECK(e.find("65.0 kN m") != std::string::npos);
-  CHECK(e.find("it fits with the timing scaled by 2.2") != std::string::npos);
-  CHECK(e.find("or set task.efforts.fit_timing: true") != std::string::npos);
+  const std::string yaml = fast_swing_scene("");
+  try {
+    read(yaml);
+    FAIL("no error");
+  } catch (const SettingsError& e) {
+    const std::string reason = e.reason();
+    MESSAGE(reason);
+    // The place: the task's waypoints, at their line.
+    exc::test::check_settings_error(e, "scene.yaml", yaml, "task.waypoints", "- {t: 0.0", "task.waypoints[0] -> task.waypoints[1] at t = ");
+    CHECK(reason.rfind("task.waypoints[0] -> task.waypoints[1] at t = ", 0) == 0);
+    CHECK(reason.find("the swing needs ") != std::string::npos);
+    CHECK(reason.find("65.0 kN m") != std::string::npos);
+    CHECK(reason.find("it fits with the timing scaled by 2.2") != std::string::npos);
+    CHECK(reason.find("or set task.efforts.fit_timing: true") != std::string::npos);
+  }
 }
 
 TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much, check: false forces it as written") {
   const app::FirmwareSettings fit =
-      app::parse_firmware_settings(YAML::Load(fast_swing_scene("  efforts: {fit_timing: true}\n")), "scene.yaml", ".");
+      read(fast_swing_scene("  efforts: {fit_timing: true}\n"));
   MESSAGE("timing scaled by " << fit.task.timing_scale);
   CHECK(fit.task.timing_scale > 2.0);
   CHECK(fit.task.timing_scale < 2.5);
@@ -104,9 +124,9 @@ TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much
   CHECK(control::check_effort_feasibility(model, fit.task.trajectory).ok);
 
   const app::FirmwareSettings forced =
-      app::parse_firmware_settings(YAML::Load(fast_swing_scene("  efforts: {check: false}\n")), "scene.yaml", ".");
+      read(fast_swing_scene("  efforts: {check: false}\n"));
   CHECK(forced.task.timing_scale == 1.0);
   CHECK(forced.task.end_time() == doctest::Approx(2.5));
-  CHECK(error_of(fast_swing_scene("  efforts: {check: maybe}\n")) == "task.efforts.check | must be true or false");
-  CHECK(error_of(fast_swing_scene("  efforts: {soil_margin: 2}\n")).rfind("task.efforts.soil_margin | ", 0) == 0);
+  const std::string maybe = fast_swing_scene("  efforts: {check: maybe}\n");
+  check_error(maybe, "task.efforts.check", "maybe", "is 'maybe'; allowed values: true, false");
 }

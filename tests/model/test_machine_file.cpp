@@ -3,9 +3,9 @@
 #include <doctest/doctest.h>
 
 #include <fstream>
-#include <regex>
 
 #include "model/machine.hpp"
+#include "settings_error_check.hpp"
 #include "text_file.hpp"
 
 using namespace exc;
@@ -21,17 +21,13 @@ std::string edited(const std::string& from, const std::string& to) {
   REQUIRE(text.find(from, pos + 1) == std::string::npos);
   return text.replace(pos, from.size(), to);
 }
-void check_error(const std::string& yaml, const std::string& field, const std::string& reason_part) {
+// The error must name bad.yaml, the field, the place where `at` begins, and the reason part.
+void check_error(const std::string& yaml, const std::string& field, const std::string& at, const std::string& reason_part) {
   try {
     load_machine_from_string(yaml, "bad.yaml");
-    FAIL("no MachineError for field " << field);
-  } catch (const MachineError& e) {
-    CHECK(e.file() == "bad.yaml");
-    CHECK(e.field() == field);
-    CHECK(e.reason().find(reason_part) != std::string::npos);
-    const std::string what = e.what();
-    CHECK(what.find("bad.yaml") != std::string::npos);
-    CHECK(what.find(field) != std::string::npos);
+    FAIL("no SettingsError for field " << field);
+  } catch (const SettingsError& e) {
+    exc::test::check_settings_error(e, "bad.yaml", yaml, field, at, reason_part);
   }
 }
 }  // namespace
@@ -95,30 +91,103 @@ TEST_CASE("model/the embedded reference machine equals the machine file") {
   }
 }
 
-TEST_CASE("model/machine file errors name the file, the field and the reason") {
-  check_error(edited("mass: 1700,", "mass: -5,"), "bodies.boom.mass", "outside the allowed range");
-  check_error(edited("mass: 1700,", "mass: heavy,"), "bodies.boom.mass", "not a number");
+TEST_CASE("model/machine file errors name the file, the line and column, the field and the reason") {
+  check_error(edited("mass: 1700,", "mass: -5,"), "bodies.boom.mass", "-5,", "is -5 kg; allowed range [0.001, 1000000] kg");
+  check_error(edited("mass: 1700,", "mass: heavy,"), "bodies.boom.mass", "heavy", "'heavy' is not a number; allowed range");
+  // A missing body: named at its section (the mapping of bodies begins at its first key).
   check_error(edited("  boom:          { mass: 1700,  com: [2.54, 0, 0.68],   inertia: [200, 4050, 3900] }\n", ""),
-              "bodies.boom", "missing");
-  check_error(edited("com: [2.54, 0, 0.68]", "com: [2.54, 0.68]"), "bodies.boom.com", "list of 3 numbers");
+              "bodies.boom", "swing:         { mass: 11500", "missing");
+  check_error(edited("com: [2.54, 0, 0.68]", "com: [2.54, 0.68]"), "bodies.boom.com", "[2.54, 0.68]",
+              "must be a list of 3 numbers in [-50, 50] m");
   check_error(edited("inertia: [200, 4050, 3900]", "inertia: [200, 4050, 9900]"), "bodies.boom.inertia",
-              "not a physical body");
-  check_error(edited("length: [1.70, 2.83]", "length: [2.83, 1.70]"), "actuators.boom.length", "below max");
-  check_error(edited("force: [-184000, 356000]", "force: [184000, 356000]"), "actuators.bucket.force", "pull");
-  check_error(edited("gravity: 9.81", "gravity: .inf"), "gravity", "finite");
-  check_error(edited("gravity: 9.81", "gravity: 0"), "gravity", "outside the allowed range [0.1, 100]");
-  check_error(edited("H: [5.6479, 0.0]", "H: [5.6479, 0.2]"), "pins.boom.H", "boom x axis");
-  check_error(edited("JK: 0.6669", "JQ: 0.6669"), "pins.link_lengths.JQ", "unknown field");
-  check_error(edited("name: reference-20t", "name: reference-20t\nswing_hieght: 3"), "swing_hieght", "unknown field");
-  check_error(edited("q_a: [0.5, 1.9, 3.0, 1.8]", "q_a: [0.5, 1.9, 3.0]"), "reference_poses[1].q_a",
+              "[200, 4050, 9900]", "not a physical body");
+  check_error(edited("length: [1.70, 2.83]", "length: [2.83, 1.70]"), "actuators.boom.length", "[2.83, 1.70]",
+              "min 2.83 must be below max 1.7");
+  check_error(edited("force: [-184000, 356000]", "force: [184000, 356000]"), "actuators.bucket.force",
+              "[184000, 356000]", "pull < 0");
+  check_error(edited("gravity: 9.81", "gravity: .inf"), "gravity", ".inf", "is inf m/s^2; allowed range [0.1, 100] m/s^2");
+  check_error(edited("gravity: 9.81", "gravity: 0"), "gravity", "0\n\nswing:", "is 0 m/s^2; allowed range [0.1, 100] m/s^2");
+  check_error(edited("H: [5.6479, 0.0]", "H: [5.6479, 0.2]"), "pins.boom.H", "[5.6479, 0.2]", "boom x axis");
+  check_error(edited("JK: 0.6669", "JK: 0.6669, JQ: 1"), "pins.link_lengths.JQ", "JQ", "unknown key; allowed keys: JL, JK");
+  // A misspelt required key is first a missing one, named at its section (a flow mapping: its brace).
+  check_error(edited("JK: 0.6669", "JQ: 0.6669"), "pins.link_lengths.JK", "{ JL:", "missing: link 12");
+  check_error(edited("name: reference-20t", "name: reference-20t\nswing_hieght: 3"), "swing_hieght", "swing_hieght",
+              "unknown key; allowed keys: name, gravity, swing, frames, assembly, pins, bodies, actuators, hydraulics, "
+              "reference_poses, terrain");
+  check_error(edited("q_a: [0.5, 1.9, 3.0, 1.8]", "q_a: [0.5, 1.9, 3.0]"), "reference_poses[1].q_a", "[0.5, 1.9, 3.0]",
               "list of 4 numbers");
-  check_error("name: [unclosed", "line 1", "YAML syntax");
-  check_error("", "", "not a YAML mapping");
+  check_error(edited("bulk_modulus: 1.0e9", "bulk_modulus: 1.0e6"), "hydraulics.bulk_modulus", "1.0e6",
+              "is 1000000 Pa; allowed range [1e+07, 5e+09] Pa");
+  check_error(edited("pump_of: [1, 0, 1, 0]", "pump_of: [1, 0, 0.5, 0]"), "hydraulics.pump_of[2]", "0.5, 0]",
+              "is 0.5; allowed values: 0, 1");
+  {
+    std::string t = edited("vapour_pressure: 0.0 ", "vapour_pressure: 0.09e6 ");
+    t.replace(t.find("tank_pressure: 0.3e6"), 20, "tank_pressure: 0.05e6");
+    check_error(t, "hydraulics.vapour_pressure", "0.09e6", "is 90000 Pa; must not exceed tank_pressure (50000 Pa)");
+  }
+  check_error(edited("tank_pressure: 0.3e6", "tank_pressure: 0.3e6\n  colour: 1"), "hydraulics.colour", "colour",
+              "unknown key; allowed keys: valve_time_constant, bulk_modulus");
+  try {
+    load_machine_from_string("name: x\ngravity: [unclosed\n", "bad.yaml");
+    FAIL("no error for bad YAML");
+  } catch (const SettingsError& e) {
+    CHECK(e.file() == "bad.yaml");
+    CHECK(e.line() == 3);  // the end of the file, where the list should have closed
+    CHECK(e.reason().rfind("not valid YAML: ", 0) == 0);
+  }
+  try {
+    load_machine_from_string("", "empty.yaml");
+    FAIL("no error for an empty file");
+  } catch (const SettingsError& e) {
+    CHECK(e.file() == "empty.yaml");
+    CHECK(e.reason().find("a YAML mapping is required") != std::string::npos);
+  }
   try {
     load_machine("/nonexistent/machine.yaml");
     FAIL("no error for a missing file");
-  } catch (const MachineError& e) {
+  } catch (const SettingsError& e) {
     CHECK(e.file() == "/nonexistent/machine.yaml");
-    CHECK(e.reason().find("cannot open") != std::string::npos);
+    CHECK(e.line() == 0);
+    CHECK(std::string(e.what()) == "/nonexistent/machine.yaml: cannot open the file");
+  }
+}
+
+TEST_CASE("model/the machine file carries the hydraulics, equal to the documented defaults, and C++ edits are checked by the same declarations") {
+  const Machine m = load_machine(EXC_MACHINE_FILE);
+  const HydraulicParameters d;
+  const HydraulicParameters& h = m.hydraulics;
+  CHECK(h.valve_time_constant == d.valve_time_constant);
+  CHECK(h.bulk_modulus == d.bulk_modulus);
+  CHECK(h.dead_volume == d.dead_volume);
+  CHECK(h.swing_volume == d.swing_volume);
+  CHECK(h.supply_pressure == d.supply_pressure);
+  CHECK(h.tank_pressure == d.tank_pressure);
+  CHECK(h.valve_pressure_drop == d.valve_pressure_drop);
+  CHECK(h.laminar_pressure == d.laminar_pressure);
+  CHECK(h.pump_flow == 439.0 / 60000.0);
+  CHECK(h.pumps_merged == d.pumps_merged);
+  CHECK(h.pump_of == d.pump_of);
+  CHECK(h.load_sensing_margin == d.load_sensing_margin);
+  CHECK(h.main_relief_pressure == d.main_relief_pressure);
+  CHECK(h.port_relief_pressure == d.port_relief_pressure);
+  CHECK(h.swing_relief_pressure == d.swing_relief_pressure);
+  CHECK(h.relief_override == d.relief_override);
+  CHECK(h.makeup_pressure_drop == d.makeup_pressure_drop);
+  CHECK(h.vapour_pressure == d.vapour_pressure);
+  CHECK(h.pilot_full_stroke == d.pilot_full_stroke);
+  CHECK(h.dead_zone_extend == d.dead_zone_extend);
+  CHECK(h.dead_zone_retract == d.dead_zone_retract);
+  CHECK(reference_machine().hydraulics.pump_flow == h.pump_flow);
+  CHECK_NOTHROW(validate_hydraulics(m));
+  Machine bad = m;
+  bad.hydraulics.dead_zone_extend[2] = 0.95;
+  try {
+    validate_hydraulics(bad);
+    FAIL("no error");
+  } catch (const SettingsError& e) {
+    CHECK(e.file() == EXC_MACHINE_FILE);
+    CHECK(e.line() == 0);  // not from the file
+    CHECK(e.field() == "hydraulics.dead_zone_extend[2]");
+    CHECK(e.reason() == "is 0.95 (not from the file); allowed range [0, 0.9]");
   }
 }

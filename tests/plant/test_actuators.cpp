@@ -54,10 +54,11 @@ TEST_CASE("plant/limited actuator clamps efforts to the relief limits (area x 34
 }
 
 TEST_CASE("plant/hydraulic closed valve: the chamber pressure follows the oil spring dp/dt = -beta A v / V") {
-  const Machine m = reference_machine();
+  Machine m = reference_machine();
+  m.hydraulics.bulk_modulus = 1.2e9;
+  const HydraulicParameters& h = m.hydraulics;
   ActuatorParameters p;
   p.fidelity = ActuatorFidelity::hydraulic;
-  p.bulk_modulus = 1.2e9;
   ActuatorModel a(m, p);
   a.reset(kMid, Vec4(0, 3e5, 1e5, 5e4));
   const Vec4 pa0 = a.pressure_a(), pb0 = a.pressure_b();
@@ -71,8 +72,8 @@ TEST_CASE("plant/hydraulic closed valve: the chamber pressure follows the oil sp
     CAPTURE(i);
     const double Aa = a.area_a()[i], Ab = a.area_b()[i];
     const double stroke = m.q_max()[i] - m.q_min()[i];
-    const double Va = p.dead_volume + Aa * (kMid[i] - m.q_min()[i]);
-    const double Vb = p.dead_volume + Ab * (m.q_max()[i] - kMid[i]);
+    const double Va = h.dead_volume + Aa * (kMid[i] - m.q_min()[i]);
+    const double Vb = h.dead_volume + Ab * (m.q_max()[i] - kMid[i]);
     (void)stroke;
     CHECK(a.pressure_a()[i] == doctest::Approx(pa0[i] - 1.2e9 * Aa * v[i] * 0.02 / Va).epsilon(1e-9));
     CHECK(a.pressure_b()[i] == doctest::Approx(pb0[i] + 1.2e9 * Ab * v[i] * 0.02 / Vb).epsilon(1e-9));
@@ -82,10 +83,10 @@ TEST_CASE("plant/hydraulic closed valve: the chamber pressure follows the oil sp
 }
 
 TEST_CASE("plant/hydraulic spool follows its first-order lag") {
-  const Machine m = reference_machine();
+  Machine m = reference_machine();
+  m.hydraulics.valve_time_constant = 0.03;
   ActuatorParameters p;
   p.fidelity = ActuatorFidelity::hydraulic;
-  p.valve_time_constant = 0.03;
   ActuatorModel a(m, p);
   a.reset(kMid, Vec4::Zero());
   ActuatorCommand c;

@@ -22,15 +22,14 @@ namespace {
 
 const Vec4 kMid(0.0, 2.2, 2.8, 2.0);  // a mid-stroke q_a
 
-// Hydraulic parameters whose spools jump to the command and open from zero, so that a test sees the
-// orifices and chambers alone.
-ActuatorParameters open_spools() {
-  ActuatorParameters p;
-  p.fidelity = ActuatorFidelity::hydraulic;
-  p.valve_time_constant = 0;
-  p.hydraulic.dead_zone_extend.setZero();
-  p.hydraulic.dead_zone_retract.setZero();
-  return p;
+// The reference machine with spools that jump to the command and open from zero, so that a test
+// sees the orifices and chambers alone.
+Machine open_spools() {
+  Machine m = reference_machine();
+  m.hydraulics.valve_time_constant = 0;
+  m.hydraulics.dead_zone_extend.setZero();
+  m.hydraulics.dead_zone_retract.setZero();
+  return m;
 }
 
 ActuatorCommand valve(const Vec4& opening) {
@@ -57,12 +56,12 @@ TEST_CASE("plant/hydraulics: a blocked cylinder fills along the closed forms of 
   // sqrt(p_relief - p) = sqrt(margin) - beta K (t - t1) / (2 V), then laminar below 0.2 MPa,
   // p_relief - p = p_lam exp(-beta K (t - t2) / (V sqrt(p_lam))). Rod side: drains to tank through
   // the meter-out, K_out = A_B v_max / sqrt(5 MPa), turbulent then laminar the same way.
-  const Machine m = reference_machine();
-  const ActuatorParameters p = open_spools();
-  HydraulicCircuit c(m, p);
+  const Machine m = open_spools();
+  const HydraulicParameters& p = m.hydraulics;
+  HydraulicCircuit c(m);
   c.reset(kMid, Vec4::Zero());
-  const double beta = p.bulk_modulus, margin = p.hydraulic.load_sensing_margin, lam = p.laminar_pressure;
-  const double relief = p.hydraulic.main_relief_pressure, tank = p.tank_pressure;
+  const double beta = p.bulk_modulus, margin = p.load_sensing_margin, lam = p.laminar_pressure;
+  const double relief = p.main_relief_pressure, tank = p.tank_pressure;
   const double A = M_PI / 4 * 0.120 * 0.120 * 2, Ab = M_PI / 4 * (0.120 * 0.120 - 0.085 * 0.085) * 2;
   const double V = p.dead_volume + A * (kMid[1] - m.boom.min_length);
   const double Vb = p.dead_volume + Ab * (m.boom.max_length - kMid[1]);
@@ -126,13 +125,13 @@ TEST_CASE("plant/hydraulics: a port relief caps a chamber driven from outside at
   // so at steady state A v = K_r (p - p_set), K_r = pump flow / override. The rod side grows and
   // its only inlet is the make-up valve from the tank line: A_B v = K_mk (p_tank - p) / sqrt(p_lam),
   // K_mk = pump flow / sqrt(make-up drop) (laminar: 7 kPa below tank here).
-  const Machine m = reference_machine();
-  const ActuatorParameters p = open_spools();
-  HydraulicCircuit c(m, p);
+  const Machine m = open_spools();
+  const HydraulicParameters& p = m.hydraulics;
+  HydraulicCircuit c(m);
   c.reset(kMid, Vec4::Zero());
   const double v = -0.05;
   const double A = M_PI / 4 * 0.115 * 0.115, Ab = M_PI / 4 * (0.115 * 0.115 - 0.080 * 0.080);
-  const HydraulicParameters& h = p.hydraulic;
+  const HydraulicParameters& h = p;
   double highest = 0, lowest = 1e9;
   for (int k = 0; k < 3000; ++k) {
     c.advance(1e-3, kMid, Vec4(0, 0, 0, v));
@@ -162,7 +161,7 @@ TEST_CASE("plant/hydraulics: a stall against the end stop holds the bore side at
   t.actuators = "fidelity: hydraulic";
   Plant p(t.scene());
   const Machine& m = p.scene().machine;
-  const double relief = p.scene().actuators.hydraulic.main_relief_pressure;
+  const double relief = p.scene().machine.hydraulics.main_relief_pressure;
   double highest = 0, at_rest = 0, drift = 0;
   for (int k = 1; k <= 3000; ++k) {
     const PlantStatus st = p.step(valve(Vec4(0, 0, 0, 1)));
@@ -178,7 +177,7 @@ TEST_CASE("plant/hydraulics: a stall against the end stop holds the bore side at
   CHECK(s.q_a[3] == doctest::Approx(m.bucket.max_length));
   CHECK(highest <= relief);
   CHECK(s.pressure_a[3] == doctest::Approx(relief).epsilon(1e-3));
-  CHECK(s.pressure_b[3] == doctest::Approx(p.scene().actuators.tank_pressure).epsilon(1e-2));
+  CHECK(s.pressure_b[3] == doctest::Approx(p.scene().machine.hydraulics.tank_pressure).epsilon(1e-2));
   CHECK(s.hydraulics.pump_pressure[0] == doctest::Approx(relief));
   CHECK(s.end_stop_loss > 0);
   CHECK(drift < 30.0);
@@ -188,9 +187,9 @@ TEST_CASE("plant/hydraulics: a blocked cylinder's oil column rings at omega_n = 
   // The boom cylinders carry a 20 t mass (no gravity; a constant outside load the chambers hold),
   // valves closed; the plant's scheme: effort from the pressures at the step's start, symplectic
   // Euler for the mass, backward Euler for the chambers.
-  const Machine m = reference_machine();
-  const ActuatorParameters p = open_spools();
-  HydraulicCircuit c(m, p);
+  const Machine m = open_spools();
+  const HydraulicParameters& p = m.hydraulics;
+  HydraulicCircuit c(m);
   Vec4 q = kMid;
   const double load = 2e5, mass = 2e4, h = 1e-4;
   c.reset(q, Vec4(0, load, 0, 0));
@@ -226,8 +225,8 @@ TEST_CASE("plant/hydraulics: the swing motor's oil column in the plant rings at 
   Mat4 M;
   mass_matrix(plant.model(), ws, M);
   const Machine& m = plant.scene().machine;
-  const double D = m.swing.max_torque / m.relief_pressure, V = plant.scene().actuators.swing_volume;
-  const double omega = std::sqrt(plant.scene().actuators.bulk_modulus * D * D * (2.0 / V) / M(0, 0));
+  const double D = m.swing.max_torque / m.relief_pressure, V = plant.scene().machine.hydraulics.swing_volume;
+  const double omega = std::sqrt(plant.scene().machine.hydraulics.bulk_modulus * D * D * (2.0 / V) / M(0, 0));
   std::vector<double> speed;
   for (int k = 0; k < 8000; ++k) {
     REQUIRE(plant.step(valve(Vec4::Zero())).ok());
@@ -242,15 +241,15 @@ TEST_CASE("plant/hydraulics: the swing motor's oil column in the plant rings at 
 }
 
 TEST_CASE("plant/hydraulics: flow sharing: functions demanding more than the pumps all slow by pump flow / demand, the total is the pumps' flow") {
-  const Machine m = reference_machine();
-  const ActuatorParameters p = open_spools();
-  const double pump = p.hydraulic.pump_flow;  // 439 L/min
+  const Machine m = open_spools();
+  const HydraulicParameters& p = m.hydraulics;
+  const double pump = p.pump_flow;  // 439 L/min
   // Alone, each fully open function takes its speed-limit flow (machine file: pump flow / area).
   const double boom = M_PI / 4 * 0.120 * 0.120 * 2 * m.boom.max_speed;
   const double arm = M_PI / 4 * 0.135 * 0.135 * m.arm.max_speed;
   const double swing = m.swing.max_torque / m.relief_pressure * m.swing.max_speed;
   auto flows = [&](const Vec4& opening) {
-    HydraulicCircuit c(m, p);
+    HydraulicCircuit c(m);
     c.reset(kMid, Vec4::Zero());
     c.command_opening(opening);
     c.advance(1e-6, kMid, Vec4::Zero());
@@ -282,10 +281,10 @@ TEST_CASE("plant/hydraulics: flow sharing: functions demanding more than the pum
   CHECK(three.meter_in_flow[2] / a5.meter_in_flow[2] == doctest::Approx(pump / demand));
   CHECK(three.meter_in_flow.sum() == doctest::Approx(pump));
   // Split pumps: boom and bucket share pump 0's half, the arm has pump 1's half to itself.
-  ActuatorParameters split = p;
-  split.hydraulic.pumps_merged = false;
-  split.hydraulic.pump_of = {1, 0, 1, 0};
-  HydraulicCircuit c(m, split);
+  Machine split = m;
+  split.hydraulics.pumps_merged = false;
+  split.hydraulics.pump_of = {1, 0, 1, 0};
+  HydraulicCircuit c(split);
   c.reset(kMid, Vec4::Zero());
   c.command_opening(Vec4(0, 1, 1, 1));
   c.advance(1e-6, kMid, Vec4::Zero());
@@ -315,7 +314,7 @@ TEST_CASE("plant/hydraulics: in the plant, boom and arm together both slow by pu
   t.q_a = "[0.5, 1.9, 3.0, 1.8]";  // the second reference pose: the boom low, the arm with room to go
   Plant plant(t.scene());
   const Machine& m = plant.scene().machine;
-  const double pump = plant.scene().actuators.hydraulic.pump_flow;
+  const double pump = plant.scene().machine.hydraulics.pump_flow;
   const double q_boom = m.boom.max_force / m.relief_pressure * m.boom.max_speed;
   const double q_arm = m.arm.max_force / m.relief_pressure * m.arm.max_speed;
   const double s = pump / (q_boom + q_arm);
@@ -350,7 +349,7 @@ TEST_CASE("plant/hydraulics: a fast boom-down (overrunning load) refills the rod
   t.actuators = "fidelity: hydraulic";
   Plant plant(t.scene());
   const Machine& m = plant.scene().machine;
-  const double floor = plant.scene().actuators.hydraulic.vapour_pressure;
+  const double floor = plant.scene().machine.hydraulics.vapour_pressure;
   const double Ab = -m.boom.min_force / m.relief_pressure;
   const double l0 = plant.state().q_a[1];
   double lowest = 1e9, metered = 0, refilled = 0, fastest = 0;
@@ -371,7 +370,7 @@ TEST_CASE("plant/hydraulics: a fast boom-down (overrunning load) refills the rod
   CHECK(swept > 1.1 * metered);
   // The speed is the meter-out's: A v = K_out sqrt(p_A - p_tank), K_out = A v_max / sqrt(5 MPa).
   const PlantState& s = plant.state();
-  const double p_tank = plant.scene().actuators.tank_pressure, drop = plant.scene().actuators.valve_pressure_drop;
+  const double p_tank = plant.scene().machine.hydraulics.tank_pressure, drop = plant.scene().machine.hydraulics.valve_pressure_drop;
   CHECK(-s.qd_a[1] == doctest::Approx(m.boom.max_speed * std::sqrt((s.pressure_a[1] - p_tank) / drop)).epsilon(0.02));
   CHECK(refilled > 0.1 * metered);  // overrunning: the make-up valves carried a real part of it
   CHECK(lowest >= floor);
@@ -449,11 +448,12 @@ TEST_CASE("plant/hydraulics: a chamber pressure above the highest relief + margi
   // Every relief set to 8 MPa while the boom needs 10.4 MPa to hold the reference pose: the boom
   // sinks through its port relief, whose override at that flow exceeds a 0.5 MPa check margin.
   plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic, supply_pressure: 8e6";
+  t.actuators = "fidelity: hydraulic";
+  t.checks += ", pressure_check_margin: 0.5e6";
   Scene scene = t.scene();
-  scene.actuators.hydraulic.port_relief_pressure = 8e6;
-  scene.actuators.hydraulic.swing_relief_pressure = 8e6;
-  scene.actuators.hydraulic.pressure_check_margin = 0.5e6;
+  scene.machine.hydraulics.supply_pressure = 8e6;
+  scene.machine.hydraulics.port_relief_pressure = 8e6;
+  scene.machine.hydraulics.swing_relief_pressure = 8e6;
   Plant p(scene);
   PlantStatus st;
   for (int k = 0; k < 500 && st.ok(); ++k) st = p.step(valve(Vec4::Zero()));
@@ -462,7 +462,7 @@ TEST_CASE("plant/hydraulics: a chamber pressure above the highest relief + margi
   CHECK(std::string(st.text()).find("boom bore-side pressure") != std::string::npos);
   CHECK(std::string(st.text()).find("outside [0, 8.5] MPa") != std::string::npos);
   // With the default 5 MPa margin the same sag is only the relief doing its work.
-  scene.actuators.hydraulic.pressure_check_margin = 5e6;
+  scene.checks.pressure_check_margin = 5e6;
   Plant q(scene);
   for (int k = 0; k < 500; ++k) REQUIRE(q.step(valve(Vec4::Zero())).ok());
   CHECK(q.state().hydraulics.relief_substeps > 0);
@@ -486,8 +486,8 @@ TEST_CASE("plant/hydraulics: dead zones: no motion below the threshold, motion a
   plant::test::SceneText t;
   t.actuators = "fidelity: hydraulic";
   Scene scene = t.scene();
-  scene.actuators.hydraulic.dead_zone_extend[1] = 0.2;
-  scene.actuators.hydraulic.dead_zone_retract[1] = 0.3;
+  scene.machine.hydraulics.dead_zone_extend[1] = 0.2;
+  scene.machine.hydraulics.dead_zone_retract[1] = 0.3;
   auto run = [&](double opening) {
     Plant p(scene);
     for (int k = 0; k < 500; ++k) REQUIRE(p.step(valve(Vec4(0, opening, 0, 0))).ok());
@@ -514,11 +514,10 @@ TEST_CASE("plant/hydraulics: dead zones: no motion below the threshold, motion a
 
 TEST_CASE("plant/hydraulics: the spool follows its lag (63 % at tau) from an opening or from pilot pressures") {
   const Machine m = reference_machine();
-  ActuatorParameters p;
-  p.fidelity = ActuatorFidelity::hydraulic;
+  const HydraulicParameters& p = m.hydraulics;
   REQUIRE(p.valve_time_constant == 0.03);  // the default: pilot-operated mobile valves, 30-100 ms
   const double k63 = 1 - std::exp(-1.0);
-  HydraulicCircuit a(m, p), b(m, p);
+  HydraulicCircuit a(m), b(m);
   a.reset(kMid, Vec4::Zero());
   b.reset(kMid, Vec4::Zero());
   a.command_opening(Vec4(1, -0.5, 0.25, 0));
@@ -581,43 +580,50 @@ TEST_CASE("plant/hydraulics: a command of a kind the actuators cannot use stops 
 }
 
 TEST_CASE("plant/hydraulics: parameters outside their ranges are refused naming the field and the range") {
+  // The ranges are the machine file's (declared once by its reader); a machine changed in C++ is held
+  // to them when the circuit is built.
   struct Case {
     void (*edit)(HydraulicParameters&);
     const char* field;
+    const char* reason;
   };
   const Case cases[] = {
-      {[](HydraulicParameters& h) { h.pump_flow = 0; }, "hydraulic.pump_flow is 0 m^3/s; allowed range [0.0001, 0.05]"},
-      {[](HydraulicParameters& h) { h.load_sensing_margin = 1e5; }, "hydraulic.load_sensing_margin"},
-      {[](HydraulicParameters& h) { h.main_relief_pressure = 1e9; }, "hydraulic.main_relief_pressure"},
-      {[](HydraulicParameters& h) { h.port_relief_pressure = NAN; }, "hydraulic.port_relief_pressure"},
-      {[](HydraulicParameters& h) { h.swing_relief_pressure = 1e6; }, "hydraulic.swing_relief_pressure"},
-      {[](HydraulicParameters& h) { h.relief_override = 0; }, "hydraulic.relief_override"},
-      {[](HydraulicParameters& h) { h.makeup_pressure_drop = 1e7; }, "hydraulic.makeup_pressure_drop"},
-      {[](HydraulicParameters& h) { h.vapour_pressure = -1e6; }, "hydraulic.vapour_pressure"},
-      {[](HydraulicParameters& h) { h.pilot_full_stroke = 0; }, "hydraulic.pilot_full_stroke"},
-      {[](HydraulicParameters& h) { h.dead_zone_extend[2] = 0.95; }, "hydraulic.dead_zone_extend[2] is 0.95"},
-      {[](HydraulicParameters& h) { h.dead_zone_retract[0] = -0.1; }, "hydraulic.dead_zone_retract[0]"},
-      {[](HydraulicParameters& h) { h.pump_of[3] = 2; }, "hydraulic.pump_of[3]"},
-      {[](HydraulicParameters& h) { h.pressure_check_margin = -1; }, "hydraulic.pressure_check_margin"},
+      {[](HydraulicParameters& h) { h.pump_flow = 0; }, "hydraulics.pump_flow", "is 0 m^3/s (not from the file); allowed range [0.0001, 0.05] m^3/s"},
+      {[](HydraulicParameters& h) { h.load_sensing_margin = 1e5; }, "hydraulics.load_sensing_margin", "is 100000 Pa (not from the file); allowed range [300000, 5000000] Pa"},
+      {[](HydraulicParameters& h) { h.main_relief_pressure = 1e9; }, "hydraulics.main_relief_pressure", "is 1e+09 Pa (not from the file); allowed range [5000000, 6e+07] Pa"},
+      {[](HydraulicParameters& h) { h.port_relief_pressure = NAN; }, "hydraulics.port_relief_pressure", "is nan Pa (not from the file); allowed range [5000000, 6e+07] Pa"},
+      {[](HydraulicParameters& h) { h.swing_relief_pressure = 1e6; }, "hydraulics.swing_relief_pressure", "is 1000000 Pa (not from the file); allowed range [5000000, 6e+07] Pa"},
+      {[](HydraulicParameters& h) { h.relief_override = 0; }, "hydraulics.relief_override", "is 0 Pa (not from the file); allowed range [10000, 1e+07] Pa"},
+      {[](HydraulicParameters& h) { h.makeup_pressure_drop = 1e7; }, "hydraulics.makeup_pressure_drop", "is 1e+07 Pa (not from the file); allowed range [10000, 2000000] Pa"},
+      {[](HydraulicParameters& h) { h.vapour_pressure = -1e6; }, "hydraulics.vapour_pressure", "is -1000000 Pa (not from the file); allowed range [-100000, 100000] Pa"},
+      {[](HydraulicParameters& h) { h.pilot_full_stroke = 0; }, "hydraulics.pilot_full_stroke", "is 0 Pa (not from the file); allowed range [1000000, 1e+07] Pa"},
+      {[](HydraulicParameters& h) { h.dead_zone_extend[2] = 0.95; }, "hydraulics.dead_zone_extend[2]", "is 0.95 (not from the file); allowed range [0, 0.9]"},
+      {[](HydraulicParameters& h) { h.dead_zone_retract[0] = -0.1; }, "hydraulics.dead_zone_retract[0]", "is -0.1 (not from the file); allowed range [0, 0.9]"},
+      {[](HydraulicParameters& h) { h.pump_of[3] = 2; }, "hydraulics.pump_of[3]", "is 2 (not from the file); allowed range [0, 1]"},
+      {[](HydraulicParameters& h) { h.bulk_modulus = 1; }, "hydraulics.bulk_modulus", "is 1 Pa (not from the file); allowed range [1e+07, 5e+09] Pa"},
+      {[](HydraulicParameters& h) { h.tank_pressure = 0, h.vapour_pressure = 0.05e6; }, "hydraulics.vapour_pressure",
+       "is 50000 Pa; must not exceed tank_pressure (0 Pa)"},
   };
-  CHECK(HydraulicParameters{}.validate().empty());
   plant::test::SceneText t;
   t.actuators = "fidelity: hydraulic";
+  CHECK_NOTHROW(Plant{t.scene()});
   for (const Case& c : cases) {
-    HydraulicParameters h;
-    c.edit(h);
-    const std::string e = h.validate();
-    CAPTURE(e);
-    CHECK(e.find(c.field) != std::string::npos);
-    CHECK(e.find("allowed range") != std::string::npos);
     Scene s = t.scene();
-    s.actuators.hydraulic = h;
-    CHECK_THROWS_WITH_AS(Plant{s}, doctest::Contains(c.field), std::invalid_argument);
+    c.edit(s.machine.hydraulics);
+    CAPTURE(std::string(c.field));
+    try {
+      Plant p{s};
+      FAIL("no error");
+    } catch (const SettingsError& e) {
+      CAPTURE(std::string(e.what()));
+      CHECK(e.file() == "<embedded>");  // the machine's source
+      CHECK(e.field() == c.field);
+      CHECK(e.reason().find(c.reason) != std::string::npos);
+    }
   }
-  Scene s = t.scene();
-  s.actuators.tank_pressure = 0;
-  s.actuators.hydraulic.vapour_pressure = 0.05e6;
-  CHECK_THROWS_WITH_AS(Plant{s}, doctest::Contains("must not exceed actuators.tank_pressure"), std::invalid_argument);
+  // The margin of the plant's pressure check is a scene check.
+  t.checks = "pressure_check_margin: -1";
+  CHECK_THROWS_WITH_AS(t.scene(), doctest::Contains("checks.pressure_check_margin: is -1"), std::runtime_error);
 }
 
 TEST_CASE("plant/hydraulics: the hydraulic step allocates nothing (valve and pilot commands, saturation, relief, make-up)") {

@@ -389,7 +389,7 @@ TEST_CASE("tools/excavator-sim: a scene's controller.type chooses the controller
   const fs::path unknown = edited_dig("controller:\n", "controller:\n  type: lqr\n", "unknown_type");
   const Run bad = run_sim("run " + unknown.string() + " --quiet --no-report");
   CHECK(bad.status == 2);
-  CHECK(bad.err.find("controller.type: 'lqr' (allowed: pid, adaptive, slotine_li)") != std::string::npos);
+  CHECK(bad.err.find("controller.type: is 'lqr'; allowed values: pid, adaptive, slotine_li") != std::string::npos);
   fs::remove(unknown);
 }
 

@@ -37,10 +37,11 @@ int cycles_per_hold(double cycle) { return static_cast<int>(std::lround(kProfile
 
 BenchScene load_bench_scene(const std::string& path, double start, double horizon) {
   BenchScene b;
-  b.scene = plant::load_scene(path);
-  if (!b.scene.has_task) throw std::runtime_error(path + ": field 'task' is missing: the bench needs the task");
-  b.task = control::load_task(path, b.scene.machine);
-  b.controller = control::load_controller_config(path);
+  // One reading of the file: the plant's sections and the firmware's (its task and controller).
+  const sim::SceneBundle bundle = sim::load_scene_bundle(path);
+  b.scene = bundle.scene;
+  b.task = bundle.firmware.task;
+  b.controller = bundle.firmware.controller;
   b.name = b.scene.name;
   b.start = start;
   b.horizon = horizon;

@@ -18,6 +18,7 @@
 #include "app/realtime_setup.hpp"
 #include "control/controller_kinds.hpp"
 #include "hal/clock.hpp"
+#include "settings/section_reader.hpp"
 
 namespace {
 
@@ -50,23 +51,17 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
           {"count", c.count()}};
 }
 
-std::vector<std::string> kind_names() {
-  std::vector<std::string> v;
-  for (const auto& e : exc::control::kControllerKinds) v.push_back(e.name);
-  return v;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
   std::string iface, scene_path, controller, json_path, lcm_url;
   double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;
-  bool realtime = false;
-  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
+  bool realtime = false, print_config = false;
+  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config)");
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
-  app.add_option("--controller", controller, exc::control::controller_kind_names() + " (default: the scene's controller.type, else adaptive)")
-      ->check(CLI::IsMember(kind_names()));
+  app.add_option("--controller", controller, exc::control::kControllerKinds.names() + " (default: the scene's controller.type, else adaptive)")
+      ->check(CLI::IsMember(exc::control::kControllerKinds.name_list()));
   app.add_option("--duration", duration, "seconds to run (default: the scene's duration)")->check(CLI::PositiveNumber);
   app.add_option("--json", json_path, "write the run's summary (ok, tracking figures, timing, deadlines) here");
   app.add_option("--lcm", lcm_url, "publish telemetry to this LCM URL (default: none)");
@@ -82,20 +77,30 @@ int main(int argc, char** argv) {
                  "real time: the run fails when its late wake-ups and skipped periods together exceed this "
                  "fraction of its cycles (default 0.01)")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_flag("--print-config", print_config,
+               "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
   CLI11_PARSE(app, argc, argv);
+  if (!print_config && iface.empty()) {
+    std::cerr << "excavator-firmware: --can is required\n";
+    return 2;
+  }
 
   try {
     const exc::app::FirmwareSettings settings = exc::app::load_firmware_settings(scene_path);
+    if (print_config) {
+      std::cout << exc::settings::emit(settings.effective);
+      return 0;
+    }
     const exc::Model model = exc::build_model(settings.machine);
     exc::app::FirmwareNodeConfig fc;
     fc.kind = settings.controller.kind;  // the scene's controller.type unless --controller says otherwise
     if (!controller.empty()) {
-      if (settings.controller.kind_given && *exc::control::controller_kind_named(controller) != settings.controller.kind) {
+      if (settings.controller.kind_given && *exc::control::kControllerKinds.named(controller) != settings.controller.kind) {
         std::cerr << "excavator-firmware: --controller " << controller << " conflicts with the scene's controller.type "
                   << exc::control::to_string(settings.controller.kind) << " (" << scene_path << "); give one of them\n";
         return 2;
       }
-      fc.kind = *exc::control::controller_kind_named(controller);
+      fc.kind = *exc::control::kControllerKinds.named(controller);
     }
     fc.controller = settings.controller;
     fc.terrain_height = settings.terrain_height;

@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   exc::Machine machine;
   try {
     machine = machine_file.empty() ? exc::reference_machine() : exc::load_machine(machine_file);
-  } catch (const exc::MachineError& e) {
+  } catch (const exc::SettingsError& e) {
     std::fprintf(stderr, "excavator-model: %s\n", e.what());
     return kBadInput;
   }

@@ -12,9 +12,9 @@ namespace exc::sim {
 namespace {
 
 control::ControllerKind parse_kind(const std::string& name) {
-  if (const auto kind = control::controller_kind_named(name)) return *kind;
+  if (const auto kind = control::kControllerKinds.named(name)) return *kind;
   throw std::invalid_argument("--controller: unknown controller '" + name + "' (allowed: " +
-                              control::controller_kind_names() + ")");
+                              control::kControllerKinds.names() + ")");
 }
 
 // The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of it,

@@ -18,6 +18,7 @@
 #include "paper_report.hpp"
 #include "run_report.hpp"
 #include "scene_job.hpp"
+#include "settings/section_reader.hpp"
 #include "sweep.hpp"
 
 namespace fs = std::filesystem;
@@ -28,7 +29,8 @@ int main(int argc, char** argv) {
       "  excavator-sim run scenes/dig.yaml            PID and adaptive, summary, log, plots, report\n"
       "  excavator-sim run scenes/dig.yaml --controller adaptive --json out.json\n"
       "  excavator-sim robustness scenes/dig.yaml     the same with wrong masses, noise, delay, stiffer soil\n"
-      "  excavator-sim paper --out out/paper          both shipped scenes and the paper's Figs. 4-12"};
+      "  excavator-sim paper --out out/paper          both shipped scenes and the paper's Figs. 4-12\n"
+      "  excavator-sim config scenes/dig.yaml         the scene's effective configuration (every default filled in)"};
   app.require_subcommand(1);
   auto* run = app.add_subcommand("run", "run a scene with one or more controllers");
   std::string scene_path;
@@ -41,7 +43,7 @@ int main(int argc, char** argv) {
   bool quiet = false;
   run->add_option("scene", scene_path, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   run->add_option("--controller", controllers,
-                  "controller(s) to run: " + exc::control::controller_kind_names() +
+                  "controller(s) to run: " + exc::control::kControllerKinds.names() +
                       " (default: the scene's controller.type, else pid and adaptive)")
       ->delimiter(',');
   run->add_option("--out", out_dir, "output directory (default: out/<scene name>)");
@@ -64,7 +66,7 @@ int main(int argc, char** argv) {
   bool robust_quiet = false;
   robust->add_option("scene", robust_scene, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   robust->add_option("--controller", robust_controllers,
-                     "controller(s): " + exc::control::controller_kind_names() + " (default: pid and adaptive)")
+                     "controller(s): " + exc::control::kControllerKinds.names() + " (default: pid and adaptive)")
       ->delimiter(',');
   robust->add_option("--json", robust_json, "write the table as JSON to this file");
   robust->add_option("--duration", robust_duration, "simulated seconds per run (default: the scene's duration)")
@@ -100,7 +102,22 @@ int main(int argc, char** argv) {
   merge->add_option("spec", merge_spec, "the sweep spec the shards ran")->required();
   merge->add_option("shards", merge_files, "shard result files")->required();
   merge->add_option("--out", merge_out, "output directory (default out/sweep)");
+  auto* config = app.add_subcommand(
+      "config", "print the scene's effective configuration as YAML: both sides' sections with every default filled in "
+                "(the machine as an absolute path); it loads back to the same run");
+  std::string config_scene;
+  config->add_option("scene", config_scene, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   CLI11_PARSE(app, argc, argv);
+
+  if (config->parsed()) {
+    try {
+      std::cout << exc::settings::emit(exc::sim::load_scene_bundle(config_scene).effective);
+      return 0;
+    } catch (const std::exception& e) {
+      std::cerr << "excavator-sim: " << e.what() << "\n";
+      return 2;
+    }
+  }
 
   if (sweep->parsed() || merge->parsed()) {
     try {

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "run_report.hpp"
+#include "settings/section_reader.hpp"
 
 namespace exc::sim {
 
@@ -28,6 +29,8 @@ SceneJobResult run_scene_job(const SceneJob& job) {
                                                  : std::vector<std::string>{"pid", "adaptive"};
   result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   fs::create_directories(result.out_dir);
+  // What the run used, every default filled in: it loads back to the same run.
+  std::ofstream(result.out_dir / "effective.yaml") << settings::emit(bundle.effective);
   options.lcm_url =
       job.lcm_url.empty() ? "file://" + (fs::absolute(result.out_dir) / "run.lcm").string() + "?mode=w" : job.lcm_url;
 

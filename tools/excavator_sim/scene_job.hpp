@@ -1,6 +1,7 @@
 #pragma once
 // One scene as the main job runs it: the runs of its controllers into one LCM log, the summary on
-// stdout and as JSON, and the report page (CSVs, figures, report.md) of excavator-log.
+// stdout and as JSON, the effective configuration (<out>/effective.yaml) and the report page (CSVs,
+// figures, report.md) of excavator-log.
 #include <filesystem>
 #include <string>
 #include <vector>

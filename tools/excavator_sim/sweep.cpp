@@ -1,7 +1,6 @@
 #include "sweep.hpp"
 
-#include <yaml-cpp/yaml.h>
-
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -13,7 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "control/config_fields.hpp"
+#include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
 
@@ -21,39 +20,21 @@ namespace exc::sim {
 namespace {
 
 namespace fs = std::filesystem;
-using control::ConfigError;
+using settings::Need;
+using settings::SectionReader;
 
-SweepRange read_range(const YAML::Node& n, const std::string& file, const std::string& field, double lo, double hi) {
-  SweepRange r;
-  if (!n) return r;
-  if (!n.IsSequence() || n.size() != 2) throw ConfigError(file, field, "must be [min, max]");
-  r.min = control::read_number(n[0], file, field + "[0]", lo, hi);
-  r.max = control::read_number(n[1], file, field + "[1]", lo, hi);
-  if (r.max < r.min) throw ConfigError(file, field, "max is below min");
-  r.given = true;
-  return r;
+void read_range(SectionReader& p, const char* key, SweepRange& r, settings::Bounds bounds, const char* what) {
+  if (!p.given(key)) return;
+  std::array<double, 2> v{};
+  p.numbers(key, v, bounds, "", what);
+  if (v[1] < v[0]) p.fail(key, "max " + settings::format_number(v[1]) + " is below min " + settings::format_number(v[0]));
+  r = SweepRange{true, v[0], v[1]};
 }
 
 double draw(std::mt19937_64& rng, const SweepRange& r, double fallback) {
   if (!r.given) return fallback;
   return r.min + (r.max - r.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
 }
-
-}  // namespace
-
-std::optional<FaultSchedule::Kind> fault_kind_named(const std::string& name) {
-  for (const FaultSchedule::Kind k : {FaultSchedule::Kind::bus_burst, FaultSchedule::Kind::sensor_freeze,
-                                      FaultSchedule::Kind::sensor_jump, FaultSchedule::Kind::actuator_loss,
-                                      FaultSchedule::Kind::actuator_jam, FaultSchedule::Kind::rock})
-    if (name == to_string(k)) return k;
-  return std::nullopt;
-}
-
-std::string fault_kind_names() {
-  return "bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock";
-}
-
-namespace {
 
 nlohmann::json per_joint(const double (&v)[4]) {
   return {{"swing", v[0]}, {"boom", v[1]}, {"arm", v[2]}, {"bucket", v[3]}};
@@ -62,46 +43,27 @@ nlohmann::json per_joint(const double (&v)[4]) {
 }  // namespace
 
 SweepSpec load_sweep_spec(const std::string& path) {
-  const YAML::Node root = control::load_yaml_file(path);
-  const YAML::Node s = root["sweep"];
-  if (!s || !s.IsMap()) throw ConfigError(path, "sweep", "missing: the sweep's mapping");
-  control::reject_unknown_keys(s, path, "sweep", {"scene", "controllers", "cases", "seed", "duration", "perturbations", "faults"});
+  const settings::Document doc = settings::Document::load(path);
+  SectionReader top(doc);
+  SectionReader s = top.section("sweep", "the sweep's mapping", Need::required);
   SweepSpec spec;
   spec.file = path;
-  if (!s["scene"] || !s["scene"].IsScalar()) throw ConfigError(path, "sweep.scene", "missing: a scene file");
-  const std::string scene = s["scene"].as<std::string>();
-  const auto slash = path.find_last_of('/');
-  spec.scene_path = scene[0] == '/' || slash == std::string::npos ? scene : path.substr(0, slash + 1) + scene;
-  if (const YAML::Node c = s["controllers"]) {
-    if (!c.IsSequence() || c.size() == 0) throw ConfigError(path, "sweep.controllers", "must be a list of controller names");
-    spec.controllers.clear();
-    for (std::size_t i = 0; i < c.size(); ++i) {
-      const std::string name = c[i].as<std::string>();
-      if (!control::controller_kind_named(name))
-        throw ConfigError(path, "sweep.controllers[" + std::to_string(i) + "]",
-                          "'" + name + "' (allowed: " + control::controller_kind_names() + ")");
-      spec.controllers.push_back(name);
-    }
-  }
-  if (s["cases"]) spec.cases = static_cast<int>(control::read_number(s["cases"], path, "sweep.cases", 1, 1e6));
-  if (s["seed"]) spec.seed = static_cast<unsigned>(control::read_number(s["seed"], path, "sweep.seed", 0, 4e9));
-  if (s["duration"]) spec.duration = control::read_number(s["duration"], path, "sweep.duration", 1e-3, 3600, "s");
-  if (const YAML::Node p = s["perturbations"]) {
-    control::reject_unknown_keys(p, path, "sweep.perturbations", {"model_mass", "soil_stiffness", "position_noise", "delay_cycles"});
-    spec.model_mass = read_range(p["model_mass"], path, "sweep.perturbations.model_mass", -0.9, 9);
-    spec.soil_stiffness = read_range(p["soil_stiffness"], path, "sweep.perturbations.soil_stiffness", 0.01, 100);
-    spec.position_noise = read_range(p["position_noise"], path, "sweep.perturbations.position_noise", 0, 0.1);
-    spec.delay_cycles = read_range(p["delay_cycles"], path, "sweep.perturbations.delay_cycles", 0, 100);
-  }
-  if (const YAML::Node f = s["faults"]) {
-    if (!f.IsSequence()) throw ConfigError(path, "sweep.faults", "must be a list of fault kinds");
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      const std::string kind = f[i].as<std::string>();
-      if (!fault_kind_named(kind))
-        throw ConfigError(path, "sweep.faults[" + std::to_string(i) + "]", "'" + kind + "' (allowed: " + fault_kind_names() + ")");
-      spec.faults.push_back(kind);
-    }
-  }
+  std::string scene;
+  s.text("scene", scene, "the scene file, relative to the spec", Need::required);
+  spec.scene_path = doc.resolve(scene);
+  s.choices("controllers", spec.controllers, control::kControllerKinds, 1, "the controllers each case runs");
+  s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws, case i from seed + i");
+  s.whole("seed", spec.seed, 0, 4e9, "", "the draws' seed");
+  if (s.given("duration")) s.number("duration", spec.duration, {1e-3, 3600}, "s", "per run (absent: the scene's)");
+  SectionReader p = s.section("perturbations", "each drawn uniformly in [min, max] per case");
+  read_range(p, "model_mass", spec.model_mass, {-0.9, 9}, "the firmware's link masses x (1 + value)");
+  read_range(p, "soil_stiffness", spec.soil_stiffness, {0.01, 100}, "the plant's soil K x value");
+  read_range(p, "position_noise", spec.position_noise, {0, 0.1}, "m (rad on the swing), 1 sigma");
+  read_range(p, "delay_cycles", spec.delay_cycles, {0, 100}, "whole cycles, drawn as integers");
+  p.finish();
+  s.choices("faults", spec.faults, kFaultKinds, 0, "one fault per case, its kind drawn from the list");
+  s.finish();
+  top.finish();
   return spec;
 }
 
@@ -124,7 +86,7 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
     c.fault_duration = 0.05 + 0.95 * u(rng);
     c.fault_joint = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
     const double x = u(rng);
-    const FaultSchedule::Kind kind = *fault_kind_named(c.fault);
+    const FaultSchedule::Kind kind = *kFaultKinds.named(c.fault);
     c.fault_magnitude = kind == FaultSchedule::Kind::bus_burst     ? 0.2 + 0.7 * x
                         : kind == FaultSchedule::Kind::sensor_jump  ? 0.02 + 0.3 * x
                         : kind == FaultSchedule::Kind::actuator_loss ? 0.3 + 0.7 * x
@@ -160,10 +122,10 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
                        {"joint", c.fault_joint}, {"magnitude", c.fault_magnitude}};
     for (const std::string& name : spec.controllers) {
       LockstepOptions o;
-      o.controller = *control::controller_kind_named(name);
+      o.controller = *control::kControllerKinds.named(name);
       o.duration = spec.duration;
       if (c.fault != "none") {
-        o.fault.kind = *fault_kind_named(c.fault);
+        o.fault.kind = *kFaultKinds.named(c.fault);
         o.fault.start = c.fault_start;
         o.fault.duration = c.fault_duration;
         o.fault.joint = c.fault_joint;

@@ -21,7 +21,6 @@
 // process would, and any set of shard files merges into the same table.
 #include <filesystem>
 #include <string>
-#include <optional>
 #include <vector>
 
 #include "harness/lockstep_run.hpp"
@@ -44,11 +43,8 @@ struct SweepSpec {
   std::vector<std::string> faults;  // fault kinds to draw from (empty: no fault)
 };
 
+// Reads a sweep spec (opened and parsed once; errors name file, line, column and field).
 SweepSpec load_sweep_spec(const std::string& path);
-
-// The fault kinds a campaign may draw (FaultSchedule's, by name).
-std::optional<FaultSchedule::Kind> fault_kind_named(const std::string& name);
-std::string fault_kind_names();
 
 struct SweepCase {
   int id = 0;

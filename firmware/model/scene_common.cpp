@@ -1,0 +1,44 @@
+#include "model/scene_common.hpp"
+
+namespace exc {
+
+using settings::Need;
+
+SceneCommon read_scene_common(settings::SectionReader& top, const settings::Document& scene) {
+  SceneCommon c;
+  top.text("name", c.name, "the scene's name", Need::required);
+  top.text("description", c.description, "one line for people");
+  if (top.given("machine")) {
+    std::string path;
+    top.text("machine", path, "machine file, relative to the scene file");
+    c.machine_file = scene.resolve(path);
+    try {
+      c.machine = load_machine(c.machine_file);
+    } catch (const SettingsError& e) {
+      top.fail("machine", std::string("the machine file does not load: ") + e.what());
+    }
+    top.record("machine", c.machine_file);
+  } else {
+    c.machine = reference_machine();
+  }
+  settings::SectionReader terrain = top.section("terrain", "the ground");
+  if (terrain.has("height") && terrain.has("profile"))
+    terrain.fail("profile", "give either 'height' or 'profile', not both");
+  c.terrain_height = c.machine.terrain_flat_height;
+  if (terrain.given("profile")) {
+    terrain.others({"height"});
+    terrain.rows("profile", c.terrain_profile, 2, SceneCommon::kMaxProfilePoints, Vec2(-100, -20), Vec2(100, 20), "m",
+                 "points [x, z] of a piecewise-linear ground along the swing plane's x");
+    for (std::size_t i = 1; i < c.terrain_profile.size(); ++i)
+      if (!(c.terrain_profile[i].x() > c.terrain_profile[i - 1].x()))
+        terrain.fail("profile", i, "x must increase strictly along the profile");
+  } else {
+    terrain.others({"profile"});
+    terrain.number("height", c.terrain_height, {-20, 20}, "m", "flat ground at world z");
+  }
+  terrain.finish();
+  top.number("duration", c.duration, {1e-3, 28800}, "s", "how long the run lasts (up to a working shift)", Need::required);
+  return c;
+}
+
+}  // namespace exc

@@ -1,0 +1,35 @@
+#pragma once
+// The keys of a scene file that both sides read, declared once: the scene's name and description,
+// the machine file (the plant's true machine, the firmware's nominal one: the same file), the ground
+// (flat height or a profile) and the run's duration. Each side then reads its own sections and names
+// the other's, so a misspelt section is refused by both:
+//   the firmware  controller, task                 (firmware/app/firmware_settings)
+//   the plant     soil, initial_state, actuators, integrator, sensors, checks   (sim_plant/scene)
+// Start-up code: allocates, throws SettingsError.
+#include <string>
+#include <vector>
+
+#include "model/machine.hpp"
+#include "settings/section_reader.hpp"
+
+namespace exc {
+
+inline const std::vector<std::string> kFirmwareSceneSections = {"controller", "task"};
+inline const std::vector<std::string> kPlantSceneSections = {"soil",       "initial_state", "actuators",
+                                                             "integrator", "sensors",       "checks"};
+
+struct SceneCommon {
+  std::string name, description;
+  std::string machine_file;  // absolute path of the machine file, empty for the built-in reference machine
+  Machine machine;
+  double terrain_height = 0;           // m, world z of flat ground (the machine's terrain.flat_height by default)
+  std::vector<Vec2> terrain_profile;   // (x, z) points of a profile instead, x strictly increasing
+  static constexpr int kMaxProfilePoints = 64;
+  double duration = 10;                // s
+};
+
+// Reads the shared keys from the scene's top level (their values recorded in its effective tree;
+// the machine as an absolute path when the scene names one).
+SceneCommon read_scene_common(settings::SectionReader& top, const settings::Document& scene);
+
+}  // namespace exc

@@ -1,0 +1,37 @@
+#include "settings/document.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace exc::settings {
+
+Document Document::load(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SettingsError(path, 0, 0, "", "cannot open the file");
+  std::ostringstream text;
+  text << in.rdbuf();
+  const auto slash = path.find_last_of('/');
+  return parse(text.str(), path, slash == std::string::npos ? "." : path.substr(0, slash));
+}
+
+Document Document::parse(const std::string& text, const std::string& file, const std::string& directory) {
+  Document d;
+  d.file_ = file;
+  d.directory_ = directory;
+  d.text_ = text;
+  try {
+    d.root_ = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw SettingsError(file, e.mark.line + 1, e.mark.column + 1, "", "not valid YAML: " + e.msg);
+  }
+  return d;
+}
+
+std::string Document::resolve(const std::string& path) const {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  return (p.is_absolute() ? p : fs::absolute(fs::path(directory_) / p)).lexically_normal().string();
+}
+
+}  // namespace exc::settings

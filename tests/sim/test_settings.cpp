@@ -1,0 +1,181 @@
+// Settings, seen from outside: each enumeration's names in the docs are exactly its table's; the
+// effective configuration of a scene loads back to the same configuration and to the same run; the
+// firmware prints its own sections the way the simulator sees them.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+#include "control/controller_config.hpp"
+#include "control/controller_kinds.hpp"
+#include "control/task.hpp"
+#include "harness/lockstep_run.hpp"
+#include "settings/section_reader.hpp"
+#include "text_file.hpp"
+
+namespace fs = std::filesystem;
+using exc::test::read_text_file;
+
+namespace {
+
+// The backquoted words of one cell (column, 1-based) of the markdown table row whose first cell is
+// `field` in backquotes.
+std::set<std::string> names_in_row(const std::string& doc, const std::string& field, int column) {
+  const std::string text = read_text_file(std::string(EXC_SOURCE_DIR) + "/docs/" + doc);
+  const std::string start = "| `" + field + "` |";
+  const auto at = text.find("\n" + start);
+  REQUIRE_MESSAGE(at != std::string::npos, doc << " has no row for " << field);
+  const std::string row = text.substr(at + 1, text.find('\n', at + 1) - at - 1);
+  std::size_t cell_start = 0;
+  for (int c = 0; c < column; ++c) cell_start = row.find('|', cell_start) + 1;
+  const std::string cell = row.substr(cell_start, row.find('|', cell_start) - cell_start);
+  std::set<std::string> names;
+  for (std::size_t p = cell.find('`'); p != std::string::npos; p = cell.find('`', cell.find('`', p + 1) + 1))
+    names.insert(cell.substr(p + 1, cell.find('`', p + 1) - p - 1));
+  return names;
+}
+
+template <typename Table>
+std::set<std::string> names_of(const Table& table) {
+  const std::vector<std::string> v = table.name_list();
+  return {v.begin(), v.end()};
+}
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+};
+
+Run run(const std::string& command, const fs::path& dir) {
+  const std::string cmd = "cd '" + dir.string() + "' && " + command + " > out.txt 2> err.txt";
+  const int raw = std::system(cmd.c_str());
+  Run r;
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = read_text_file(dir / "out.txt");
+  r.err = read_text_file(dir / "err.txt");
+  return r;
+}
+
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / (name + "_" + std::to_string(getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+const char* const kScenes[] = {"dig.yaml", "free_motion.yaml", "truck_loading.yaml"};
+
+}  // namespace
+
+TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly its table's names") {
+  using namespace exc;
+  CHECK(names_in_row("scene-schema.md", "soil.preset", 2) == names_of(plant::kSoilPresets));
+  CHECK(names_in_row("scene-schema.md", "actuators.fidelity", 2) == names_of(plant::kActuatorFidelities));
+  CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::kIntegrationMethods));
+  CHECK(names_in_row("scene-schema.md", "integrator.formulation", 2) == names_of(plant::kFormulations));
+  CHECK(names_in_row("scene-schema.md", "controller.type", 2) == names_of(control::kControllerKinds));
+  CHECK(names_in_row("scene-schema.md", "controller.regressor_acceleration", 2) ==
+        names_of(control::kRegressorAccelerations));
+  CHECK(names_in_row("scene-schema.md", "task.type", 2) == names_of(control::kTaskTypes));
+  CHECK(names_in_row("control.md", "type", 3) == names_of(control::kControllerKinds));
+  CHECK(names_in_row("control.md", "regressor_acceleration", 3) == names_of(control::kRegressorAccelerations));
+  CHECK(names_in_row("sweeps.md", "sweep.controllers", 2) == names_of(control::kControllerKinds));
+  CHECK(names_in_row("sweeps.md", "sweep.faults", 2) == names_of(sim::kFaultKinds));
+}
+
+TEST_CASE("tools/settings: a shipped scene's effective configuration fills every default and loads back to itself") {
+  const fs::path dir = fresh_dir("effective");
+  for (const char* name : kScenes) {
+    CAPTURE(std::string(name));
+    const exc::sim::SceneBundle a = exc::sim::load_scene_bundle(std::string(EXC_SOURCE_DIR) + "/scenes/" + name);
+    const std::string dump = exc::settings::emit(a.effective);
+    // Both sides' sections, with the defaults the file does not give.
+    for (const char* key : {"name", "terrain", "duration", "soil", "initial_state", "actuators", "integrator", "sensors",
+                            "checks", "controller", "task"})
+      CHECK_MESSAGE(a.effective[key].IsDefined(), key);
+    CHECK(a.effective["integrator"]["implicit_tolerance"].IsDefined());
+    CHECK(a.effective["checks"]["pressure_check_margin"].IsDefined());
+    CHECK(a.effective["controller"]["slotine_li"]["kd"].IsDefined());
+    CHECK(a.effective["task"]["efforts"]["soil_margin"].IsDefined());
+    const fs::path copy = dir / name;
+    std::ofstream(copy) << dump;
+    const exc::sim::SceneBundle b = exc::sim::load_scene_bundle(copy.string());
+    CHECK(exc::settings::emit(b.effective) == dump);
+    // The same configuration, to the bit.
+    CHECK(b.firmware.controller.gains.kp == a.firmware.controller.gains.kp);
+    CHECK(b.firmware.controller.adaptation_rate == a.firmware.controller.adaptation_rate);
+    CHECK(b.firmware.task.trajectory.times() == a.firmware.task.trajectory.times());
+    CHECK(b.firmware.task.trajectory.points() == a.firmware.task.trajectory.points());
+    CHECK(b.scene.q_a0 == a.scene.q_a0);
+    CHECK(b.scene.soil.stiffness == a.scene.soil.stiffness);
+    CHECK(b.scene.sensors.position_quantum == a.scene.sensors.position_quantum);
+  }
+}
+
+TEST_CASE("tools/settings: a scene naming its machine dumps the machine's absolute path, which loads from anywhere") {
+  const fs::path dir = fresh_dir("machine_path");
+  std::string text = read_text_file(std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml");
+  fs::copy_file(EXC_MACHINE_FILE, dir / "m.yaml");
+  std::ofstream(dir / "scene.yaml") << "machine: m.yaml\n" << text;
+  const exc::sim::SceneBundle a = exc::sim::load_scene_bundle((dir / "scene.yaml").string());
+  const std::string machine = a.effective["machine"].as<std::string>();
+  CHECK(machine == fs::absolute(dir / "m.yaml").lexically_normal().string());
+  fs::create_directories(dir / "elsewhere");
+  std::ofstream(dir / "elsewhere" / "dump.yaml") << exc::settings::emit(a.effective);
+  const exc::sim::SceneBundle b = exc::sim::load_scene_bundle((dir / "elsewhere" / "dump.yaml").string());
+  CHECK(b.scene.machine_file == machine);
+  CHECK(b.firmware.machine_file == machine);
+  CHECK(b.scene.machine.hydraulics.pump_flow == a.scene.machine.hydraulics.pump_flow);
+}
+
+TEST_CASE("tools/excavator-sim config prints the effective configuration, run writes it, and a run of it gives the same figures to the bit") {
+  const fs::path dir = fresh_dir("config_run");
+  const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+  const Run config = run(std::string(EXC_SIM_TOOL) + " config " + dig, dir);
+  REQUIRE_MESSAGE(config.status == 0, config.err);
+  std::ofstream(dir / "dumped.yaml") << config.out;
+  const Run original = run(std::string(EXC_SIM_TOOL) + " run " + dig +
+                               " --duration 2 --quiet --no-report --out original --json original.json", dir);
+  REQUIRE_MESSAGE(original.status == 0, original.err);
+  const Run dumped = run(std::string(EXC_SIM_TOOL) + " run dumped.yaml --duration 2 --quiet --no-report --out dumped --json dumped.json", dir);
+  REQUIRE_MESSAGE(dumped.status == 0, dumped.err);
+  // run writes what config prints.
+  CHECK(read_text_file(dir / "original" / "effective.yaml") == config.out);
+  CHECK(read_text_file(dir / "dumped" / "effective.yaml") == config.out);
+  const nlohmann::json a = nlohmann::json::parse(read_text_file(dir / "original.json"));
+  const nlohmann::json b = nlohmann::json::parse(read_text_file(dir / "dumped.json"));
+  for (const char* c : {"pid", "adaptive"}) {
+    CAPTURE(c);
+    REQUIRE(a[c]["rms_error"]["bucket"].get<double>() > 0);
+    CHECK(a[c]["rms_error"] == b[c]["rms_error"]);  // JSON numbers: every digit of the double
+    CHECK(a[c]["max_error"] == b[c]["max_error"]);
+    CHECK(a[c]["tracking"] == b[c]["tracking"]);  // as the firmware measured it
+    CHECK(a[c]["theta_hat"] == b[c]["theta_hat"]);
+    CHECK(a[c]["peak_soil_force"] == b[c]["peak_soil_force"]);
+  }
+  const Run bad = run(std::string(EXC_SIM_TOOL) + " config /nonexistent.yaml", dir);
+  CHECK(bad.status == 2);
+  CHECK(bad.err.find("/nonexistent.yaml: cannot open the file") != std::string::npos);
+}
+
+TEST_CASE("tools/excavator-firmware --print-config prints the firmware's sections as excavator-sim config does") {
+  const fs::path dir = fresh_dir("firmware_config");
+  const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+  const Run fw = run(std::string(EXC_FIRMWARE_TOOL) + " --print-config --scene " + dig, dir);
+  REQUIRE_MESSAGE(fw.status == 0, fw.err);
+  const Run sim = run(std::string(EXC_SIM_TOOL) + " config " + dig, dir);
+  REQUIRE(sim.status == 0);
+  const YAML::Node f = YAML::Load(fw.out), s = YAML::Load(sim.out);
+  std::set<std::string> keys;
+  for (const auto& kv : f) keys.insert(kv.first.Scalar());
+  CHECK(keys == std::set<std::string>{"name", "description", "terrain", "duration", "controller", "task"});
+  for (const std::string& k : keys) CHECK_MESSAGE(exc::settings::emit(f[k]) == exc::settings::emit(s[k]), k);
+}
