@@ -70,7 +70,7 @@ TEST_CASE("plant/node: CMD_PILOT drives the hydraulic plant as pilot commands, s
     REQUIRE_FALSE(bench.node.failed());
     REQUIRE(bench.plant.state().q_a == direct.state().q_a);  // bit for bit
   }
-  const double full = scene.actuators.hydraulic.pilot_full_stroke;
+  const double full = scene.machine.hydraulics.pilot_full_stroke;
   MESSAGE("boom " << l0 << " -> " << bench.plant.state().q_a[1] << " m in 0.6 s; spool " << bench.plant.state().spool[1]
                   << " (pilot difference / full stroke " << 2e6 / full << ")");
   CHECK(bench.plant.state().q_a[1] > l0 + 0.01);  // A end above B end: the boom extends
