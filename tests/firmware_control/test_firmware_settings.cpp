@@ -110,3 +110,9 @@ TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much
   CHECK(error_of(fast_swing_scene("  efforts: {check: maybe}\n")) == "task.efforts.check | must be true or false");
   CHECK(error_of(fast_swing_scene("  efforts: {soil_margin: 2}\n")).rfind("task.efforts.soil_margin | ", 0) == 0);
 }
+
+TEST_CASE("firmware/settings accept a run of a working shift (duration 28800 s) and refuse one second more, naming the field and the range") {
+  CHECK(error_of("name: x\nduration: 28800\n" + std::string(kTask)) == "no error");
+  CHECK(error_of("name: x\nduration: 28801\n" + std::string(kTask)) ==
+        "duration | 28801 s outside the allowed range 0.001 .. 28800");
+}
