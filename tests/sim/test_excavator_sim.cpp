@@ -253,6 +253,8 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
     INFO(c);
     CHECK_FALSE(j[c]["ok"].get<bool>());
     CHECK(j[c]["failure"].get<std::string>().find("tracking error: swing") != std::string::npos);
+    // The printed summary carries the whole reason (it was cut at 256 characters of the run's line).
+    CHECK(f.out.find("  FAILED: " + j[c]["failure"].get<std::string>() + "\n") != std::string::npos);
   }
   fs::remove(refused);
   fs::remove(forced);
@@ -457,6 +459,8 @@ TEST_CASE("tools/excavator-sim: the 10 s dig run for 40 s ends its task at 10.05
     INFO(c);
     CHECK(l[c]["task_finished"].get<bool>());
     CHECK(l[c]["task_finish_time"].get<double>() == doctest::Approx(10.05).epsilon(1e-4));
+    CHECK(long_run.out.find(std::string(c) + (std::string(c) == "pid" ? "       " : "  ") + " task finished at 10.050 s;") !=
+          std::string::npos);
     // The pass itself is the 10 s run's (the metric covers tracking only).
     CHECK(l[c]["max_error"]["bucket"].get<double>() <= s[c]["max_error"]["bucket"].get<double>() * 1.0001);
   }

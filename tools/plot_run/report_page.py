@@ -55,6 +55,8 @@ def sim_table(runs):
     row("heap allocations in the loop", lambda r: "%d" % r["heap_allocations_in_loop"])
     row("telemetry messages (dropped)", lambda r: "%d (%d)" % (r["telemetry"]["published"], r["telemetry"]["dropped"]))
     row("simulated (s)", lambda r: "%.3g" % r["simulated_seconds"])
+    row("task finished at (s)", lambda r: "%.3f" % r["task_finish_time"] if r["task_finished"] else
+        "not finished (run ended at %.3g s)" % r["simulated_seconds"])
     for name in ("M_x", "B_x", "K_x", "M_z", "B_z", "K_z"):
         row("soil estimate %s (true)" % name,
             lambda r, n=name: "%.4g (%.4g)" % (r["theta_hat"][n], r["theta_true"][n]))
