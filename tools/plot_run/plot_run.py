@@ -14,7 +14,8 @@ controller side by side (Figs. 4-7 free motion, 9-12 digging); tracking_error.pn
 (the zig-zag of Fig. 8); soil_estimates.png (Theta_hat against the true values); loop_timing.png
 (histogram of the control cycle). A run of more than 20 s at 1 kHz is drawn as its envelope (min
 and max over time) with a zoom on each controller's worst window. A task that repeats adds
-work_cycles.png (per-cycle errors and soil force).
+work_cycles.png (per-cycle errors, soil force and estimates) and cycle_errors.png (each cycle's
+error over the cycle's time).
 
 `plot-run --robustness JSON --out DIR` draws robustness.png from `excavator-sim robustness --json`.
 """
@@ -23,7 +24,7 @@ import json
 import os
 import sys
 
-from cycle_figures import plot_work_cycles
+from cycle_figures import plot_cycle_errors, plot_work_cycles
 from plot_failure import fail
 from report_page import write_report
 from run_data import discover_runs
@@ -81,6 +82,7 @@ def main(argv):
     plot_soil_estimates(plt, runs, args.out, written)
     plot_timing(plt, runs, args.out, written)
     plot_work_cycles(plt, summary, args.out, written)
+    plot_cycle_errors(plt, runs, summary, args.out, written)
     report = write_report(runs, summary, args.title, args.out, written)
     print("plot-run: runs %s; wrote %d figures and %s" % (", ".join(runs), len(written), report))
     return 0

@@ -125,7 +125,9 @@ def write_report(runs, summary, title, out_dir, written):
     lines += note
     lines += cycle_table(summary)
     captions = {
-        "work_cycles.png": "Work cycles: RMS error per joint and peak soil force, per cycle and controller",
+        "work_cycles.png": "Work cycles: RMS and worst error per joint, cycle time, peak soil force and the "
+                           "soil estimates, per cycle and controller",
+        "cycle_errors.png": "Each work cycle's tracking error over the cycle's time, per controller and joint",
         "tracking_error.png": "Tracking error of each active joint",
         "soil_force.png": "Soil force at the tip (the zig-zag of the paper's Fig. 8)",
         "soil_estimates.png": "Soil parameter estimates against the true values",
