@@ -130,3 +130,9 @@ TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much
   const std::string maybe = fast_swing_scene("  efforts: {check: maybe}\n");
   check_error(maybe, "task.efforts.check", "maybe", "is 'maybe'; allowed values: true, false");
 }
+
+TEST_CASE("firmware/settings accept a run of a working shift (duration 28800 s) and refuse one second more, naming the field and the range") {
+  CHECK(error_of("name: x\nduration: 28800\n" + std::string(kTask)) == "no error");
+  CHECK(error_of("name: x\nduration: 28801\n" + std::string(kTask)) ==
+        "duration | 28801 s outside the allowed range 0.001 .. 28800");
+}

@@ -128,3 +128,11 @@ TEST_CASE("plant/scene shipped scenes load and their initial states assemble") {
   Plant p(dig);
   CHECK_FALSE(p.state().in_soil);
 }
+
+TEST_CASE("plant/scene accepts a run of a working shift (duration 28800 s) and refuses one second more, naming the field and the range") {
+  const std::string task = "initial_state: {q_a: [0, 2.4626, 2.3231, 2.1447]}\n";
+  CHECK(load_scene_from_string("name: t\nduration: 28800\n" + task, "ok.yaml").duration == 28800);
+  const std::string e = error_of("name: t\nduration: 28801\n" + task);
+  CAPTURE(e);
+  CHECK(contains(e, "bad.yaml: duration: is 28801; allowed range [0.001, 28800]"));
+}

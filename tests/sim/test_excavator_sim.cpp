@@ -18,53 +18,20 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "text_file.hpp"
+#include "sim_runs.hpp"
 
 namespace fs = std::filesystem;
 
 extern char** environ;
 
+using exc::test::edited_dig;
+using exc::test::kDig;
 using exc::test::read_text_file;
+using exc::test::Run;
+using exc::test::run_sim;
 
 namespace {
 
-struct Run {
-  int status = -1;
-  std::string out, err;
-  fs::path dir;
-};
-
-// Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel).
-Run run_sim(const std::string& args) {
-  static int call = 0;
-  Run r;
-  r.dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("run_" + std::to_string(getpid()) + "_" + std::to_string(call++));
-  fs::remove_all(r.dir);
-  fs::create_directories(r.dir);
-  const std::string cmd = "cd '" + r.dir.string() + "' && " + EXC_SIM_TOOL + " " + args + " > out.txt 2> err.txt";
-  const int raw = std::system(cmd.c_str());
-  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-  r.out = read_text_file(r.dir / "out.txt");
-  r.err = read_text_file(r.dir / "err.txt");
-  return r;
-}
-
-const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
-
-// The shipped dig scene with one edit (which must apply exactly once), written next to the test's
-// runs under a name of this process; returns its path.
-fs::path edited_dig(const std::string& from, const std::string& to, const std::string& stem) {
-  std::string text = read_text_file(kDig);
-  const auto pos = text.find(from);
-  REQUIRE(pos != std::string::npos);
-  REQUIRE(text.find(from, pos + 1) == std::string::npos);
-  text.replace(pos, from.size(), to);
-  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
-  fs::create_directories(dir);
-  const fs::path path = dir / (stem + "_" + std::to_string(getpid()) + ".yaml");
-  std::ofstream(path) << text;
-  return path;
-}
 const char* const kJoints[4] = {"swing", "boom", "arm", "bucket"};
 
 // A shipped sweep spec with fewer cases, the shipped dig scene by absolute path and `extra` lines
@@ -156,12 +123,8 @@ TEST_CASE("tools/excavator-sim run writes the issue's JSON summary: adaptive bea
                               "' --csv '" + csv.string() + "' > /dev/null 2>&1";
       REQUIRE(std::system(cmd.c_str()) == 0);
       for (const char* base : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
-        std::ifstream in(csv / (std::string(base) + "__" + c + ".csv"));
-        std::string line;
-        long rows = -1;  // the header
-        while (std::getline(in, line)) ++rows;
         INFO(base);
-        CHECK(rows == 10000);
+        CHECK(exc::test::csv_data_rows(csv / (std::string(base) + "__" + c + ".csv")) == 10000);
       }
     }
     // The telemetry path's own counters: nothing dropped (blocking publisher), every message published.
@@ -290,6 +253,8 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
     INFO(c);
     CHECK_FALSE(j[c]["ok"].get<bool>());
     CHECK(j[c]["failure"].get<std::string>().find("tracking error: swing") != std::string::npos);
+    // The printed summary carries the whole reason (it was cut at 256 characters of the run's line).
+    CHECK(f.out.find("  FAILED: " + j[c]["failure"].get<std::string>() + "\n") != std::string::npos);
   }
   fs::remove(refused);
   fs::remove(forced);
@@ -494,6 +459,8 @@ TEST_CASE("tools/excavator-sim: the 10 s dig run for 40 s ends its task at 10.05
     INFO(c);
     CHECK(l[c]["task_finished"].get<bool>());
     CHECK(l[c]["task_finish_time"].get<double>() == doctest::Approx(10.05).epsilon(1e-4));
+    CHECK(long_run.out.find(std::string(c) + (std::string(c) == "pid" ? "       " : "  ") + " task finished at 10.050 s;") !=
+          std::string::npos);
     // The pass itself is the 10 s run's (the metric covers tracking only).
     CHECK(l[c]["max_error"]["bucket"].get<double>() <= s[c]["max_error"]["bucket"].get<double>() * 1.0001);
   }

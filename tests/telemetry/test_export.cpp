@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -234,4 +235,116 @@ TEST_CASE("telemetry/export names the file when the log is missing") {
   std::string error;
   CHECK_FALSE(exc::log::export_log_to_csv("/nonexistent/run.lcm", "/tmp/unused", &summary, &error));
   CHECK(error.find("/nonexistent/run.lcm") != std::string::npos);
+}
+
+namespace {
+
+// A column of a CSV read by read_csv, by its header name.
+double cell(const std::vector<std::vector<std::string>>& rows, std::size_t row, const std::string& column) {
+  const auto& header = rows.at(0);
+  const auto at = std::find(header.begin(), header.end(), column);
+  REQUIRE_MESSAGE(at != header.end(), "no column " << column);
+  return std::strtod(rows.at(row).at(static_cast<std::size_t>(at - header.begin())).c_str(), nullptr);
+}
+
+}  // namespace
+
+TEST_CASE("telemetry/export writes a long channel's bucketed view (min, max, first, last and exact sums per bucket) in place of its rows beyond full_rows, beside them beyond bucket_rows, and its detail rows around the largest error and at the end") {
+  const fs::path dir = fs::temp_directory_path() / ("exc-export-buckets-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log_path = dir / "long.lcm";
+  // 10 s at 1 kHz: q_active_0 = k, a tracking error peaking at 7.0 s (larger in wait_sensors, mode
+  // 1, before 1 s: not a tracking error), and 10 timing messages (short: one row each).
+  constexpr int kMessages = 10000;
+  const auto error_at = [](int k) { return k < 1000 ? 10.0 : 0.1 - 1e-5 * std::abs(k - 7000); };
+  {
+    lcm::LogFile log(log_path.string(), "w");
+    REQUIRE(log.good());
+    std::vector<std::uint8_t> buffer(4096);
+    const auto write = [&](const char* channel, std::int64_t stamp, const auto& message) {
+      const int size = message.encode(buffer.data(), 0, static_cast<int>(buffer.size()));
+      REQUIRE(size > 0);
+      lcm::LogEvent event{};
+      event.timestamp = stamp;
+      event.channel = channel;
+      event.datalen = size;
+      event.data = buffer.data();
+      REQUIRE(log.writeEvent(&event) == 0);
+    };
+    for (int k = 0; k < kMessages; ++k) {
+      exlcm::machine_state_t state{};
+      state.utime = state.seq = k;
+      state.utime *= 1000;
+      state.q_active[0] = k;
+      state.q_active[1] = std::nan("");  // no finite value: min and max nan, n 0
+      write("EXC_STATE/pid", 1700000000000000 + k, state);
+      exlcm::controller_state_t ctrl{};
+      ctrl.utime = state.utime;
+      ctrl.mode = k < 1000 ? 1 : 3;
+      for (double& e : ctrl.error) e = error_at(k);
+      write("EXC_CONTROLLER/pid", 1700000000000000 + k, ctrl);
+      if (k % 1000 == 0) {
+        exlcm::timing_t timing{};
+        timing.utime = state.utime;
+        write("EXC_TIMING/pid", 1700000000000000 + k, timing);
+      }
+    }
+  }
+  // Beyond full_rows the bucketed view replaces the rows; beyond bucket_rows it joins them (buckets/).
+  exc::log::ExportOptions replaced, joined;
+  replaced.full_rows = joined.bucket_rows = 1000;
+  replaced.buckets = joined.buckets = 10;
+  for (const auto& [options, view_dir] : {std::pair{replaced, fs::path("csv")}, std::pair{joined, fs::path("csv/buckets")}}) {
+    const fs::path out = dir / (options.full_rows == 1000 ? "replaced" : "joined");
+    CAPTURE(out);
+    exc::log::LogSummary summary;
+    std::string error;
+    REQUIRE_MESSAGE(exc::log::export_log_to_csv(log_path.string(), (out / "csv").string(), &summary, &error, options),
+                    error);
+    CHECK(summary.channels["EXC_STATE/pid"].bucketed);
+    CHECK(summary.channels["EXC_STATE/pid"].rows_written == (options.full_rows > kMessages));
+    CHECK_FALSE(summary.channels["EXC_TIMING/pid"].bucketed);
+    CHECK(read_csv(out / "csv" / "EXC_TIMING__pid.csv").size() == 1 + 10);
+    if (summary.channels["EXC_STATE/pid"].rows_written) CHECK(read_csv(out / "csv" / "EXC_STATE__pid.csv").size() == 1 + kMessages);
+
+    const auto view = read_csv(out / view_dir / "EXC_STATE__pid.csv");
+    REQUIRE(view.size() == 1 + 10);
+    const std::vector<std::string> first_columns = {"bucket", "rows", "log_utime_first", "log_utime_last", "utime_first"};
+    CHECK(std::vector<std::string>(view[0].begin(), view[0].begin() + 5) == first_columns);
+    double sum_sq = 0, n = 0;
+    for (int b = 0; b < 10; ++b) {
+      CAPTURE(b);
+      const std::size_t r = static_cast<std::size_t>(b) + 1;
+      const double k0 = 1000.0 * b, k1 = k0 + 999;
+      CHECK(cell(view, r, "bucket") == b);
+      CHECK(cell(view, r, "rows") == 1000);
+      CHECK(cell(view, r, "log_utime_first") == 1700000000000000 + k0);
+      CHECK(cell(view, r, "q_active_0_first") == k0);
+      CHECK(cell(view, r, "q_active_0_last") == k1);
+      CHECK(cell(view, r, "q_active_0_min") == k0);
+      CHECK(cell(view, r, "q_active_0_max") == k1);
+      CHECK(cell(view, r, "q_active_0_sum") == 1000 * (k0 + k1) / 2);  // exact in doubles
+      CHECK(cell(view, r, "q_active_0_n") == 1000);
+      CHECK(std::isnan(cell(view, r, "q_active_1_min")));
+      CHECK(cell(view, r, "q_active_1_n") == 0);
+      sum_sq += cell(view, r, "q_active_0_sumsq");
+      n += cell(view, r, "q_active_0_n");
+    }
+    // The RMS over every message, from the buckets' sums.
+    double exact = 0;
+    for (int k = 0; k < kMessages; ++k) exact += double(k) * k;
+    CHECK(std::sqrt(sum_sq / n) == doctest::Approx(std::sqrt(exact / kMessages)).epsilon(1e-14));
+
+    // Detail rows: every message within 2 s of the largest tracking error (7.0 s) and in the last
+    // second (8.999 .. 9.999 s): 5.0 .. 9.999 s, one row each, on both channels of the controller.
+    for (const char* channel : {"EXC_STATE__pid.csv", "EXC_CONTROLLER__pid.csv"}) {
+      CAPTURE(channel);
+      const auto detail = read_csv(out / "csv" / "detail" / channel);
+      REQUIRE(detail.size() == 1 + 5000);
+      CHECK(cell(detail, 1, "utime") == 5000000);
+      CHECK(cell(detail, 5000, "utime") == 9999000);
+    }
+  }
+  fs::remove_all(dir);
 }

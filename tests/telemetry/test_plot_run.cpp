@@ -18,9 +18,11 @@
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/machine_state_t.hpp"
 #include "exlcm/timing_t.hpp"
+#include "png_size.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
 namespace fs = std::filesystem;
+using exc::test::png_size;
 using exc::telemetry::Channel;
 using exc::telemetry::LcmOutput;
 using exc::telemetry::TelemetryConfig;
@@ -60,23 +62,6 @@ void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale) {
   timing.p99_us = 150;
   timing.max_us = 190;
   publisher.publish(Channel::timing, timing);
-}
-
-// Width and height from a PNG's IHDR chunk; false if the file is not a PNG.
-bool png_size(const fs::path& path, std::uint32_t* width, std::uint32_t* height) {
-  std::ifstream in(path, std::ios::binary);
-  unsigned char header[24] = {};
-  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return false;
-  const unsigned char signature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-  if (!std::equal(signature, signature + 8, header)) return false;
-  if (std::string(reinterpret_cast<char*>(header + 12), 4) != "IHDR") return false;
-  auto be32 = [&](int at) {
-    return std::uint32_t(header[at]) << 24 | std::uint32_t(header[at + 1]) << 16 |
-           std::uint32_t(header[at + 2]) << 8 | std::uint32_t(header[at + 3]);
-  };
-  *width = be32(16);
-  *height = be32(20);
-  return true;
 }
 
 }  // namespace

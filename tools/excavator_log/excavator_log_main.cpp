@@ -1,7 +1,7 @@
 // excavator-log: reads LCM logs of the excavator's telemetry (lcm-logger's or the firmware's own
 // file:// provider output) with LCM's log reader.
 //   excavator-log info run.lcm            channels, types, counts, duration
-//   excavator-log export run.lcm --csv DIR  one CSV per channel
+//   excavator-log export run.lcm --csv DIR  one CSV per channel (a long one: its bucketed view)
 //   excavator-log report run.lcm --out DIR [--summary JSON]  CSV, then plot-run's figures and report
 #include <CLI/CLI.hpp>
 
@@ -62,9 +62,12 @@ int main(int argc, char** argv) {
 
   std::string export_log;
   std::string csv_dir;
+  exc::log::ExportOptions options;
   CLI::App* exporter = app.add_subcommand(
       "export", "Write every channel of known exlcm type to DIR/<channel>.csv ('/' -> '__'), "
-                "with a header row, doubles at 17 significant digits");
+                "with a header row, doubles at 17 significant digits; a channel of more than "
+                "--full-rows messages as its bucketed view, one of more than --bucket-rows with its "
+                "bucketed view in DIR/buckets too; both with their detail rows in DIR/detail");
   exporter->add_option("log", export_log, "LCM log file")->required();
   exporter->add_option("--csv", csv_dir, "Output directory for the CSV files (created)")
       ->required();
@@ -80,6 +83,18 @@ int main(int argc, char** argv) {
   reporter->add_option("--summary", summary_json, "JSON summary table to include in the report")
       ->check(CLI::ExistingFile);
   reporter->add_option("--title", title, "Report title");
+  for (CLI::App* sub : {exporter, reporter}) {
+    sub->add_option("--full-rows", options.full_rows, "Most messages a channel is written one row each")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    sub->add_option("--bucket-rows", options.bucket_rows,
+                    "More messages than this: the channel's bucketed view (buckets/) and detail rows (detail/) too")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    sub->add_option("--buckets", options.buckets, "Time buckets of a long channel's bucketed view")
+        ->capture_default_str()
+        ->check(CLI::Range(10, 100000));
+  }
 
   CLI11_PARSE(app, argc, argv);
 
@@ -95,7 +110,7 @@ int main(int argc, char** argv) {
   }
   if (reporter->parsed()) {
     const std::string csv = (std::filesystem::path(report_dir) / "csv").string();
-    if (!exc::log::export_log_to_csv(report_log, csv, &summary, &error)) {
+    if (!exc::log::export_log_to_csv(report_log, csv, &summary, &error, options)) {
       std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
       return 1;
     }
@@ -109,7 +124,7 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  if (!exc::log::export_log_to_csv(export_log, csv_dir, &summary, &error)) {
+  if (!exc::log::export_log_to_csv(export_log, csv_dir, &summary, &error, options)) {
     std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
     return 1;
   }
@@ -118,6 +133,11 @@ int main(int argc, char** argv) {
     if (channel.type_name == "unknown") {
       std::fprintf(stderr, "excavator-log: channel %s is not an exlcm type: not exported\n",
                    name.c_str());
+    }
+    if (channel.bucketed) {
+      std::printf("%s: %llu messages: %s as %d time buckets (first, last, min, max, sums), detail rows "
+                  "in detail/\n", name.c_str(), static_cast<unsigned long long>(channel.messages),
+                  channel.rows_written ? "one row each, and in buckets/" : "written", options.buckets);
     }
   }
   std::printf("CSV files written to %s\n", csv_dir.c_str());

@@ -2,14 +2,18 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <array>
 #include <cerrno>
-#include <cinttypes>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
-#include "message_fields.hpp"  // generated from the .lcm files by message_fields.cmake
+#include "csv_writers.hpp"
+#include "exlcm/controller_state_t.hpp"
 
 namespace exc::log {
 
@@ -25,56 +29,6 @@ bool fingerprint_of(const void* data, std::int32_t size, std::int64_t* hash) {
   return true;
 }
 
-// Writes the header row.
-struct HeaderWriter {
-  std::FILE* file;
-  void column(const char* name, int index, int count) {
-    if (count == 1) {
-      std::fprintf(file, ",%s", name);
-    } else {
-      std::fprintf(file, ",%s_%d", name, index);
-    }
-  }
-  template <class T>
-  void number(const char* name, const T*, int count) {
-    for (int i = 0; i < count; ++i) column(name, i, count);
-  }
-  void boolean(const char* name, const std::int8_t*, int count) {
-    for (int i = 0; i < count; ++i) column(name, i, count);
-  }
-  void text(const char* name, const std::int8_t*, int) { column(name, 0, 1); }
-};
-
-// Writes one data row.
-struct RowWriter {
-  std::FILE* file;
-  void value(double x) { std::fprintf(file, ",%.17g", x); }
-  void value(std::int64_t x) { std::fprintf(file, ",%" PRId64, x); }
-  void value(std::int32_t x) { std::fprintf(file, ",%" PRId32, x); }
-  void value(std::int8_t x) { std::fprintf(file, ",%d", static_cast<int>(x)); }
-  template <class T>
-  void number(const char*, const T* values, int count) {
-    for (int i = 0; i < count; ++i) value(values[i]);
-  }
-  void boolean(const char*, const std::int8_t* values, int count) {
-    for (int i = 0; i < count; ++i) std::fprintf(file, ",%d", values[i] ? 1 : 0);
-  }
-  void text(const char*, const std::int8_t* chars, int capacity) {
-    std::fputs(",\"", file);
-    for (int i = 0; i < capacity && chars[i] != 0; ++i) {
-      const char c = static_cast<char>(chars[i]);
-      if (c == '"') {
-        std::fputs("\"\"", file);
-      } else if (c >= 0x20 && c < 0x7f) {
-        std::fputc(c, file);
-      } else {
-        std::fputc('?', file);  // the CSV stays one line per message
-      }
-    }
-    std::fputc('"', file);
-  }
-};
-
 struct FileCloser {
   void operator()(std::FILE* f) const {
     if (f != nullptr) std::fclose(f);
@@ -82,10 +36,40 @@ struct FileCloser {
 };
 using File = std::unique_ptr<std::FILE, FileCloser>;
 
+// Opens `path` for writing; on failure sets `error` (once) and returns null.
+File open_csv(const std::string& path, std::string* error, bool* failed) {
+  File file(std::fopen(path.c_str(), "w"));
+  if (!file) {
+    if (!*failed) *error = path + ": cannot write (" + std::strerror(errno) + ")";
+    *failed = true;
+  }
+  return file;
+}
+
+// A channel's outputs: its rows (one per message), its bucketed view (view, written to view_file)
+// and its detail rows (for utimes within one of `windows`); each one null when not written.
 struct ChannelWriter {
-  File file;
-  std::string path;
+  std::string rows_path, view_path, detail_path;
+  File rows, view_file, detail;
+  std::unique_ptr<BucketView> view;
+  std::vector<std::pair<std::int64_t, std::int64_t>> windows;
 };
+
+// The firmware's modes in which q_desired is commanded: hold and track (control::Mode 2 and 3).
+bool commanded_mode(std::int8_t mode) { return mode == 2 || mode == 3; }
+
+// Each controller's largest tracking error per joint and its utime, by channel suffix.
+struct Worst {
+  double error = -1;
+  std::int64_t utime = 0;
+};
+using WorstErrors = std::map<std::string, std::array<Worst, 4>>;
+
+// The controller a channel belongs to: its suffix (EXC_STATE/pid: pid), "" without one.
+std::string controller_of(const std::string& channel) {
+  const auto slash = channel.rfind('/');
+  return slash == std::string::npos ? std::string() : channel.substr(slash + 1);
+}
 
 // Reads every event of the log into `summary`; calls on_event(event, decoded message) for each
 // event that decodes as a known exlcm type.
@@ -118,6 +102,9 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
             ++channel.undecodable;
             return;
           }
+          const bool first = channel.messages - channel.undecodable == 1;  // the first decoded one
+          channel.min_utime = first ? prototype.utime : std::min(channel.min_utime, prototype.utime);
+          channel.max_utime = first ? prototype.utime : std::max(channel.max_utime, prototype.utime);
           on_event(*event, prototype);
         });
     if (!known) channel.type_name = "unknown";
@@ -151,46 +138,108 @@ std::string csv_file_name(const std::string& channel) {
   return name + ".csv";
 }
 
+namespace {
+
+// The channel's writer, opened at its first message (see ExportOptions): its rows up to
+// options.full_rows messages, its bucketed view beyond options.bucket_rows (in buckets/ next to the
+// rows, in place of them beyond full_rows), and then its detail rows around `worst` and at its end.
+template <class Message>
+ChannelWriter open_writer(const std::string& channel, const ChannelSummary& counts, const Message& message,
+                          const WorstErrors& worst, const std::string& out_dir, const ExportOptions& options,
+                          std::string* error, bool* failed) {
+  namespace fs = std::filesystem;
+  const auto path_in = [&](const char* subdirectory) {
+    std::error_code ec;
+    fs::create_directories(fs::path(out_dir) / subdirectory, ec);
+    return (fs::path(out_dir) / subdirectory / csv_file_name(channel)).string();
+  };
+  ChannelWriter w;
+  if (counts.messages <= options.full_rows) {
+    w.rows_path = path_in("");
+    w.rows = open_csv(w.rows_path, error, failed);
+    if (w.rows) write_header(w.rows.get(), message);
+  }
+  if (w.rows && counts.messages <= options.bucket_rows) return w;
+  w.view_path = path_in(w.rows_path.empty() ? "" : "buckets");
+  w.view_file = open_csv(w.view_path, error, failed);
+  if (w.view_file) {
+    w.view = std::make_unique<BucketView>(w.view_file.get(), counts.min_utime, counts.max_utime, options.buckets);
+    w.view->write_header(message);
+  }
+  const auto us = [](double s) { return static_cast<std::int64_t>(s * 1e6); };
+  const auto found = worst.find(controller_of(channel));
+  if (found != worst.end()) {
+    for (const Worst& j : found->second) {
+      if (j.error >= 0) w.windows.push_back({j.utime - us(options.detail_half_width_s), j.utime + us(options.detail_half_width_s)});
+    }
+  }
+  w.windows.push_back({counts.max_utime - us(options.detail_tail_s), counts.max_utime});
+  w.detail_path = path_in("detail");
+  w.detail = open_csv(w.detail_path, error, failed);
+  if (w.detail) write_header(w.detail.get(), message);
+  return w;
+}
+
+bool close_csv(File& file, const std::string& path, std::string* error) {
+  if (!file) return true;
+  if (std::ferror(file.get()) || std::fclose(file.release()) != 0) {
+    *error = path + ": write failed";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool export_log_to_csv(const std::string& log_path, const std::string& out_dir,
-                       LogSummary* summary, std::string* error) {
+                       LogSummary* summary, std::string* error, const ExportOptions& options) {
+  // First reading: the counts and utime spans of every channel, each controller's largest errors.
+  WorstErrors worst;
+  const bool counted = read_log(log_path, summary, error, [&](const lcm::LogEvent& event, const auto& message) {
+    if constexpr (std::is_same_v<std::decay_t<decltype(message)>, exlcm::controller_state_t>) {
+      if (!commanded_mode(message.mode)) return;
+      std::array<Worst, 4>& w = worst[controller_of(event.channel)];
+      for (int j = 0; j < 4; ++j) {
+        if (std::abs(message.error[j]) > w[j].error) w[j] = {std::abs(message.error[j]), message.utime};
+      }
+    }
+  });
+  if (!counted) return false;
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {
     *error = out_dir + ": cannot create the CSV directory (" + ec.message() + ")";
     return false;
   }
+  // Second reading: the rows.
   std::map<std::string, ChannelWriter> writers;
   bool write_failed = false;
-  const bool read_ok = read_log(log_path, summary, error,
-      [&](const lcm::LogEvent& event, const auto& message) {
-        auto it = writers.find(event.channel);
-        if (it == writers.end()) {
-          ChannelWriter writer;
-          writer.path = (std::filesystem::path(out_dir) / csv_file_name(event.channel)).string();
-          writer.file.reset(std::fopen(writer.path.c_str(), "w"));
-          if (!writer.file) {
-            if (!write_failed) {
-              *error = writer.path + ": cannot write (" + std::strerror(errno) + ")";
-            }
-            write_failed = true;
-            return;
-          }
-          std::fputs("log_utime", writer.file.get());
-          HeaderWriter header{writer.file.get()};
-          visit_fields(message, header);
-          std::fputc('\n', writer.file.get());
-          it = writers.emplace(event.channel, std::move(writer)).first;
-        }
-        std::FILE* file = it->second.file.get();
-        std::fprintf(file, "%" PRId64, event.timestamp);
-        RowWriter row{file};
-        visit_fields(message, row);
-        std::fputc('\n', file);
-      });
+  LogSummary again;
+  const bool read_ok = read_log(log_path, &again, error, [&](const lcm::LogEvent& event, const auto& message) {
+    auto it = writers.find(event.channel);
+    if (it == writers.end()) {
+      ChannelSummary& counts = summary->channels[event.channel];
+      it = writers.emplace(event.channel,
+                           open_writer(event.channel, counts, message, worst, out_dir, options, error, &write_failed))
+               .first;
+      counts.rows_written = it->second.rows != nullptr;
+      counts.bucketed = it->second.view != nullptr;
+    }
+    ChannelWriter& w = it->second;
+    if (w.rows) write_row(w.rows.get(), event.timestamp, message);
+    if (w.view) w.view->add(event.timestamp, message);
+    for (const auto& [from, to] : w.windows) {
+      if (w.detail && message.utime >= from && message.utime <= to) {
+        write_row(w.detail.get(), event.timestamp, message);
+        break;
+      }
+    }
+  });
   if (!read_ok) return false;
-  for (auto& [channel, writer] : writers) {
-    if (std::ferror(writer.file.get()) || std::fclose(writer.file.release()) != 0) {
-      *error = writer.path + ": write failed";
+  for (auto& [channel, w] : writers) {
+    if (w.view) w.view->finish();
+    if (!close_csv(w.rows, w.rows_path, error) || !close_csv(w.view_file, w.view_path, error) ||
+        !close_csv(w.detail, w.detail_path, error)) {
       return false;
     }
   }

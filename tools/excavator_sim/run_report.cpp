@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdarg>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -20,6 +21,21 @@ nlohmann::json per_joint(const double (&v)[4]) {
   return j;
 }
 
+// printf into a string of any length (a failure reason may be long).
+std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
+std::string format(const char* fmt, ...) {
+  va_list args;
+  va_start(args, fmt);
+  va_list again;
+  va_copy(again, args);
+  const int size = std::vsnprintf(nullptr, 0, fmt, args);
+  va_end(args);
+  std::string text(size > 0 ? size : 0, '\0');
+  if (size > 0) std::vsnprintf(text.data(), text.size() + 1, fmt, again);
+  va_end(again);
+  return text;
+}
+
 nlohmann::json timing_json(const Timing& t) {
   return {{"median", t.median_us}, {"p99", t.p99_us}, {"max", t.max_us}, {"count", t.count}};
 }
@@ -31,65 +47,51 @@ void print_cycles(const Summary& summary, std::ostream& out) {
   std::size_t most = 0;
   for (const RunRecord& r : summary.runs) most = std::max(most, r.cycles.size());
   if (most < 2) return;
-  char line[256];
   out << "\nper work cycle: RMS error (mm; swing mrad), worst bucket error, peak soil force, K_x estimate at the end\n";
-  std::snprintf(line, sizeof line, "%-6s %-10s %8s %8s %8s %8s %10s %10s %10s %10s\n", "cycle", "controller", "swing",
-                "boom", "arm", "bucket", "bucket max", "time (s)", "soil (kN)", "K_x est");
-  out << line;
+  out << format("%-6s %-10s %8s %8s %8s %8s %10s %10s %10s %10s\n", "cycle", "controller", "swing", "boom", "arm",
+                "bucket", "bucket max", "time (s)", "soil (kN)", "K_x est");
   for (std::size_t c = 0; c < most; ++c)
     for (const RunRecord& r : summary.runs) {
       if (c >= r.cycles.size()) continue;
       const CycleRecord& k = r.cycles[c];
-      std::snprintf(line, sizeof line, "%-6zu %-10s %8.3f %8.3f %8.3f %8.3f %10.2f %10.2f %10.1f %10.4g\n", c + 1,
-                    r.controller.c_str(), k.rms_error[0] * 1e3, k.rms_error[1] * 1e3, k.rms_error[2] * 1e3,
-                    k.rms_error[3] * 1e3, k.max_error[3] * 1e3, k.end - k.start, k.peak_soil_force * 1e-3, k.theta_hat[2]);
-      out << line;
+      out << format("%-6zu %-10s %8.3f %8.3f %8.3f %8.3f %10.2f %10.2f %10.1f %10.4g\n", c + 1, r.controller.c_str(),
+                    k.rms_error[0] * 1e3, k.rms_error[1] * 1e3, k.rms_error[2] * 1e3, k.rms_error[3] * 1e3,
+                    k.max_error[3] * 1e3, k.end - k.start, k.peak_soil_force * 1e-3, k.theta_hat[2]);
     }
 }
 
 void print_summary(const Summary& summary, std::ostream& out) {
-  char line[256];
   out << "\nscene " << summary.scene << ": " << summary.setup << "\n\n";
   out << "tracking error (while tracking)     ";
   for (const RunResult& r : summary.runs) {
-    std::snprintf(line, sizeof line, "| %-10s RMS      max     ", r.controller.c_str());
-    out << line;
+    out << format("| %-10s RMS      max     ", r.controller.c_str());
   }
   out << "\n";
   for (int j = 0; j < 4; ++j) {
-    std::snprintf(line, sizeof line, "  %-7s (%-3s)                     ", kJoints[j], kUnits[j]);
-    out << line;
-    for (const RunResult& r : summary.runs) {
-      std::snprintf(line, sizeof line, "| %10.3e %10.3e    ", r.rms_error[j], r.max_error[j]);
-      out << line;
-    }
+    out << format("  %-7s (%-3s)                     ", kJoints[j], kUnits[j]);
+    for (const RunResult& r : summary.runs) out << format("| %10.3e %10.3e    ", r.rms_error[j], r.max_error[j]);
     out << "\n";
   }
   print_cycles(summary, out);
   out << "\nsoil estimates at the end (true value)\n";
   for (int i = 0; i < 6; ++i) {
-    std::snprintf(line, sizeof line, "  %-4s true %10.4g   ", kTheta[i], summary.runs.empty() ? 0.0 : summary.runs[0].theta_true[i]);
-    out << line;
-    for (const RunResult& r : summary.runs) {
-      std::snprintf(line, sizeof line, "| %-10s %10.4g ", r.controller.c_str(), r.theta_hat[i]);
-      out << line;
-    }
+    out << format("  %-4s true %10.4g   ", kTheta[i], summary.runs.empty() ? 0.0 : summary.runs[0].theta_true[i]);
+    for (const RunResult& r : summary.runs) out << format("| %-10s %10.4g ", r.controller.c_str(), r.theta_hat[i]);
     out << "\n";
   }
   out << "\n";
   for (const RunResult& r : summary.runs) {
-    std::snprintf(line, sizeof line,
-                  "%-10s peak soil force %8.1f kN, %d shear re-anchorings; control step median %.1f us, p99 %.1f us, "
+    const std::string task =
+        r.task_finished ? format("task finished at %.3f s", r.task_finish_time) : std::string("task not finished");
+    out << format("%-10s %s; peak soil force %8.1f kN, %d shear re-anchorings; control step median %.1f us, p99 %.1f us, "
                   "max %.1f us; heap allocations in loop %llu; telemetry %llu messages, %llu dropped; "
-                  "%.1f s simulated in %.2f s (%.0fx real time)%s%s\n",
-                  r.controller.c_str(), r.peak_soil_force * 1e-3, r.reanchor_count, r.control_step.median_us,
-                  r.control_step.p99_us, r.control_step.max_us,
+                  "%.1f s simulated in %.2f s (%.0fx real time)\n",
+                  r.controller.c_str(), task.c_str(), r.peak_soil_force * 1e-3, r.reanchor_count,
+                  r.control_step.median_us, r.control_step.p99_us, r.control_step.max_us,
                   static_cast<unsigned long long>(r.heap_allocations_in_loop),
                   static_cast<unsigned long long>(r.telemetry_published), static_cast<unsigned long long>(r.telemetry_dropped),
-                  r.simulated_seconds, r.wall_seconds,
-                  r.wall_seconds > 0 ? r.simulated_seconds / r.wall_seconds : 0.0, r.ok ? "" : "\n  FAILED: ",
-                  r.ok ? "" : r.failure.c_str());
-    out << line;
+                  r.simulated_seconds, r.wall_seconds, r.wall_seconds > 0 ? r.simulated_seconds / r.wall_seconds : 0.0);
+    if (!r.ok) out << "  FAILED: " << r.failure << "\n";
   }
 }
 

@@ -3,7 +3,8 @@
 
 Input: one or more CSV directories written by `excavator-log export run.lcm --csv DIR`. Each
 controller's run is recognised by its channel suffix (EXC_STATE__pid.csv is channel EXC_STATE/pid)
-or, without a suffix, by the directory name. Output (in --out): PNG files of a fixed pixel size and
+or, without a suffix, by the directory name. A long channel's CSV is its bucketed view (run_data.py);
+memory does not grow with the run. Output (in --out): PNG files of a fixed pixel size and
 report.md embedding them with the summary table (--summary JSON: excavator-sim's as a table of
 figures per controller, any other rendered generically) and the RMS
 tracking errors computed from the CSVs.
@@ -11,21 +12,24 @@ tracking errors computed from the CSVs.
 Figures (paper: Kim, Yoo, Lee): tracking_<joint>.png, desired against actual with one panel per
 controller side by side (Figs. 4-7 free motion, 9-12 digging); tracking_error.png; soil_force.png
 (the zig-zag of Fig. 8); soil_estimates.png (Theta_hat against the true values); loop_timing.png
-(histogram of the control cycle).
+(histogram of the control cycle). A run of more than 20 s at 1 kHz is drawn as its envelope (min
+and max over time) with a zoom on each controller's worst window. A task that repeats adds
+work_cycles.png (per-cycle errors, soil force and estimates) and cycle_errors.png (each cycle's
+error over the cycle's time).
 
 `plot-run --robustness JSON --out DIR` draws robustness.png from `excavator-sim robustness --json`.
 """
 import argparse
-import csv
 import json
-import math
 import os
 import sys
 
+from cycle_figures import plot_cycle_errors, plot_work_cycles
 from plot_failure import fail
 from report_page import write_report
+from run_data import discover_runs
 from run_figures import (plot_errors, plot_robustness, plot_soil_estimates, plot_soil_force,
-                         plot_timing, plot_tracking, plot_work_cycles)
+                         plot_timing, plot_tracking)
 
 
 def load_matplotlib():
@@ -36,71 +40,6 @@ def load_matplotlib():
         return plt
     except ImportError as error:
         fail("matplotlib is not available (%s); install python3-matplotlib" % error)
-
-
-# Rows kept per CSV for the figures: a run of any length is drawn from at most this many rows (every
-# k-th), so the report's memory does not grow with the run; the RMS figures use every row.
-MAX_ROWS = 20000
-
-
-def read_csv(path, max_rows=MAX_ROWS):
-    """Columns of a CSV as lists of floats (text columns are kept as strings), every k-th row of a
-    long file (k in columns["__stride__"]); columns["__rms__"] holds the exact RMS of every error_*
-    column over all rows."""
-    with open(path, newline="") as f:
-        rows = sum(1 for _ in f) - 1
-    stride = max(1, math.ceil(rows / max_rows)) if rows > 0 else 1
-    with open(path, newline="") as f:
-        reader = csv.reader(f)
-        try:
-            header = next(reader)
-        except StopIteration:
-            return {}
-        columns = {name: [] for name in header}
-        errors = [i for i, name in enumerate(header) if name.startswith("error_")]
-        sum_sq = [0.0] * len(errors)
-        counted = [0] * len(errors)
-        for line_no, row in enumerate(reader, start=2):
-            if len(row) != len(header):
-                fail("%s line %d: %d fields, header has %d" % (path, line_no, len(row), len(header)))
-            for k, i in enumerate(errors):
-                try:
-                    v = float(row[i])
-                except ValueError:
-                    continue
-                if not math.isnan(v):
-                    sum_sq[k] += v * v
-                    counted[k] += 1
-            if (line_no - 2) % stride:
-                continue
-            for name, value in zip(header, row):
-                try:
-                    columns[name].append(float(value))
-                except ValueError:
-                    columns[name].append(value)
-    columns["__stride__"] = stride
-    columns["__rms__"] = {header[i]: math.sqrt(sum_sq[k] / counted[k]) if counted[k] else float("nan")
-                          for k, i in enumerate(errors)}
-    return columns
-
-
-def discover_runs(csv_dirs):
-    """{run label: {channel base name: columns}} from the CSV directories."""
-    runs = {}
-    for directory in csv_dirs:
-        if not os.path.isdir(directory):
-            fail("%s: not a directory (expected the output of excavator-log export)" % directory)
-        names = sorted(n for n in os.listdir(directory) if n.endswith(".csv"))
-        if not any(n.startswith("EXC_STATE") for n in names):
-            fail("%s: no EXC_STATE*.csv (is this an excavator-log export directory?)" % directory)
-        for name in names:
-            stem = name[:-4]
-            base, _, suffix = stem.partition("__")
-            label = suffix if suffix else os.path.basename(os.path.normpath(directory))
-            runs.setdefault(label, {})[base] = read_csv(os.path.join(directory, name))
-    # The baseline first, the adaptive law second, as in the paper's side-by-side figures.
-    order = {"pid": 0, "adaptive": 1}
-    return dict(sorted(runs.items(), key=lambda kv: (order.get(kv[0], 2), kv[0])))
 
 
 def main(argv):
@@ -143,6 +82,7 @@ def main(argv):
     plot_soil_estimates(plt, runs, args.out, written)
     plot_timing(plt, runs, args.out, written)
     plot_work_cycles(plt, summary, args.out, written)
+    plot_cycle_errors(plt, runs, summary, args.out, written)
     report = write_report(runs, summary, args.title, args.out, written)
     print("plot-run: runs %s; wrote %d figures and %s" % (", ".join(runs), len(written), report))
     return 0

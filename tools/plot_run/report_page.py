@@ -1,12 +1,9 @@
 """The report page of a run (plot-run): report.md with the summary table and the figures."""
-import math
 import os
 
-from run_figures import JOINTS, work_cycles
-
-def rms(values):
-    finite = [v for v in values if isinstance(v, float) and not math.isnan(v)]
-    return math.sqrt(sum(v * v for v in finite) / len(finite)) if finite else float("nan")
+from figure_base import JOINTS
+from run_data import ZOOM_HALF_WIDTH, is_long
+from work_cycles import cycle_table
 
 
 def format_value(value):
@@ -55,6 +52,8 @@ def sim_table(runs):
     row("heap allocations in the loop", lambda r: "%d" % r["heap_allocations_in_loop"])
     row("telemetry messages (dropped)", lambda r: "%d (%d)" % (r["telemetry"]["published"], r["telemetry"]["dropped"]))
     row("simulated (s)", lambda r: "%.3g" % r["simulated_seconds"])
+    row("task finished at (s)", lambda r: "%.3f" % r["task_finish_time"] if r["task_finished"] else
+        "not finished (run ended at %.3g s)" % r["simulated_seconds"])
     for name in ("M_x", "B_x", "K_x", "M_z", "B_z", "K_z"):
         row("soil estimate %s (true)" % name,
             lambda r, n=name: "%.4g (%.4g)" % (r["theta_hat"][n], r["theta_true"][n]))
@@ -84,26 +83,20 @@ def summary_table(summary):
     return lines
 
 
-def cycle_table(summary):
-    """Markdown rows per work cycle and controller (tasks that repeat)."""
-    cycles = work_cycles(summary)
-    if not cycles:
+def long_run_note(runs):
+    """How a long run's figures and CSVs were made (nothing for a short run)."""
+    channels = [c for run in runs.values() for c in run.values() if c]
+    if not any(is_long(c) for c in channels):
         return []
-    lines = ["## Per work cycle", "",
-             "| cycle | controller | cycle time (s) | RMS boom / arm / bucket (mm) | worst bucket (mm) |"
-             " peak soil force (kN) | soil estimates at the end (M_x B_x K_x M_z B_z K_z) |",
-             "|---|---|---|---|---|---|---|"]
-    for c in range(max(len(v) for v in cycles.values())):
-        for controller, rows in cycles.items():
-            if c >= len(rows):
-                continue
-            r = rows[c]
-            theta = " ".join("%.3g" % r["theta_hat"][k] for k in ("M_x", "B_x", "K_x", "M_z", "B_z", "K_z"))
-            lines.append("| %d | %s | %.2f | %.3g / %.3g / %.3g | %.3g | %.1f | %s |" % (
-                c + 1, controller, r["end"] - r["start"], 1e3 * r["rms_error"]["boom"],
-                1e3 * r["rms_error"]["arm"], 1e3 * r["rms_error"]["bucket"], 1e3 * r["max_error"]["bucket"],
-                1e-3 * r["peak_soil_force"], theta))
-    return lines + [""]
+    note = ("A long run: the time-series figures show each signal's envelope (its minimum and maximum "
+            "per time bucket) over the whole run, and the tracking figures a zoom on the %g s either side "
+            "of each controller's largest error on that joint." % ZOOM_HALF_WIDTH)
+    if any(c.buckets is not None for c in channels):
+        note += (" The long channels' CSVs (csv/, a header that starts with `bucket`) are their bucketed "
+                 "view (per time bucket: first, last, min, max and sums of every column), with every "
+                 "message of the zoom windows and of the run's last second in csv/detail/; the RMS "
+                 "figures above are over every message.")
+    return [note, ""]
 
 
 def write_report(runs, summary, title, out_dir, written):
@@ -124,14 +117,17 @@ def write_report(runs, summary, title, out_dir, written):
         cells = []
         for channels in runs.values():
             ctrl = channels.get("EXC_CONTROLLER", {})
-            exact = ctrl.get("__rms__", {}).get("error_%d" % j) if ctrl else None
-            cells.append("%.4g" % (exact if exact is not None else rms(ctrl["error_%d" % j])) if ctrl else "n/a")
+            cells.append("%.4g" % ctrl.rms["error_%d" % j] if ctrl else "n/a")
         lines.append("| %s (%s) | " % (joint, unit.split("[")[-1].rstrip("]")) + " | ".join(cells)
                      + " |")
     lines.append("")
+    note = long_run_note(runs)
+    lines += note
     lines += cycle_table(summary)
     captions = {
-        "work_cycles.png": "Work cycles: RMS error per joint and peak soil force, per cycle and controller",
+        "work_cycles.png": "Work cycles: RMS and worst error per joint, cycle time, peak soil force and the "
+                           "soil estimates, per cycle and controller",
+        "cycle_errors.png": "Each work cycle's tracking error over the cycle's time, per controller and joint",
         "tracking_error.png": "Tracking error of each active joint",
         "soil_force.png": "Soil force at the tip (the zig-zag of the paper's Fig. 8)",
         "soil_estimates.png": "Soil parameter estimates against the true values",
@@ -139,8 +135,9 @@ def write_report(runs, summary, title, out_dir, written):
     }
     lines += ["## Figures", ""]
     for name in written:
-        caption = captions.get(name, "Tracking of the %s, desired against actual" %
-                               name[len("tracking_"):-4])
+        caption = captions.get(name, "Tracking of the %s, desired against actual%s" % (
+            name[len("tracking_"):-4], ": the envelope over the run, and each controller's worst window"
+            if note else ""))
         lines += ["### %s" % caption, "", "![%s](%s)" % (caption, name), ""]
     path = os.path.join(out_dir, "report.md")
     with open(path, "w") as f:

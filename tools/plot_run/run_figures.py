@@ -1,75 +1,23 @@
 """The figures of a run (plot-run): tracking per joint with the controllers side by side (the paper's
 Figs. 4-7 and 9-12), tracking error, soil force (Fig. 8), soil estimates, loop timing, and the
-robustness chart. Every PNG is exactly 1200 x 700 pixels."""
+robustness chart. A long run's are drawn by long_figures.py (envelope and worst window)."""
 import json
 import math
-import os
 
+import long_figures
+from figure_base import JOINTS, THETA, decorate, new_figure, plot_runs, save
 from plot_failure import fail
-
-FIG_INCHES = (12.0, 7.0)
-
-
-FIG_DPI = 100  # every PNG is exactly 1200 x 700 pixels
+from run_data import commanded, is_long, seconds
 
 
-JOINTS = [("swing", "angle [rad]"), ("boom", "cylinder length [m]"),
-          ("arm", "cylinder length [m]"), ("bucket", "cylinder length [m]")]
-
-
-THETA = ["M_x [kg]", "B_x [N s/m]", "K_x [N/m]", "M_z [kg]", "B_z [N s/m]", "K_z [N/m]"]
-
-
-TIMING_STAGES = {0: "whole cycle", 1: "read", 2: "update", 3: "write", 4: "plant step",
-                 5: "cycle interval"}
-
-
-def seconds(columns):
-    return [u * 1e-6 for u in columns.get("utime", [])]
-
-
-def commanded(ctrl, column):
-    """The column where the firmware commands the machine (hold or track); NaN before, so that the
-    desired trajectory is not drawn at 0 while the firmware starts up."""
-    modes = ctrl.get("mode", [])
-    return [v if i < len(modes) and modes[i] in (2.0, 3.0) else float("nan")
-            for i, v in enumerate(ctrl[column])]
-
-
-def new_figure(plt, rows, cols, title):
-    fig, axes = plt.subplots(rows, cols, figsize=FIG_INCHES, dpi=FIG_DPI, squeeze=False)
-    fig.suptitle(title)
-    return fig, axes
-
-
-def save(plt, fig, out_dir, name, written):
-    fig.tight_layout(rect=(0, 0, 1, 0.95))
-    fig.savefig(os.path.join(out_dir, name), dpi=FIG_DPI)  # no bbox_inches: keep the exact pixel size
-    written.append(name)
-    plt.close(fig)
-
-
-def decorate(ax, xlabel, ylabel=None, title=None, legend=True, **legend_options):
-    """A panel's labels and title, a light grid and (legend=True) its legend."""
-    if title is not None:
-        ax.set_title(title)
-    ax.set_xlabel(xlabel)
-    if ylabel is not None:
-        ax.set_ylabel(ylabel)
-    ax.grid(True, alpha=0.3)
-    if legend:
-        ax.legend(loc="best", **legend_options)
-
-
-def plot_runs(ax, runs, channel, values):
-    """One line per run that logged `channel`: values(its columns) against time, labelled by the run."""
-    for label, channels in runs.items():
-        columns = channels.get(channel, {})
-        if columns:
-            ax.plot(seconds(columns), values(columns), label=label)
+def any_long(runs):
+    return any(is_long(channels.get(c, {})) for channels in runs.values()
+               for c in ("EXC_STATE", "EXC_CONTROLLER"))
 
 
 def plot_tracking(plt, runs, out_dir, written):
+    if any_long(runs):
+        return long_figures.plot_tracking(plt, runs, out_dir, written)
     for j, (joint, unit) in enumerate(JOINTS):
         fig, axes = new_figure(plt, 1, len(runs), "Tracking of the %s (desired vs actual)" % joint)
         for k, (label, channels) in enumerate(runs.items()):
@@ -86,6 +34,8 @@ def plot_tracking(plt, runs, out_dir, written):
 
 
 def plot_errors(plt, runs, out_dir, written):
+    if any_long(runs):
+        return long_figures.plot_errors(plt, runs, out_dir, written)
     fig, axes = new_figure(plt, 2, 2, "Tracking error e = q - q_d")
     for j, (joint, unit) in enumerate(JOINTS):
         ax = axes[j // 2][j % 2]
@@ -95,6 +45,8 @@ def plot_errors(plt, runs, out_dir, written):
 
 
 def plot_soil_force(plt, runs, out_dir, written):
+    if any_long(runs):
+        return long_figures.plot_soil_force(plt, runs, out_dir, written)
     fig, axes = new_figure(plt, 2, 1, "Soil force at the bucket tip (swing plane)")
     for a, axis_name in enumerate(("x", "z")):
         ax = axes[a][0]
@@ -104,6 +56,8 @@ def plot_soil_force(plt, runs, out_dir, written):
 
 
 def plot_soil_estimates(plt, runs, out_dir, written):
+    if any_long(runs):
+        return long_figures.plot_soil_estimates(plt, runs, out_dir, written)
     fig, axes = new_figure(plt, 2, 3, "Soil parameter estimates Theta_hat (dashed: true)")
     for i, name in enumerate(THETA):
         ax = axes[i // 3][i % 3]
@@ -143,7 +97,7 @@ def plot_timing(plt, runs, out_dir, written):
                 drawn = True
                 continue
         state = channels.get("EXC_STATE", {})
-        stamps = state.get("log_utime", [])
+        stamps = state.get("log_utime", []) if state and state.buckets is None else []
         if len(stamps) > 2:
             # No timing counters in the log: the intervals at which states were logged.
             intervals = [b - a for a, b in zip(stamps, stamps[1:])]
@@ -188,32 +142,3 @@ def plot_robustness(plt, path, out_dir):
     written = []
     save(plt, fig, out_dir, "robustness.png", written)
     return written
-
-
-def work_cycles(summary):
-    """{controller: [cycle, ...]} from an excavator-sim summary whose task repeats (else {})."""
-    if not isinstance(summary, dict):
-        return {}
-    found = {k: v["cycles"] for k, v in summary.items()
-             if isinstance(v, dict) and isinstance(v.get("cycles"), list) and len(v["cycles"]) > 1}
-    order = {"pid": 0, "adaptive": 1}
-    return dict(sorted(found.items(), key=lambda kv: (order.get(kv[0], 2), kv[0])))
-
-
-def plot_work_cycles(plt, summary, out_dir, written):
-    """work_cycles.png: per cycle and controller, RMS error of boom, arm and bucket, and the peak soil
-    force: whether a law learns from pass to pass (the adaptive law's estimates carry over)."""
-    cycles = work_cycles(summary)
-    if not cycles:
-        return
-    fig, axes = new_figure(plt, 2, 2, "Work cycles: tracking error and soil force per cycle")
-    panels = [("boom", "RMS error boom [mm]"), ("arm", "RMS error arm [mm]"),
-              ("bucket", "RMS error bucket [mm]"), (None, "peak soil force [kN]")]
-    for ax, (joint, label) in zip([a for row in axes for a in row], panels):
-        for controller, rows in cycles.items():
-            xs = list(range(1, len(rows) + 1))
-            ys = [1e3 * r["rms_error"][joint] if joint else 1e-3 * r["peak_soil_force"] for r in rows]
-            ax.plot(xs, ys, "o-", label=controller)
-        ax.set_xticks(range(1, max(len(r) for r in cycles.values()) + 1))
-        decorate(ax, "cycle", label)
-    save(plt, fig, out_dir, "work_cycles.png", written)

@@ -1,0 +1,74 @@
+#pragma once
+// excavator-sim as a user runs it, for the tests/sim cases: a run in a directory of its own (its exit
+// status, stdout and stderr) and the shipped dig scene with edits.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "text_file.hpp"
+
+namespace exc::test {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int status = -1;
+  std::string out, err;
+  fs::path dir;
+};
+
+// Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel).
+inline Run run_sim(const std::string& args) {
+  static int call = 0;
+  Run r;
+  r.dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("run_" + std::to_string(getpid()) + "_" + std::to_string(call++));
+  fs::remove_all(r.dir);
+  fs::create_directories(r.dir);
+  const std::string cmd = "cd '" + r.dir.string() + "' && " + EXC_SIM_TOOL + " " + args + " > out.txt 2> err.txt";
+  const int raw = std::system(cmd.c_str());
+  r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  r.out = read_text_file(r.dir / "out.txt");
+  r.err = read_text_file(r.dir / "err.txt");
+  return r;
+}
+
+inline const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+
+// The shipped dig scene with edits (each must apply exactly once), written next to the test's runs
+// under a name of this process; returns its path.
+inline fs::path edited_dig(const std::vector<std::pair<std::string, std::string>>& edits, const std::string& stem) {
+  std::string text = read_text_file(kDig);
+  for (const auto& [from, to] : edits) {
+    const auto pos = text.find(from);
+    REQUIRE_MESSAGE(pos != std::string::npos, from);
+    REQUIRE(text.find(from, pos + 1) == std::string::npos);
+    text.replace(pos, from.size(), to);
+  }
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
+  fs::create_directories(dir);
+  const fs::path path = dir / (stem + "_" + std::to_string(getpid()) + ".yaml");
+  std::ofstream(path) << text;
+  return path;
+}
+
+inline fs::path edited_dig(const std::string& from, const std::string& to, const std::string& stem) {
+  return edited_dig({{from, to}}, stem);
+}
+
+// The data rows of a CSV file (its lines but the header).
+inline long csv_data_rows(const fs::path& csv) {
+  std::ifstream in(csv);
+  std::string line;
+  long rows = -1;  // the header
+  while (std::getline(in, line)) ++rows;
+  return rows;
+}
+
+}  // namespace exc::test
