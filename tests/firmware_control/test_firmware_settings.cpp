@@ -132,7 +132,7 @@ TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much
 }
 
 TEST_CASE("firmware/settings accept a run of a working shift (duration 28800 s) and refuse one second more, naming the field and the range") {
-  CHECK(error_of("name: x\nduration: 28800\n" + std::string(kTask)) == "no error");
-  CHECK(error_of("name: x\nduration: 28801\n" + std::string(kTask)) ==
-        "duration | 28801 s outside the allowed range 0.001 .. 28800");
+  CHECK(read("name: x\nduration: 28800\n" + std::string(kTask)).duration == 28800);
+  check_error("name: x\nduration: 28801\n" + std::string(kTask), "duration", "28801",
+              "is 28801 s; allowed range [0.001, 28800] s");
 }
