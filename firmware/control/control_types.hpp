@@ -46,9 +46,13 @@ struct ControlOutput {
   bool in_soil = false;               // contact as the controller sees it
   Vec2 rho = Vec2::Zero(), rho_env = Vec2::Zero();  // tip and anchor as the controller sees them
   ModelStatus status = ModelStatus::ok;  // not ok: tau is the last good command held (never NaN)
+  // Flow laws (FlowPositionControl) command each valve's flow instead of an effort: the velocity it
+  // should pass (m/s; swing rad/s). Effort laws leave velocity_command false and command tau.
+  bool velocity_command = false;
+  Vec4 velocity = Vec4::Zero();
 };
 
-enum class ControllerKind : std::uint8_t { pid = 0, adaptive = 1, slotine_li = 2 };
+enum class ControllerKind : std::uint8_t { pid = 0, adaptive = 1, slotine_li = 2, flow = 3 };
 const char* to_string(ControllerKind kind);
 
 class Controller {

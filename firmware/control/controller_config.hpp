@@ -62,6 +62,10 @@ struct ControllerConfig {
   double actuator_lag = 0;            // s
   double actuator_lag_target = 0.005; // s
 
+  // Flow-based position control (flow_position_control.hpp): u = qd_d - flow_kp e, 1/s. 3 rad/s
+  // keeps the position loop below a third of the boom's 2-3 Hz oil column (hydraulics.md).
+  Vec4 flow_kp = Vec4::Constant(3);
+
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop
   // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a

@@ -7,10 +7,13 @@
 
 namespace exc::control {
 
-inline constexpr settings::EnumTable<ControllerKind, 3> kControllerKinds{{{
+inline constexpr settings::EnumTable<ControllerKind, 4> kControllerKinds{{{
     {ControllerKind::pid, "pid", "closed-chain inverse dynamics + PID (the paper's baseline)"},
     {ControllerKind::adaptive, "adaptive", "adaptive computed torque with the soil regressor (paper eqs. 12-28)"},
     {ControllerKind::slotine_li, "slotine_li", "Slotine-Li passivity-based adaptive law (needs no acceleration)"},
+    {ControllerKind::flow, "flow",
+     "flow-based position control: valve flow from the desired velocity plus position feedback, no model (the "
+     "industry's baseline; valve-commanded machines only)"},
 }}};
 
 }  // namespace exc::control

@@ -4,6 +4,7 @@
 
 #include "control/adaptive_computed_torque.hpp"
 #include "control/computed_torque_pid.hpp"
+#include "control/flow_position_control.hpp"
 #include "control/slotine_li.hpp"
 
 namespace exc::control {
@@ -22,6 +23,7 @@ inline std::unique_ptr<Controller> make_controller(ControllerKind kind, const Mo
     case ControllerKind::pid: return std::make_unique<ComputedTorquePid>(model, config, limits);
     case ControllerKind::adaptive: return std::make_unique<AdaptiveComputedTorque>(model, config, limits);
     case ControllerKind::slotine_li: return std::make_unique<SlotineLi>(model, config, limits);
+    case ControllerKind::flow: return std::make_unique<FlowPositionControl>(config);
   }
   return nullptr;
 }

@@ -1,0 +1,125 @@
+#include "control/valve_inner_loop.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace exc::control {
+namespace {
+
+// The orifice law per unit gain: sqrt(dp), linear below the laminar pressure (same value there).
+double orifice(double dp, double laminar) {
+  if (dp <= 0) return 0;
+  return dp < laminar ? dp / std::sqrt(laminar) : std::sqrt(dp);
+}
+
+EffortLimits spool_limits() {
+  EffortLimits l;
+  l.min = Vec4::Constant(-1);
+  l.max = Vec4::Constant(1);
+  return l;
+}
+
+}  // namespace
+
+ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSettings& settings, double period)
+    : model_(model),
+      settings_(settings),
+      spool_lead_(settings.spool_lag_target > 0 ? model.spool_time_constant : 0.0,
+                  settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()) {}
+
+void ValveInnerLoop::reset() {
+  spool_lead_.reset(Vec4::Zero());
+  command_ = ValveCommand{};
+}
+
+Vec4 ValveInnerLoop::measured_force(const Vec4& p_a, const Vec4& p_b) const {
+  return model_.area_a.cwiseProduct(p_a) - model_.area_b.cwiseProduct(p_b);
+}
+
+Vec4 ValveInnerLoop::hydraulic_stiffness(const Vec4& q) const {
+  Vec4 k;
+  for (int i = 0; i < kNumActive; ++i) {
+    double v_a = model_.swing_volume, v_b = model_.swing_volume;
+    if (i > 0) {
+      const double stroke = std::clamp(q[i] - model_.q_min[i], 0.0, model_.q_max[i] - model_.q_min[i]);
+      v_a = model_.dead_volume + model_.area_a[i] * stroke;
+      v_b = model_.dead_volume + model_.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
+    }
+    k[i] = model_.bulk_modulus * (model_.area_a[i] * model_.area_a[i] / v_a + model_.area_b[i] * model_.area_b[i] / v_b);
+  }
+  return k;
+}
+
+double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) const {
+  if (u == 0) return 0;
+  const bool extend = u > 0;
+  // Meter-in: the compensator holds the margin across it unless the load nears the main relief.
+  const double load = extend ? p_a : p_b;
+  const double drop_in = std::min(model_.load_sensing_margin, model_.main_relief - load);
+  const double k_in = extend ? model_.k_in_a[i] : model_.k_in_b[i];
+  const double area_in = extend ? model_.area_a[i] : model_.area_b[i];
+  const double flow_in = k_in * orifice(drop_in, model_.laminar_pressure);
+  double a = flow_in > 0 ? area_in * std::abs(u) / flow_in : 2.0;  // stalled at the relief: fully open
+  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills.
+  const double p_out = extend ? p_b : p_a;
+  const double k_out = extend ? model_.k_out_b[i] : model_.k_out_a[i];
+  const double area_out = extend ? model_.area_b[i] : model_.area_a[i];
+  const double flow_out = k_out * orifice(p_out - model_.tank_pressure, model_.laminar_pressure);
+  // Only while the filling chamber is down at the make-up (within the laminar pressure of tank): a
+  // resisting load keeps it above, and then the meter-in alone sets the speed.
+  const double p_in = extend ? p_a : p_b;
+  if (flow_out > 0 && p_in < model_.tank_pressure + model_.laminar_pressure)
+    a = std::min(a, area_out * std::abs(u) / flow_out);
+  return extend ? a : -a;
+}
+
+const ValveCommand& ValveInnerLoop::from_force(const Vec4& force_desired, const Vec4& v_ff, const Vec4& q,
+                                               const Vec4& p_a, const Vec4& p_b) {
+  command_.force = measured_force(p_a, p_b);
+  const Vec4 k_h = hydraulic_stiffness(q);
+  for (int i = 0; i < kNumActive; ++i)
+    command_.velocity[i] = v_ff[i] + (force_desired[i] - command_.force[i]) / (k_h[i] * settings_.force_time_constant);
+  finish(q, p_a, p_b);
+  return command_;
+}
+
+const ValveCommand& ValveInnerLoop::from_velocity(const Vec4& velocity, const Vec4& q, const Vec4& p_a,
+                                                  const Vec4& p_b) {
+  command_.force = measured_force(p_a, p_b);
+  command_.velocity = velocity;
+  finish(q, p_a, p_b);
+  return command_;
+}
+
+void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
+  (void)q;
+  ValveCommand& c = command_;
+  c.limited = 0;
+  c.demanded_flow = 0;
+  Vec4 spool;
+  const double band = settings_.opening_band;
+  for (int i = 0; i < kNumActive; ++i) {
+    double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], p_a[i], p_b[i]) : 0.0;
+    if (std::abs(a) >= 1) {
+      a = a > 0 ? 1.0 : -1.0;
+      c.limited |= static_cast<std::uint8_t>(1u << i);
+    }
+    c.opening[i] = a;
+    // Dead-zone inverse, continuous: linear from 0 to the band's edge, then z + (1 - z)|a|.
+    const double z = a >= 0 ? model_.dead_zone_extend[i] : model_.dead_zone_retract[i];
+    const double m = std::abs(a);
+    const double s = m >= band ? z + (1 - z) * m : (z + (1 - z) * band) * m / band;
+    spool[i] = a >= 0 ? s : -s;
+    // The meter-in flow this opening asks of the pumps (at the margin).
+    const double k_in = a >= 0 ? model_.k_in_a[i] : model_.k_in_b[i];
+    c.demanded_flow += k_in * m * orifice(model_.load_sensing_margin, model_.laminar_pressure);
+  }
+  c.pump_limited = c.demanded_flow > model_.pump_flow;
+  c.spool = spool_lead_.apply(spool);
+  for (int i = 0; i < kNumActive; ++i) {
+    c.pilot_a[i] = std::max(c.spool[i], 0.0) * model_.pilot_full_stroke;
+    c.pilot_b[i] = std::max(-c.spool[i], 0.0) * model_.pilot_full_stroke;
+  }
+}
+
+}  // namespace exc::control

@@ -1,0 +1,104 @@
+#pragma once
+// The inner loop between a control law and a hydraulic machine's valves (hydraulics.md, "How
+// published automation closes the loop"). Per function i (swing motor, boom, arm, bucket):
+//
+//   force loop   u = v_ff + (F_d - F) / (K_h(q) T_f)                       (m/s; swing rad/s)
+//                F = p_A A_A - p_B A_B from the measured chamber pressures (swing: D (p_A - p_B)),
+//                K_h = beta (A_A^2 / V_A(q) + A_B^2 / V_B(q)), the oil columns' stiffness. With u the
+//                flow the valve passes per piston area, dF/dt = K_h (u - qd): with v_ff = qd the
+//                force follows F_d with the time constant T_f; v_ff is the desired velocity (the
+//                flow feedforward), equal to qd while the machine tracks.
+//   (a flow law, FlowPositionControl, gives u directly and skips the force loop)
+//   orifice map  the opening that passes the flow A u: the pressure-compensated meter-in
+//                a_in = A_in |u| / (K_in f(min(margin, p_relief - p_load))) and, for an overrunning
+//                load, the meter-out a_out = A_out |u| / (K_out f(p_out - p_tank)) that holds it
+//                back; a = min(a_in, a_out), at most 1 (the valve's limit: flagged, anti-windup).
+//   dead zone    spool s = sign(a) (z + (1 - z) |a|) with the nominal dead zone z of the direction,
+//                linear through zero over |a| < opening_band so the command stays continuous.
+//   spool lead   the pilot-operated spool's first-order lag T_s made to look like the shorter T_t
+//                (ActuatorLagCompensator on the spool position, limits -1..1).
+//   pilots       p_pilot_A = max(s, 0) p_full, p_pilot_B = max(-s, 0) p_full.
+//
+// f(dp) is the orifice law with its laminar branch. Allocation-free after construction; the update
+// calls never throw.
+#include <cstdint>
+
+#include "control/actuator_lag_compensator.hpp"
+#include "model/types.hpp"
+
+namespace exc::control {
+
+// The nominal hydraulic machine as the inner loop sees it (valve_loop_model() fills it from the
+// firmware's machine file). Per function: swing, boom, arm, bucket.
+struct ValveLoopModel {
+  Vec4 area_a = Vec4::Zero(), area_b = Vec4::Zero();   // m^2 (swing: displacement m^3/rad, both ports)
+  Vec4 k_in_a = Vec4::Zero(), k_in_b = Vec4::Zero();   // fully open meter-in into A / B, m^3/s/sqrt(Pa)
+  Vec4 k_out_a = Vec4::Zero(), k_out_b = Vec4::Zero(); // fully open meter-out from A / B
+  Vec4 dead_zone_extend = Vec4::Zero(), dead_zone_retract = Vec4::Zero();  // of the spool stroke
+  Vec4 q_min = Vec4::Zero(), q_max = Vec4::Zero();     // strokes (chamber volumes)
+  double bulk_modulus = 1e9;         // Pa
+  double dead_volume = 0.002;        // m^3 per cylinder chamber at zero stroke
+  double swing_volume = 0.01;        // m^3 per swing motor side
+  double load_sensing_margin = 2e6;  // Pa
+  double main_relief = 34.3e6;       // Pa
+  double tank_pressure = 0.3e6;      // Pa
+  double laminar_pressure = 0.2e6;   // Pa
+  double pump_flow = 439.0 / 60000;  // m^3/s, both pumps
+  double spool_time_constant = 0.03; // s
+  double pilot_full_stroke = 5e6;    // Pa
+};
+
+struct ValveLoopSettings {
+  double force_time_constant = 0.04;  // s, T_f: the force loop's time constant
+  double spool_lag_target = 0.01;     // s, T_t the spool lead aims for (0: no lead)
+  double opening_band = 0.02;         // opening below which the dead-zone inverse is linear
+};
+
+// What the valve stage sends and what it found.
+struct ValveCommand {
+  Vec4 velocity = Vec4::Zero();   // u: commanded flow per piston area (m/s; swing rad/s)
+  Vec4 opening = Vec4::Zero();    // a: metering opening asked for, -1..1 (before the dead zone)
+  Vec4 spool = Vec4::Zero();      // s: spool command after dead zone and lead, -1..1
+  Vec4 pilot_a = Vec4::Zero();    // Pa on each spool's A end (extends / swings counter-clockwise)
+  Vec4 pilot_b = Vec4::Zero();    // Pa on each spool's B end
+  Vec4 force = Vec4::Zero();      // F measured from the pressures (N; swing N m)
+  std::uint8_t limited = 0;       // bit i: the valve could not pass the flow asked for (fully open)
+  double demanded_flow = 0;       // m^3/s the meter-ins ask of the pumps together
+  bool pump_limited = false;      // demanded_flow above the pumps' flow: every function slows
+};
+
+class ValveInnerLoop {
+ public:
+  ValveInnerLoop() = default;
+  // The nominal machine's hydraulics; period of the calls (s).
+  ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSettings& settings, double period);
+
+  // Spool model and lead restart from the centred spool.
+  void reset();
+
+  // Force loop: the desired efforts of the outer law, the flow feedforward v_ff, the measured
+  // positions and chamber pressures (per function; swing ports first).
+  const ValveCommand& from_force(const Vec4& force_desired, const Vec4& v_ff, const Vec4& q, const Vec4& p_a,
+                                 const Vec4& p_b);
+  // Flow law: the commanded velocity directly.
+  const ValveCommand& from_velocity(const Vec4& velocity, const Vec4& q, const Vec4& p_a, const Vec4& p_b);
+
+  // The measured effort F of each function.
+  Vec4 measured_force(const Vec4& p_a, const Vec4& p_b) const;
+  // K_h(q) of each function (N/m per m/s of flow mismatch, i.e. N/m; swing N m/rad).
+  Vec4 hydraulic_stiffness(const Vec4& q) const;
+  // The opening that passes the velocity u at these pressures (before the dead zone), unclamped.
+  double opening_for(int i, double u, double p_a, double p_b) const;
+  const ValveCommand& last() const { return command_; }
+  const ValveLoopSettings& settings() const { return settings_; }
+
+ private:
+  void finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b);
+
+  ValveLoopModel model_;
+  ValveLoopSettings settings_;
+  ActuatorLagCompensator spool_lead_;
+  ValveCommand command_;
+};
+
+}  // namespace exc::control

@@ -1,0 +1,258 @@
+// The valve stage (valve_inner_loop.hpp) against closed forms: the measured effort from the
+// pressures, the oil columns' stiffness, the inverse orifice map (meter-in, near the relief, the
+// overrunning load's meter-out), the dead-zone inverse, saturation, pilots, the spool lead against
+// an independently integrated spool, the force loop's law, the pump flow, and the flow law.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "allocation_counter.hpp"
+#include "control/flow_position_control.hpp"
+#include "control/valve_inner_loop.hpp"
+
+using namespace exc;
+using namespace exc::control;
+
+namespace {
+
+constexpr double kPeriod = 1e-3;
+
+// A round-number machine so the expectations below are hand-computable.
+ValveLoopModel simple_model() {
+  ValveLoopModel m;
+  m.area_a = Vec4(1e-4, 0.02, 0.015, 0.01);
+  m.area_b = Vec4(1e-4, 0.01, 0.008, 0.005);
+  const Vec4 speed(1.0, 0.3, 0.5, 0.7);  // the fully open meter-in passes A * speed at the margin
+  m.load_sensing_margin = 2e6;
+  m.laminar_pressure = 0.2e6;
+  m.tank_pressure = 0.3e6;
+  m.main_relief = 34e6;
+  for (int i = 0; i < 4; ++i) {
+    m.k_in_a[i] = m.area_a[i] * speed[i] / std::sqrt(2e6);
+    m.k_in_b[i] = m.area_b[i] * speed[i] / std::sqrt(2e6);
+    m.k_out_a[i] = m.area_a[i] * speed[i] / std::sqrt(5e6);  // at a 5 MPa drop
+    m.k_out_b[i] = m.area_b[i] * speed[i] / std::sqrt(5e6);
+  }
+  m.dead_zone_extend = Vec4(0.1, 0.15, 0.2, 0.25);
+  m.dead_zone_retract = Vec4(0.12, 0.17, 0.22, 0.27);
+  m.q_min = Vec4(-10, 1.0, 1.0, 1.0);
+  m.q_max = Vec4(10, 2.0, 2.0, 2.0);
+  m.bulk_modulus = 1e9;
+  m.dead_volume = 0.002;
+  m.swing_volume = 0.01;
+  m.pump_flow = 0.007;
+  m.spool_time_constant = 0.03;
+  m.pilot_full_stroke = 5e6;
+  return m;
+}
+
+ValveLoopSettings no_lead() {
+  ValveLoopSettings s;
+  s.spool_lag_target = 0;
+  return s;
+}
+
+const Vec4 kMid(0, 1.5, 1.5, 1.5);
+const Vec4 kLowP = Vec4::Constant(1e6);  // a modest load on either side: the meter-in governs
+
+}  // namespace
+
+TEST_CASE("firmware/valve stage measures each function's effort as p_A A_A - p_B A_B") {
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  const Vec4 pa(10e6, 12e6, 3e6, 20e6), pb(2e6, 1e6, 9e6, 0.5e6);
+  const Vec4 f = loop.measured_force(pa, pb);
+  CHECK(f[0] == doctest::Approx(1e-4 * 10e6 - 1e-4 * 2e6));  // swing: D (p_A - p_B), 800 N m
+  CHECK(f[1] == doctest::Approx(0.02 * 12e6 - 0.01 * 1e6));  // 230 kN
+  CHECK(f[2] == doctest::Approx(0.015 * 3e6 - 0.008 * 9e6)); // -27 kN: pulling
+  CHECK(f[3] == doctest::Approx(0.01 * 20e6 - 0.005 * 0.5e6));
+}
+
+TEST_CASE("firmware/valve stage's oil-column stiffness is beta (A_A^2/V_A + A_B^2/V_B) at the stroke") {
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  const Vec4 q(0.3, 1.25, 1.5, 1.9);
+  const Vec4 k = loop.hydraulic_stiffness(q);
+  CHECK(k[0] == doctest::Approx(1e9 * 2 * 1e-8 / 0.01));
+  // boom at a quarter stroke: V_A = 0.002 + 0.02 * 0.25, V_B = 0.002 + 0.01 * 0.75
+  CHECK(k[1] == doctest::Approx(1e9 * (0.02 * 0.02 / 0.007 + 0.01 * 0.01 / 0.0095)));
+  CHECK(k[3] == doctest::Approx(1e9 * (0.01 * 0.01 / (0.002 + 0.01 * 0.9) + 0.005 * 0.005 / (0.002 + 0.005 * 0.1))));
+}
+
+TEST_CASE("firmware/valve stage's orifice map passes the asked flow through the compensated meter-in") {
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  for (int i = 0; i < 4; ++i) {
+    // Extending at 40 % of the speed limit through the meter-in into A at the 2 MPa margin.
+    const double u_ext = 0.4 * std::sqrt(2e6) * m.k_in_a[i] / m.area_a[i];
+    const double a = loop.opening_for(i, u_ext, kLowP[i], kLowP[i]);
+    CHECK(m.k_in_a[i] * a * std::sqrt(2e6) == doctest::Approx(m.area_a[i] * u_ext));
+    CHECK(a == doctest::Approx(0.4));
+    // Retracting: into B.
+    const double b = loop.opening_for(i, -0.25 * std::sqrt(2e6) * m.k_in_b[i] / m.area_b[i], kLowP[i], kLowP[i]);
+    CHECK(b == doctest::Approx(-0.25));
+  }
+  CHECK(loop.opening_for(1, 0.0, 5e6, 5e6) == 0.0);
+}
+
+TEST_CASE("firmware/valve stage opens wider when the load nears the main relief (less drop across the meter-in)") {
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  const double u = 0.1;  // m/s on the boom
+  const double nominal = loop.opening_for(1, u, 1e6, 1e6);
+  // 0.5 MPa left below the 34 MPa main relief: the meter-in sees 0.5 MPa instead of 2 MPa.
+  const double near = loop.opening_for(1, u, 33.5e6, 1e6);
+  CHECK(near == doctest::Approx(nominal * std::sqrt(2e6 / 0.5e6)));
+  // At the relief the function stalls: the stage asks for the whole valve and says so.
+  ValveInnerLoop stalled(m, no_lead(), kPeriod);
+  Vec4 pa = kLowP;
+  pa[1] = 34e6;
+  const ValveCommand& c = stalled.from_velocity(Vec4(0, u, 0, 0), kMid, pa, kLowP);
+  CHECK(c.opening[1] == 1.0);
+  CHECK(((c.limited >> 1) & 1u) == 1u);
+}
+
+TEST_CASE("firmware/valve stage meters an overrunning load out (the filling side at the make-up)") {
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  // Boom lowering under its weight: the rod side B fills (at tank, held by the make-up), the bore
+  // side A carries the load at 15 MPa and its meter-out sets the speed: A_A u = K_out,A a sqrt(dp).
+  const double u = -0.1, p_a = 15e6, p_b = m.tank_pressure;
+  const double a = loop.opening_for(1, u, p_a, p_b);
+  CHECK(a < 0);
+  CHECK(m.k_out_a[1] * -a * std::sqrt(p_a - m.tank_pressure) == doctest::Approx(m.area_a[1] * 0.1));
+  // The same speed against a resisting load (B well above tank): the meter-in decides.
+  const double resisting = loop.opening_for(1, u, p_a, 3e6);
+  CHECK(m.k_in_b[1] * -resisting * std::sqrt(2e6) == doctest::Approx(m.area_b[1] * 0.1));
+}
+
+TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates at the valve's limit") {
+  const ValveLoopModel m = simple_model();
+  ValveLoopSettings s = no_lead();
+  ValveInnerLoop loop(m, s, kPeriod);
+  const Vec4 speed(1.0, 0.3, 0.5, 0.7);
+  for (int i = 0; i < 4; ++i) {
+    for (double frac : {0.05, 0.3, 0.9, -0.05, -0.3, -0.9}) {
+      Vec4 u = Vec4::Zero();
+      u[i] = frac * speed[i];
+      const ValveCommand& c = loop.from_velocity(u, kMid, kLowP, kLowP);
+      // The plant's metering opening of this spool: (|s| - z) / (1 - z) past the dead zone z.
+      const double z = frac > 0 ? m.dead_zone_extend[i] : m.dead_zone_retract[i];
+      const double opened = (std::abs(c.spool[i]) - z) / (1 - z);
+      CHECK(opened == doctest::Approx(std::abs(frac)));
+      CHECK((c.spool[i] > 0) == (frac > 0));
+      CHECK(c.limited == 0);
+    }
+    // Inside the band the inverse runs linearly to zero: no jump to the dead zone's edge.
+    Vec4 u = Vec4::Zero();
+    u[i] = 1e-3 * s.opening_band * speed[i];
+    const double z = m.dead_zone_extend[i];
+    CHECK(loop.from_velocity(u, kMid, kLowP, kLowP).spool[i] ==
+          doctest::Approx(1e-3 * (z + (1 - z) * s.opening_band)));
+    CHECK(loop.from_velocity(Vec4::Zero(), kMid, kLowP, kLowP).spool[i] == 0.0);
+    // Twice the speed limit: fully open, flagged.
+    u[i] = 2 * speed[i];
+    const ValveCommand& sat = loop.from_velocity(u, kMid, kLowP, kLowP);
+    CHECK(sat.spool[i] == 1.0);
+    CHECK(sat.limited == (1u << i));
+  }
+}
+
+TEST_CASE("firmware/valve stage sends the spool command as pilot pressures on the end it opens") {
+  ValveInnerLoop loop(simple_model(), no_lead(), kPeriod);
+  const ValveCommand& c = loop.from_velocity(Vec4(0.5, -0.15, 0, 0.35), kMid, kLowP, kLowP);
+  CHECK(c.pilot_a[0] == doctest::Approx(c.spool[0] * 5e6));
+  CHECK(c.pilot_b[0] == 0.0);
+  CHECK(c.pilot_a[1] == 0.0);
+  CHECK(c.pilot_b[1] == doctest::Approx(-c.spool[1] * 5e6));
+  CHECK(c.pilot_a[2] == 0.0);
+  CHECK(c.pilot_b[2] == 0.0);
+}
+
+TEST_CASE("firmware/valve stage's force loop commands the flow that closes the force error in T_f") {
+  const ValveLoopModel m = simple_model();
+  ValveLoopSettings s = no_lead();
+  s.force_time_constant = 0.05;
+  ValveInnerLoop loop(m, s, kPeriod);
+  const Vec4 pa(5e6, 8e6, 4e6, 6e6), pb(5e6, 2e6, 2e6, 1e6);
+  const Vec4 force = loop.measured_force(pa, pb);
+  const Vec4 step(200, 5e3, -4e3, 2e3);
+  const Vec4 v_ff(0.01, 0.02, -0.03, 0.0);
+  const ValveCommand& c = loop.from_force(force + step, v_ff, kMid, pa, pb);
+  const Vec4 k = loop.hydraulic_stiffness(kMid);
+  for (int i = 0; i < 4; ++i) CHECK(c.velocity[i] == doctest::Approx(v_ff[i] + step[i] / (k[i] * 0.05)));
+  // No error, no feedforward: the valve stays shut.
+  const ValveCommand& hold = loop.from_force(force, Vec4::Zero(), kMid, pa, pb);
+  CHECK(hold.spool.cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("firmware/valve stage's spool lead makes the 30 ms spool answer with its 10 ms target") {
+  const ValveLoopModel m = simple_model();
+  ValveLoopSettings s;
+  s.spool_lag_target = 0.01;
+  ValveInnerLoop lead(m, s, kPeriod);
+  ValveInnerLoop plain(m, no_lead(), kPeriod);
+  // The real spool: y' = (c - y) / 30 ms, integrated with 20 Euler substeps per period (independent
+  // of the stage's exact exponential model).
+  auto spool_step = [&](double y, double c) {
+    for (int k = 0; k < 20; ++k) y += kPeriod / 20 * (c - y) / m.spool_time_constant;
+    return y;
+  };
+  const Vec4 u(0, 0.3 * 0.3, 0, 0);  // boom at 30 % of its speed: spool target 0.15 + 0.85 * 0.3
+  const double target = 0.15 + 0.85 * 0.3;
+  double y_lead = 0, y_plain = 0, t_lead = -1, t_plain = -1;
+  for (int k = 1; k <= 200; ++k) {
+    y_lead = spool_step(y_lead, lead.from_velocity(u, kMid, kLowP, kLowP).spool[1]);
+    y_plain = spool_step(y_plain, plain.from_velocity(u, kMid, kLowP, kLowP).spool[1]);
+    if (t_lead < 0 && y_lead >= 0.632 * target) t_lead = k * kPeriod;
+    if (t_plain < 0 && y_plain >= 0.632 * target) t_plain = k * kPeriod;
+  }
+  CHECK(t_plain == doctest::Approx(0.030).epsilon(0.05));
+  CHECK(t_lead == doctest::Approx(0.010).epsilon(0.15));
+  CHECK(y_lead == doctest::Approx(target).epsilon(1e-3));  // no steady-state offset
+}
+
+TEST_CASE("firmware/valve stage counts the pumps' flow the openings ask for") {
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  const Vec4 speed(1.0, 0.3, 0.5, 0.7);
+  const ValveCommand& half = loop.from_velocity(0.2 * speed, kMid, kLowP, kLowP);
+  const double expected = 0.2 * (m.area_a.dot(speed));
+  CHECK(half.demanded_flow == doctest::Approx(expected));
+  CHECK(half.pump_limited == (expected > m.pump_flow));
+  const ValveCommand& full = loop.from_velocity(0.99 * speed, kMid, kLowP, kLowP);
+  CHECK(full.demanded_flow == doctest::Approx(0.99 * m.area_a.dot(speed)));
+  CHECK(full.pump_limited);  // 0.020 m^3/s against 0.007
+}
+
+TEST_CASE("firmware/flow law passes the desired velocity plus K_p times the position error") {
+  ControllerConfig config;
+  config.flow_kp = Vec4(1, 2, 3, 4);
+  FlowPositionControl flow(config);
+  ControlInput in;
+  in.q = Vec4(0.1, 2.0, 2.5, 1.8);
+  in.q_d = Vec4(0.15, 1.9, 2.5, 1.85);
+  in.qd_d = Vec4(0.2, -0.1, 0.05, 0.0);
+  const ControlOutput out = flow.update(in);
+  CHECK(out.velocity_command);
+  for (int i = 0; i < 4; ++i) CHECK(out.velocity[i] == doctest::Approx(in.qd_d[i] - config.flow_kp[i] * (in.q[i] - in.q_d[i])));
+  CHECK(out.tau.isZero());
+}
+
+TEST_CASE("firmware/valve stage allocates nothing over 100000 cycles") {
+  ValveLoopSettings s;
+  ValveInnerLoop loop(simple_model(), s, kPeriod);
+  double sink = 0;
+  exc::test::AllocationCounter counter;
+  {
+    exc::test::EigenNoMallocScope no_malloc;
+    for (int k = 0; k < 100000; ++k) {
+      const double w = 1e-3 * k;
+      const Vec4 pa = Vec4::Constant(5e6 + 1e6 * std::sin(w)), pb = Vec4::Constant(2e6);
+      sink += loop.from_force(Vec4::Constant(1e4 * std::cos(w)), Vec4::Constant(0.05 * std::sin(w)), kMid, pa, pb).spool.sum();
+      sink += loop.from_velocity(Vec4::Constant(0.1 * std::cos(w)), kMid, pa, pb).spool.sum();
+    }
+  }
+  CHECK(counter.count() == 0);
+  CHECK(std::isfinite(sink));
+}
