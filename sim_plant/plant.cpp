@@ -106,41 +106,65 @@ bool Plant::accept_command(const ActuatorCommand& command) {
 // coordinate alone let a force held against the stop accelerate the joints coupled to it through
 // M_a without doing work on them: energy from nowhere. The impact's energy 1/2 v^2 / (M_a^-1)_ii,
 // v the speed into the stop at the substep's start, goes to state_.end_stop_loss; a cylinder resting
-// on its stop (v = 0) loses nothing. Returns true if the state was changed.
+// on its stop (v = 0) loses nothing. The limited actuators' speed limit acts the same way (below),
+// and its loss is booked there too. Returns true if the state was changed.
 bool Plant::apply_limits(const Vec4& qd_start) {
   if (scene_.actuators.fidelity == ActuatorFidelity::ideal) return false;
   bool changed = false;
   bool have_inverse = false;
   Mat4 m_inv = Mat4::Identity();
+  // M_a^-1 at the state, once per substep and only when a limit acts.
+  auto inverse = [&]() -> const Mat4& {
+    if (!have_inverse) {
+      integrator_.invalidate_cache();
+      Mat4 M;
+      if (update_closed_chain(model_, ws_, mech_.q_a, mech_.qd_a).ok()) {
+        mass_matrix(model_, ws_, M);
+        m_inv = M.inverse();
+      }
+      have_inverse = true;
+    }
+    return m_inv;
+  };
   for (int i = 0; i < kNumActive; ++i) {
     const bool below = mech_.q_a[i] < q_min_[i], above = mech_.q_a[i] > q_max_[i];
     if (below || above) {
       changed = true;
-      if (!have_inverse) {
-        integrator_.invalidate_cache();
-        Mat4 M;
-        if (update_closed_chain(model_, ws_, mech_.q_a, mech_.qd_a).ok()) {
-          mass_matrix(model_, ws_, M);
-          m_inv = M.inverse();
-        }
-        have_inverse = true;
-      }
+      const Mat4& mi = inverse();
       const double stop = below ? q_min_[i] : q_max_[i];
       // Back onto the stop along the same direction: the joints coupled to the cylinder give back the
       // displacement the stop's reaction would have denied them within the substep, whatever the
       // integrator's position update was.
-      mech_.q_a -= m_inv.col(i) * ((mech_.q_a[i] - stop) / m_inv(i, i));
+      mech_.q_a -= mi.col(i) * ((mech_.q_a[i] - stop) / mi(i, i));
       mech_.q_a[i] = stop;
       const double into = below ? std::min(mech_.qd_a[i], 0.0) : std::max(mech_.qd_a[i], 0.0);
       if (into != 0) {
-        mech_.qd_a -= m_inv.col(i) * (into / m_inv(i, i));
+        mech_.qd_a -= mi.col(i) * (into / mi(i, i));
         mech_.qd_a[i] = 0;
         const double arriving = below ? std::min(qd_start[i], 0.0) : std::max(qd_start[i], 0.0);
-        state_.end_stop_loss += 0.5 * arriving * arriving / m_inv(i, i);
+        state_.end_stop_loss += 0.5 * arriving * arriving / mi(i, i);
       }
     }
-    if (scene_.actuators.fidelity == ActuatorFidelity::limited && std::abs(mech_.qd_a[i]) > speed_max_[i]) {
-      mech_.qd_a[i] = std::copysign(speed_max_[i], mech_.qd_a[i]);
+    const double v = mech_.qd_a[i];
+    if (scene_.actuators.fidelity == ActuatorFidelity::limited && std::abs(v) > speed_max_[i]) {
+      // The flow limit as an impulse along M_a^-1 e_i (the same as the end stop's): it takes the
+      // excess d off this joint and lets the coupled joints keep their momentum (setting the one
+      // coordinate instead can add energy through the mass matrix's coupling). The positions give
+      // back what the excess moved them within the substep: all of it for semi-implicit Euler, which
+      // moves with the end velocity, half for the others, whose velocity grew through the substep.
+      // The motion is then the one the valve allows, at the limit over the substep, and the impulse
+      // lambda = d / (M_a^-1)_ii spread over it does the work lambda v_limit: the valve's loss,
+      // booked in the balance (first order in the step, like the integrator's own error).
+      const Mat4& mi = inverse();
+      const double limit = std::copysign(speed_max_[i], v);
+      const double d = v - limit;
+      const double lambda = d / mi(i, i);
+      const double moved = scene_.integrator.method == IntegrationMethod::semi_implicit_euler ? 1.0 : 0.5;
+      const Vec4 excess = mi.col(i) * lambda;
+      mech_.qd_a -= excess;
+      mech_.q_a -= moved * scene_.integrator.step * excess;
+      mech_.qd_a[i] = limit;
+      state_.end_stop_loss += lambda * limit;
       changed = true;
     }
   }

@@ -40,7 +40,7 @@ struct PlantState {
   double actuator_work = 0, soil_work = 0;          // J, done on the machine
   double constraint_residual = 0;  // m, |h(q)|
   int end_stop_events = 0;         // substeps at which an end stop or a speed limit acted
-  double end_stop_loss = 0;        // J the end stops' impacts took (inelastic), in the energy balance
+  double end_stop_loss = 0;        // J the end stops' impacts and the speed limits took (inelastic), in the energy balance
   int implicit_iterations = 0;     // of the last substep (implicit_midpoint)
 };
 

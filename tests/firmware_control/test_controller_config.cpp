@@ -74,7 +74,7 @@ controller:
 }
 
 TEST_CASE("firmware/controller config errors name the field, its line and column and the allowed range") {
-  check_error("controller: {type: lqr}", "controller.type", "lqr", "is 'lqr'; allowed values: pid, adaptive, slotine_li");
+  check_error("controller: {type: lqr}", "controller.type", "lqr", "is 'lqr'; allowed values: pid, adaptive, slotine_li, flow");
   check_error("controller: {kp: [1, 2, 3]}", "controller.kp", "[1, 2, 3]", "must be a list of 4 numbers in [0.001, 1000000] 1/s^2");
   check_error("controller: {kp: [1, 2, -3, 4]}", "controller.kp[2]", "-3", "is -3 1/s^2; allowed range [0.001, 1000000] 1/s^2");
   check_error("controller: {gain: 3}", "controller.gain", "gain", "unknown key; allowed keys: type, period, kp, kv, ki");

@@ -214,7 +214,7 @@ TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits
   fs::remove(bad);
   const Run unknown = run_sim("run " + kDig + " --controller lqr --quiet --no-report");
   CHECK(unknown.status == 2);
-  CHECK(unknown.err.find("pid, adaptive, slotine_li") != std::string::npos);
+  CHECK(unknown.err.find("pid, adaptive, slotine_li, flow") != std::string::npos);
   const Run help = run_sim("robustness --help");
   CHECK(help.status == 0);
   CHECK(help.out.find("--json") != std::string::npos);
@@ -354,7 +354,7 @@ TEST_CASE("tools/excavator-sim: a scene's controller.type chooses the controller
   const fs::path unknown = edited_dig("controller:\n", "controller:\n  type: lqr\n", "unknown_type");
   const Run bad = run_sim("run " + unknown.string() + " --quiet --no-report");
   CHECK(bad.status == 2);
-  CHECK(bad.err.find("controller.type: is 'lqr'; allowed values: pid, adaptive, slotine_li") != std::string::npos);
+  CHECK(bad.err.find("controller.type: is 'lqr'; allowed values: pid, adaptive, slotine_li, flow") != std::string::npos);
   fs::remove(unknown);
 }
 
