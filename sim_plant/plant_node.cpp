@@ -135,6 +135,17 @@ void PlantNode::publish_state() {
   }
   m.in_soil = s.in_soil;
   m.depth = s.depth;
+  if (plant_.scene().actuators.fidelity == plant::ActuatorFidelity::hydraulic) {
+    for (int j = 0; j < 4; ++j) {
+      m.pressure_a[j] = s.pressure_a[j];
+      m.pressure_b[j] = s.pressure_b[j];
+      m.spool[j] = s.spool[j];
+    }
+    for (int i = 0; i < 2; ++i) {
+      m.pump_pressure[i] = s.hydraulics.pump_pressure[i];
+      m.flow_scale[i] = s.hydraulics.flow_scale[i];
+    }
+  }
   telemetry_->publish(telemetry::Channel::state, m);
 }
 

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 
 #include "app/can_stats_message.hpp"
 #include "app/timing_message.hpp"
@@ -35,8 +37,17 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::sensor_timeout: return "sensor timeout";
     case FirmwareFault::model: return "model";
     case FirmwareFault::tracking_error: return "tracking error";
+    case FirmwareFault::no_pressures: return "no pressures";
   }
   return "unknown";
+}
+
+void check_controller_interface(control::ControllerKind kind, const control::ControllerConfig& config) {
+  if (kind == control::ControllerKind::flow && config.command_interface != control::CommandInterface::valve)
+    throw std::invalid_argument(std::string("controller ") + control::to_string(kind) +
+                                " commands the valves' flow; the scene's controller.command_interface is " +
+                                control::kCommandInterfaces.name_of(config.command_interface) +
+                                " (set it to valve for a hydraulic machine)");
 }
 
 FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
@@ -52,13 +63,16 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       blender_(config.controller.blend_time),
       lag_compensator_(config.controller.actuator_lag, config.controller.actuator_lag_target,
                        config.controller.period, control::effort_limits_of(model.machine)),
+      valves_(control::valve_loop_model(model.machine), config.controller.valves, config.controller.period),
       control_timing_("control", 100.0),
       cycle_timing_("cycle", config.controller.period * 1e6),
       read_timing_("read", 100.0),
       write_timing_("write", 100.0),
       telemetry_timing_("telemetry", 100.0),
       interval_timing_("interval", config.controller.period * 1.5e6),
-      period_(config.controller.period) {}
+      period_(config.controller.period) {
+  check_controller_interface(config.kind, config.controller);
+}
 
 FirmwareNode::~FirmwareNode() = default;
 
@@ -186,6 +200,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   if (restarted) {
     estimator_.reset(q, qd);
     controller_->reset();
+    valves_.reset();
   } else {
     estimator_.update(q, qd);
   }
@@ -209,7 +224,9 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   input.soil.terrain_height = config_.terrain_height;
   input.soil.theta_known = config_.theta_known;
   input.soil.theta = config_.theta_true;
-  input.actuator_limited = lag_compensator_.clamped();
+  // What the stage after the law could not deliver last cycle (a clamped lead, a fully open valve):
+  // the adaptive laws leave those joints out of their update, the PID its integrator.
+  input.actuator_limited = valve_interface() ? valves_.last().limited : lag_compensator_.clamped();
   out_ = controller_->update(input);
   if (!fault_ && (out_.status != ModelStatus::ok || !finite(out_.tau))) {
     fault_ = true;
@@ -230,15 +247,46 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   // Bumpless: entering hold/track from another effort-commanding mode starts from the last command.
   if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))
     blender_.on_switch(t, last_sent_, out_.tau);
-  const Vec4 tau = blender_.apply(t, out_.tau);
-  // After a restart the actuator is taken to deliver what the law asks for first (the plant's
-  // actuators hold their effort); last_sent_ stays the effort asked for, the blend's reference.
-  if (restarted) lag_compensator_.reset(tau);
-  const Vec4 sent = lag_compensator_.apply(tau);
-  command_.mode = hal::CommandMode::effort;
-  for (int j = 0; j < 4; ++j) command_.value[j] = sent[j];
-  last_sent_ = tau;
+  if (valve_interface()) {
+    command_valves(q);
+  } else {
+    const Vec4 tau = blender_.apply(t, out_.tau);
+    // After a restart the actuator is taken to deliver what the law asks for first (the plant's
+    // actuators hold their effort); last_sent_ stays the effort asked for, the blend's reference.
+    if (restarted) lag_compensator_.reset(tau);
+    const Vec4 sent = lag_compensator_.apply(tau);
+    command_.mode = hal::CommandMode::effort;
+    for (int j = 0; j < 4; ++j) command_.value[j] = sent[j];
+    last_sent_ = tau;
+  }
   control_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
+}
+
+void FirmwareNode::command_valves(const Vec4& q) {
+  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  const control::ValveCommand* v = nullptr;
+  if (out_.velocity_command) {
+    v = &valves_.from_velocity(out_.velocity, q, p_a, p_b);
+  } else {
+    // The force loop closes on the measured chamber pressures: without them it would drive the
+    // valves blind. Fault (the safe state centres the valves next cycle) rather than guess.
+    if (!sensors_.pressure_valid && !fault_) {
+      fault_ = true;
+      pending_fault_ = FirmwareFault::no_pressures;
+      std::snprintf(pending_text_, sizeof pending_text_,
+                    "no pressures: the valve stage's force loop needs the chamber pressures (t = %.3f s)", time());
+    }
+    const Vec4 tau = blender_.apply(time(), out_.tau);
+    last_sent_ = tau;
+    v = &valves_.from_force(tau, qd_d_, q, p_a, p_b);
+  }
+  if (v->pump_limited) ++pump_limited_cycles_;
+  command_.mode = hal::CommandMode::pilot;
+  for (int j = 0; j < 4; ++j) {
+    command_.value[j] = v->spool[j];
+    command_.pilot_a[j] = v->pilot_a[j];
+    command_.pilot_b[j] = v->pilot_b[j];
+  }
 }
 
 void FirmwareNode::publish_cycle() {
@@ -247,12 +295,20 @@ void FirmwareNode::publish_cycle() {
   c.utime = utime;
   c.mode = static_cast<std::int8_t>(machine_.mode());
   c.controller = static_cast<std::int8_t>(config_.kind);
+  c.command_interface = static_cast<std::int8_t>(config_.controller.command_interface);
+  const bool effort = command_.mode == hal::CommandMode::effort;
+  const bool valves = command_.mode == hal::CommandMode::pilot;
+  const control::ValveCommand& v = valves_.last();
   for (int j = 0; j < 4; ++j) {
-    const bool effort = command_.mode == hal::CommandMode::effort;
-    c.effort[j] = effort ? command_.value[j] : 0.0;
+    c.effort[j] = effort ? command_.value[j] : valves && !out_.velocity_command ? last_sent_[j] : 0.0;
     c.valve[j] = effort ? 0.0 : command_.value[j];
-    c.saturated[j] = (out_.saturated >> j) & 1;
+    c.saturated[j] = ((out_.saturated | (valves ? v.limited : 0)) >> j) & 1;
+    c.valve_velocity[j] = valves ? v.velocity[j] : 0.0;
+    c.pilot_a[j] = valves ? v.pilot_a[j] : 0.0;
+    c.pilot_b[j] = valves ? v.pilot_b[j] : 0.0;
+    c.force_measured[j] = valves ? v.force[j] : 0.0;
   }
+  c.pump_limited = valves && v.pump_limited;
   telemetry_->publish(telemetry::Channel::command, c);
 
   exlcm::controller_state_t s{};

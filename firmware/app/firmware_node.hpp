@@ -17,6 +17,7 @@
 #include "control/state_estimator.hpp"
 #include "control/state_machine.hpp"
 #include "control/task.hpp"
+#include "control/valve_inner_loop.hpp"
 #include "hal/can_ports.hpp"
 #include "app/can_stats_message.hpp"
 #include "app/tracking_metrics.hpp"
@@ -38,12 +39,17 @@ struct FirmwareNodeConfig {
   Vec6 theta_true = Vec6::Zero();
 };
 
+// Refuses a controller the command interface cannot carry (a flow law on the effort interface):
+// start-up check, throws std::invalid_argument naming both.
+void check_controller_interface(control::ControllerKind kind, const control::ControllerConfig& config);
+
 // Firmware fault codes (fault_t.code and the CAN fault frame).
 enum class FirmwareFault : std::uint16_t {
   none = 0,
   sensor_timeout = 1,  // watchdog: no valid sensor set within the timeout
   model = 2,           // the closed-chain model refused the state (no assembly, toggle)
   tracking_error = 3,  // a joint's |q_a - q_d| exceeded controller.tracking_error_limit
+  no_pressures = 4,    // the valve stage's force loop needs chamber pressures the sensor frame lacks
 };
 const char* to_string(FirmwareFault fault);
 
@@ -90,6 +96,11 @@ class FirmwareNode {
   // A complete, valid sensor set has arrived at least once.
   bool has_sensors() const { return have_valid_; }
   const control::ControlOutput& last_output() const { return out_; }
+  // The valve stage's last command (valve interface; zeros otherwise), and how many cycles its
+  // openings asked the pumps for more flow than they give.
+  const control::ValveCommand& last_valve_command() const { return valves_.last(); }
+  std::uint64_t pump_limited_cycles() const { return pump_limited_cycles_; }
+  bool valve_interface() const { return config_.controller.command_interface == control::CommandInterface::valve; }
   const hal::CommandState& last_command() const { return command_; }
   // Time of the control computation (estimate + trajectory + control law), and of the whole
   // end_cycle: from its start (the plant has answered) through read, compute and write to the end of
@@ -110,6 +121,9 @@ class FirmwareNode {
 
  private:
   void compute_command(const control::Transition& transition);
+  // The valve interface: the law's effort through the force loop (or a flow law's velocity) to the
+  // spools' pilot pressures.
+  void command_valves(const Vec4& q);
   void publish_cycle();
 
   const Model& model_;
@@ -122,6 +136,8 @@ class FirmwareNode {
   control::ControlStateMachine machine_;
   control::CommandBlender blender_;
   control::ActuatorLagCompensator lag_compensator_;
+  control::ValveInnerLoop valves_;
+  std::uint64_t pump_limited_cycles_ = 0;
   control::PerfCounter control_timing_;
   control::PerfCounter cycle_timing_;
   control::PerfCounter read_timing_, write_timing_, telemetry_timing_, interval_timing_;

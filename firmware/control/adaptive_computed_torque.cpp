@@ -57,7 +57,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   const Vec2 rhodd = ws_.J_t * qdd_for_y + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, ws_.rhod, rhodd, out.rho_env, out.in_soil);
 
-  const Vec4 v = in.qdd_d - feedback_.update(out.e, out.ed, config_.period, saturated_);
+  const Vec4 v = in.qdd_d - feedback_.update(out.e, out.ed, config_.period, saturated_ | in.actuator_limited);
   out.tau_unsaturated = M_a * v + h_a + Y * theta_hat_;  // eq. 12
   saturated_ = saturate_output(limits_, out, last_tau_);
 

@@ -25,7 +25,7 @@ ControlOutput ComputedTorquePid::update(const ControlInput& in) {
   Mat4 M_a;
   Vec4 h_a;
   if (!model_at(model_, ws_, in.q, in.qd, last_tau_, out, M_a, h_a)) return out;
-  const Vec4 feedback = pid_.update(out.e, out.ed, config_.period, saturated_);
+  const Vec4 feedback = pid_.update(out.e, out.ed, config_.period, saturated_ | in.actuator_limited);
   out.tau_unsaturated = M_a * (in.qdd_d - feedback) + h_a;  // eq. 12 without the soil term
   saturated_ = saturate_output(limits_, out, last_tau_);
 

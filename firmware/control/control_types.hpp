@@ -30,8 +30,9 @@ struct ControlInput {
   Vec4 qdd = Vec4::Zero();       // filtered qdd_a (state_estimator.hpp); only the adaptive law uses it
   Vec4 q_d = Vec4::Zero(), qd_d = Vec4::Zero(), qdd_d = Vec4::Zero();  // desired
   SoilContext soil;
-  // Bit j set: downstream of the law (actuator-lag compensation) joint j's command was clamped to its
-  // effort limit last cycle, so the effort asked for was not delivered; the adaptive laws freeze.
+  // Bit j set: downstream of the law joint j's command was not delivered last cycle (the actuator-lag
+  // lead clamped it to its effort limit, or the valve stage opened the valve fully): the adaptive
+  // laws leave the joint out of their update and the integrators hold (anti-windup).
   std::uint8_t actuator_limited = 0;
 };
 

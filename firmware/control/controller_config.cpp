@@ -84,7 +84,19 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.numbers("lyapunov_q_integral", c.lyapunov_q_integral, kWeight, "", "Q of the integral states");
   r.number("actuator_lag", c.actuator_lag, {0, 1}, "s", "the effort lag the firmware compensates (0: none)");
   r.number("actuator_lag_target", c.actuator_lag_target, {1e-4, 1}, "s", "the lag the compensated actuator should show");
+  r.choice("command_interface", c.command_interface, kCommandInterfaces, "what the firmware commands on the bus");
+  SectionReader v = r.section("valves", "the valve stage between the law and a hydraulic machine's valves");
+  v.number("force_time_constant", c.valves.force_time_constant, {1e-3, 1}, "s", "T_f: the force loop's time constant");
+  v.number("spool_lag_target", c.valves.spool_lag_target, {0, 1}, "s",
+           "the spool lag the lead aims for (0: no lead); at most the machine's valve_time_constant");
+  v.number("opening_band", c.valves.opening_band, {1e-4, 0.5}, "", "opening below which the dead-zone inverse is linear");
+  v.finish();
+  SectionReader fl = r.section("flow", "flow-based position control (controller.type flow)");
+  fl.numbers("kp", c.flow_kp, {0, 1e3}, "1/s", "position gains: u = qd_d - kp e");
+  fl.finish();
   r.finish();
+  if (c.kind_given && c.kind == ControllerKind::flow && c.command_interface != CommandInterface::valve)
+    r.fail("type", "flow commands the valves' flow: it needs command_interface: valve");
   c.filter.period = c.period;
   check_nyquist(f, c);
   check_cross_fields(r, c);

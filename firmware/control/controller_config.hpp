@@ -11,6 +11,7 @@
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
 #include "control/state_estimator.hpp"
+#include "control/valve_inner_loop.hpp"
 #include "settings/section_reader.hpp"
 
 namespace exc::control {
@@ -20,6 +21,15 @@ enum class RegressorAcceleration : std::uint8_t { filtered = 0, desired = 1 };
 inline constexpr settings::EnumTable<RegressorAcceleration, 2> kRegressorAccelerations{{{
     {RegressorAcceleration::filtered, "filtered", "the estimator's filtered joint acceleration"},
     {RegressorAcceleration::desired, "desired", "the trajectory's desired acceleration"},
+}}};
+
+// What the firmware commands on the bus: the efforts (a force-commanded machine, the paper's) or
+// the valves of a hydraulic machine through the valve stage (valve_inner_loop.hpp).
+enum class CommandInterface : std::uint8_t { effort = 0, valve = 1 };
+inline constexpr settings::EnumTable<CommandInterface, 2> kCommandInterfaces{{{
+    {CommandInterface::effort, "effort", "swing torque and cylinder forces (CMD_EFFORT): force-commanded actuators"},
+    {CommandInterface::valve, "valve",
+     "pilot pressures per spool end (CMD_PILOT) from the valve stage: a hydraulic machine's main valves"},
 }}};
 
 struct ControllerConfig {
@@ -62,6 +72,9 @@ struct ControllerConfig {
   double actuator_lag = 0;            // s
   double actuator_lag_target = 0.005; // s
 
+  // The bus's command set, and for valves the valve stage's settings (force loop, spool lead).
+  CommandInterface command_interface = CommandInterface::effort;
+  ValveLoopSettings valves;
   // Flow-based position control (flow_position_control.hpp): u = qd_d - flow_kp e, 1/s. 3 rad/s
   // keeps the position loop below a third of the boom's 2-3 Hz oil column (hydraulics.md).
   Vec4 flow_kp = Vec4::Constant(3);

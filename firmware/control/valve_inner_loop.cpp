@@ -6,11 +6,8 @@
 namespace exc::control {
 namespace {
 
-// The orifice law per unit gain: sqrt(dp), linear below the laminar pressure (same value there).
-double orifice(double dp, double laminar) {
-  if (dp <= 0) return 0;
-  return dp < laminar ? dp / std::sqrt(laminar) : std::sqrt(dp);
-}
+// The orifice law per unit gain for a drop across it (none when the drop is not positive).
+double orifice(double dp, double laminar) { return dp > 0 ? orifice_unit_flow(dp, laminar) : 0.0; }
 
 EffortLimits spool_limits() {
   EffortLimits l;
@@ -21,10 +18,19 @@ EffortLimits spool_limits() {
 
 }  // namespace
 
+ValveLoopModel valve_loop_model(const Machine& nominal) {
+  ValveLoopModel m;
+  m.geometry = hydraulic_geometry(nominal);
+  m.hydraulics = nominal.hydraulics;
+  m.q_min = nominal.q_min();
+  m.q_max = nominal.q_max();
+  return m;
+}
+
 ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSettings& settings, double period)
     : model_(model),
       settings_(settings),
-      spool_lead_(settings.spool_lag_target > 0 ? model.spool_time_constant : 0.0,
+      spool_lead_(settings.spool_lag_target > 0 ? model.hydraulics.valve_time_constant : 0.0,
                   settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()) {}
 
 void ValveInnerLoop::reset() {
@@ -33,43 +39,45 @@ void ValveInnerLoop::reset() {
 }
 
 Vec4 ValveInnerLoop::measured_force(const Vec4& p_a, const Vec4& p_b) const {
-  return model_.area_a.cwiseProduct(p_a) - model_.area_b.cwiseProduct(p_b);
+  return model_.geometry.area_a.cwiseProduct(p_a) - model_.geometry.area_b.cwiseProduct(p_b);
 }
 
 Vec4 ValveInnerLoop::hydraulic_stiffness(const Vec4& q) const {
+  const HydraulicGeometry& g = model_.geometry;
+  const HydraulicParameters& h = model_.hydraulics;
   Vec4 k;
   for (int i = 0; i < kNumActive; ++i) {
-    double v_a = model_.swing_volume, v_b = model_.swing_volume;
+    double v_a = h.swing_volume, v_b = h.swing_volume;
     if (i > 0) {
       const double stroke = std::clamp(q[i] - model_.q_min[i], 0.0, model_.q_max[i] - model_.q_min[i]);
-      v_a = model_.dead_volume + model_.area_a[i] * stroke;
-      v_b = model_.dead_volume + model_.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
+      v_a = h.dead_volume + g.area_a[i] * stroke;
+      v_b = h.dead_volume + g.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
     }
-    k[i] = model_.bulk_modulus * (model_.area_a[i] * model_.area_a[i] / v_a + model_.area_b[i] * model_.area_b[i] / v_b);
+    k[i] = h.bulk_modulus * (g.area_a[i] * g.area_a[i] / v_a + g.area_b[i] * g.area_b[i] / v_b);
   }
   return k;
 }
 
 double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) const {
   if (u == 0) return 0;
+  const HydraulicGeometry& g = model_.geometry;
+  const HydraulicParameters& h = model_.hydraulics;
   const bool extend = u > 0;
   // Meter-in: the compensator holds the margin across it unless the load nears the main relief.
   const double load = extend ? p_a : p_b;
-  const double drop_in = std::min(model_.load_sensing_margin, model_.main_relief - load);
-  const double k_in = extend ? model_.k_in_a[i] : model_.k_in_b[i];
-  const double area_in = extend ? model_.area_a[i] : model_.area_b[i];
-  const double flow_in = k_in * orifice(drop_in, model_.laminar_pressure);
+  const double drop_in = std::min(h.load_sensing_margin, model_.main_relief() - load);
+  const double k_in = extend ? g.meter_in_a[i] : g.meter_in_b[i];
+  const double area_in = extend ? g.area_a[i] : g.area_b[i];
+  const double flow_in = k_in * orifice(drop_in, h.laminar_pressure);
   double a = flow_in > 0 ? area_in * std::abs(u) / flow_in : 2.0;  // stalled at the relief: fully open
-  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills.
-  const double p_out = extend ? p_b : p_a;
-  const double k_out = extend ? model_.k_out_b[i] : model_.k_out_a[i];
-  const double area_out = extend ? model_.area_b[i] : model_.area_a[i];
-  const double flow_out = k_out * orifice(p_out - model_.tank_pressure, model_.laminar_pressure);
-  // Only while the filling chamber is down at the make-up (within the laminar pressure of tank): a
-  // resisting load keeps it above, and then the meter-in alone sets the speed.
-  const double p_in = extend ? p_a : p_b;
-  if (flow_out > 0 && p_in < model_.tank_pressure + model_.laminar_pressure)
-    a = std::min(a, area_out * std::abs(u) / flow_out);
+  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills
+  // the other side. Only while that side is down at the make-up (within the laminar pressure of
+  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed.
+  const double p_in = extend ? p_a : p_b, p_out = extend ? p_b : p_a;
+  const double k_out = extend ? g.meter_out_b[i] : g.meter_out_a[i];
+  const double area_out = extend ? g.area_b[i] : g.area_a[i];
+  const double flow_out = k_out * orifice(p_out - h.tank_pressure, h.laminar_pressure);
+  if (flow_out > 0 && p_in < h.tank_pressure + h.laminar_pressure) a = std::min(a, area_out * std::abs(u) / flow_out);
   return extend ? a : -a;
 }
 
@@ -106,19 +114,19 @@ void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
     }
     c.opening[i] = a;
     // Dead-zone inverse, continuous: linear from 0 to the band's edge, then z + (1 - z)|a|.
-    const double z = a >= 0 ? model_.dead_zone_extend[i] : model_.dead_zone_retract[i];
+    const double z = a >= 0 ? model_.hydraulics.dead_zone_extend[i] : model_.hydraulics.dead_zone_retract[i];
     const double m = std::abs(a);
     const double s = m >= band ? z + (1 - z) * m : (z + (1 - z) * band) * m / band;
     spool[i] = a >= 0 ? s : -s;
     // The meter-in flow this opening asks of the pumps (at the margin).
-    const double k_in = a >= 0 ? model_.k_in_a[i] : model_.k_in_b[i];
-    c.demanded_flow += k_in * m * orifice(model_.load_sensing_margin, model_.laminar_pressure);
+    const double k_in = a >= 0 ? model_.geometry.meter_in_a[i] : model_.geometry.meter_in_b[i];
+    c.demanded_flow += k_in * m * orifice(model_.hydraulics.load_sensing_margin, model_.hydraulics.laminar_pressure);
   }
-  c.pump_limited = c.demanded_flow > model_.pump_flow;
+  c.pump_limited = c.demanded_flow > model_.hydraulics.pump_flow;
   c.spool = spool_lead_.apply(spool);
   for (int i = 0; i < kNumActive; ++i) {
-    c.pilot_a[i] = std::max(c.spool[i], 0.0) * model_.pilot_full_stroke;
-    c.pilot_b[i] = std::max(-c.spool[i], 0.0) * model_.pilot_full_stroke;
+    c.pilot_a[i] = std::max(c.spool[i], 0.0) * model_.hydraulics.pilot_full_stroke;
+    c.pilot_b[i] = std::max(-c.spool[i], 0.0) * model_.hydraulics.pilot_full_stroke;
   }
 }
 

@@ -19,34 +19,27 @@
 //                (ActuatorLagCompensator on the spool position, limits -1..1).
 //   pilots       p_pilot_A = max(s, 0) p_full, p_pilot_B = max(-s, 0) p_full.
 //
-// f(dp) is the orifice law with its laminar branch. Allocation-free after construction; the update
-// calls never throw.
+// f(dp) is the orifice law with its laminar branch (model/hydraulic_geometry.hpp, shared with the
+// plant). Allocation-free after construction; the update calls never throw.
 #include <cstdint>
 
 #include "control/actuator_lag_compensator.hpp"
-#include "model/types.hpp"
+#include "model/hydraulic_geometry.hpp"
+#include "model/machine.hpp"
 
 namespace exc::control {
 
-// The nominal hydraulic machine as the inner loop sees it (valve_loop_model() fills it from the
-// firmware's machine file). Per function: swing, boom, arm, bucket.
+// The nominal hydraulic machine as the valve stage sees it: the firmware's machine file (its
+// hydraulics section and the geometry derived from it, as the plant derives its own).
 struct ValveLoopModel {
-  Vec4 area_a = Vec4::Zero(), area_b = Vec4::Zero();   // m^2 (swing: displacement m^3/rad, both ports)
-  Vec4 k_in_a = Vec4::Zero(), k_in_b = Vec4::Zero();   // fully open meter-in into A / B, m^3/s/sqrt(Pa)
-  Vec4 k_out_a = Vec4::Zero(), k_out_b = Vec4::Zero(); // fully open meter-out from A / B
-  Vec4 dead_zone_extend = Vec4::Zero(), dead_zone_retract = Vec4::Zero();  // of the spool stroke
-  Vec4 q_min = Vec4::Zero(), q_max = Vec4::Zero();     // strokes (chamber volumes)
-  double bulk_modulus = 1e9;         // Pa
-  double dead_volume = 0.002;        // m^3 per cylinder chamber at zero stroke
-  double swing_volume = 0.01;        // m^3 per swing motor side
-  double load_sensing_margin = 2e6;  // Pa
-  double main_relief = 34.3e6;       // Pa
-  double tank_pressure = 0.3e6;      // Pa
-  double laminar_pressure = 0.2e6;   // Pa
-  double pump_flow = 439.0 / 60000;  // m^3/s, both pumps
-  double spool_time_constant = 0.03; // s
-  double pilot_full_stroke = 5e6;    // Pa
+  HydraulicGeometry geometry;
+  HydraulicParameters hydraulics;
+  Vec4 q_min = Vec4::Zero(), q_max = Vec4::Zero();  // strokes (chamber volumes)
+  double main_relief() const {
+    return hydraulics.supply_pressure > 0 ? hydraulics.supply_pressure : hydraulics.main_relief_pressure;
+  }
 };
+ValveLoopModel valve_loop_model(const Machine& nominal);
 
 struct ValveLoopSettings {
   double force_time_constant = 0.04;  // s, T_f: the force loop's time constant

@@ -20,29 +20,32 @@ constexpr double kPeriod = 1e-3;
 // A round-number machine so the expectations below are hand-computable.
 ValveLoopModel simple_model() {
   ValveLoopModel m;
-  m.area_a = Vec4(1e-4, 0.02, 0.015, 0.01);
-  m.area_b = Vec4(1e-4, 0.01, 0.008, 0.005);
+  HydraulicGeometry& g = m.geometry;
+  HydraulicParameters& h = m.hydraulics;
+  g.area_a = Vec4(1e-4, 0.02, 0.015, 0.01);
+  g.area_b = Vec4(1e-4, 0.01, 0.008, 0.005);
   const Vec4 speed(1.0, 0.3, 0.5, 0.7);  // the fully open meter-in passes A * speed at the margin
-  m.load_sensing_margin = 2e6;
-  m.laminar_pressure = 0.2e6;
-  m.tank_pressure = 0.3e6;
-  m.main_relief = 34e6;
+  h.load_sensing_margin = 2e6;
+  h.laminar_pressure = 0.2e6;
+  h.tank_pressure = 0.3e6;
+  h.main_relief_pressure = 34e6;
+  h.supply_pressure = 0;
   for (int i = 0; i < 4; ++i) {
-    m.k_in_a[i] = m.area_a[i] * speed[i] / std::sqrt(2e6);
-    m.k_in_b[i] = m.area_b[i] * speed[i] / std::sqrt(2e6);
-    m.k_out_a[i] = m.area_a[i] * speed[i] / std::sqrt(5e6);  // at a 5 MPa drop
-    m.k_out_b[i] = m.area_b[i] * speed[i] / std::sqrt(5e6);
+    g.meter_in_a[i] = g.area_a[i] * speed[i] / std::sqrt(2e6);
+    g.meter_in_b[i] = g.area_b[i] * speed[i] / std::sqrt(2e6);
+    g.meter_out_a[i] = g.area_a[i] * speed[i] / std::sqrt(5e6);  // at a 5 MPa drop
+    g.meter_out_b[i] = g.area_b[i] * speed[i] / std::sqrt(5e6);
   }
-  m.dead_zone_extend = Vec4(0.1, 0.15, 0.2, 0.25);
-  m.dead_zone_retract = Vec4(0.12, 0.17, 0.22, 0.27);
+  h.dead_zone_extend = Vec4(0.1, 0.15, 0.2, 0.25);
+  h.dead_zone_retract = Vec4(0.12, 0.17, 0.22, 0.27);
   m.q_min = Vec4(-10, 1.0, 1.0, 1.0);
   m.q_max = Vec4(10, 2.0, 2.0, 2.0);
-  m.bulk_modulus = 1e9;
-  m.dead_volume = 0.002;
-  m.swing_volume = 0.01;
-  m.pump_flow = 0.007;
-  m.spool_time_constant = 0.03;
-  m.pilot_full_stroke = 5e6;
+  h.bulk_modulus = 1e9;
+  h.dead_volume = 0.002;
+  h.swing_volume = 0.01;
+  h.pump_flow = 0.007;
+  h.valve_time_constant = 0.03;
+  h.pilot_full_stroke = 5e6;
   return m;
 }
 
@@ -84,12 +87,12 @@ TEST_CASE("firmware/valve stage's orifice map passes the asked flow through the 
   ValveInnerLoop loop(m, no_lead(), kPeriod);
   for (int i = 0; i < 4; ++i) {
     // Extending at 40 % of the speed limit through the meter-in into A at the 2 MPa margin.
-    const double u_ext = 0.4 * std::sqrt(2e6) * m.k_in_a[i] / m.area_a[i];
+    const double u_ext = 0.4 * std::sqrt(2e6) * m.geometry.meter_in_a[i] / m.geometry.area_a[i];
     const double a = loop.opening_for(i, u_ext, kLowP[i], kLowP[i]);
-    CHECK(m.k_in_a[i] * a * std::sqrt(2e6) == doctest::Approx(m.area_a[i] * u_ext));
+    CHECK(m.geometry.meter_in_a[i] * a * std::sqrt(2e6) == doctest::Approx(m.geometry.area_a[i] * u_ext));
     CHECK(a == doctest::Approx(0.4));
     // Retracting: into B.
-    const double b = loop.opening_for(i, -0.25 * std::sqrt(2e6) * m.k_in_b[i] / m.area_b[i], kLowP[i], kLowP[i]);
+    const double b = loop.opening_for(i, -0.25 * std::sqrt(2e6) * m.geometry.meter_in_b[i] / m.geometry.area_b[i], kLowP[i], kLowP[i]);
     CHECK(b == doctest::Approx(-0.25));
   }
   CHECK(loop.opening_for(1, 0.0, 5e6, 5e6) == 0.0);
@@ -117,13 +120,13 @@ TEST_CASE("firmware/valve stage meters an overrunning load out (the filling side
   ValveInnerLoop loop(m, no_lead(), kPeriod);
   // Boom lowering under its weight: the rod side B fills (at tank, held by the make-up), the bore
   // side A carries the load at 15 MPa and its meter-out sets the speed: A_A u = K_out,A a sqrt(dp).
-  const double u = -0.1, p_a = 15e6, p_b = m.tank_pressure;
+  const double u = -0.1, p_a = 15e6, p_b = m.hydraulics.tank_pressure;
   const double a = loop.opening_for(1, u, p_a, p_b);
   CHECK(a < 0);
-  CHECK(m.k_out_a[1] * -a * std::sqrt(p_a - m.tank_pressure) == doctest::Approx(m.area_a[1] * 0.1));
+  CHECK(m.geometry.meter_out_a[1] * -a * std::sqrt(p_a - m.hydraulics.tank_pressure) == doctest::Approx(m.geometry.area_a[1] * 0.1));
   // The same speed against a resisting load (B well above tank): the meter-in decides.
   const double resisting = loop.opening_for(1, u, p_a, 3e6);
-  CHECK(m.k_in_b[1] * -resisting * std::sqrt(2e6) == doctest::Approx(m.area_b[1] * 0.1));
+  CHECK(m.geometry.meter_in_b[1] * -resisting * std::sqrt(2e6) == doctest::Approx(m.geometry.area_b[1] * 0.1));
 }
 
 TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates at the valve's limit") {
@@ -137,7 +140,7 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
       u[i] = frac * speed[i];
       const ValveCommand& c = loop.from_velocity(u, kMid, kLowP, kLowP);
       // The plant's metering opening of this spool: (|s| - z) / (1 - z) past the dead zone z.
-      const double z = frac > 0 ? m.dead_zone_extend[i] : m.dead_zone_retract[i];
+      const double z = frac > 0 ? m.hydraulics.dead_zone_extend[i] : m.hydraulics.dead_zone_retract[i];
       const double opened = (std::abs(c.spool[i]) - z) / (1 - z);
       CHECK(opened == doctest::Approx(std::abs(frac)));
       CHECK((c.spool[i] > 0) == (frac > 0));
@@ -146,7 +149,7 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
     // Inside the band the inverse runs linearly to zero: no jump to the dead zone's edge.
     Vec4 u = Vec4::Zero();
     u[i] = 1e-3 * s.opening_band * speed[i];
-    const double z = m.dead_zone_extend[i];
+    const double z = m.hydraulics.dead_zone_extend[i];
     CHECK(loop.from_velocity(u, kMid, kLowP, kLowP).spool[i] ==
           doctest::Approx(1e-3 * (z + (1 - z) * s.opening_band)));
     CHECK(loop.from_velocity(Vec4::Zero(), kMid, kLowP, kLowP).spool[i] == 0.0);
@@ -195,7 +198,7 @@ TEST_CASE("firmware/valve stage's spool lead makes the 30 ms spool answer with i
   // The real spool: y' = (c - y) / 30 ms, integrated with 20 Euler substeps per period (independent
   // of the stage's exact exponential model).
   auto spool_step = [&](double y, double c) {
-    for (int k = 0; k < 20; ++k) y += kPeriod / 20 * (c - y) / m.spool_time_constant;
+    for (int k = 0; k < 20; ++k) y += kPeriod / 20 * (c - y) / m.hydraulics.valve_time_constant;
     return y;
   };
   const Vec4 u(0, 0.3 * 0.3, 0, 0);  // boom at 30 % of its speed: spool target 0.15 + 0.85 * 0.3
@@ -217,11 +220,11 @@ TEST_CASE("firmware/valve stage counts the pumps' flow the openings ask for") {
   ValveInnerLoop loop(m, no_lead(), kPeriod);
   const Vec4 speed(1.0, 0.3, 0.5, 0.7);
   const ValveCommand& half = loop.from_velocity(0.2 * speed, kMid, kLowP, kLowP);
-  const double expected = 0.2 * (m.area_a.dot(speed));
+  const double expected = 0.2 * (m.geometry.area_a.dot(speed));
   CHECK(half.demanded_flow == doctest::Approx(expected));
-  CHECK(half.pump_limited == (expected > m.pump_flow));
+  CHECK(half.pump_limited == (expected > m.hydraulics.pump_flow));
   const ValveCommand& full = loop.from_velocity(0.99 * speed, kMid, kLowP, kLowP);
-  CHECK(full.demanded_flow == doctest::Approx(0.99 * m.area_a.dot(speed)));
+  CHECK(full.demanded_flow == doctest::Approx(0.99 * m.geometry.area_a.dot(speed)));
   CHECK(full.pump_limited);  // 0.020 m^3/s against 0.007
 }
 
