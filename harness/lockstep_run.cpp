@@ -145,6 +145,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   const std::vector<double>& starts = firmware.task.cycle_starts;
   std::vector<CycleRecord> cycles_acc(std::max<std::size_t>(1, starts.size()));
   std::vector<std::array<double, 4>> cycle_sum_sq(cycles_acc.size(), std::array<double, 4>{});
+  const bool hydraulic = scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
+  result.hydraulic = hydraulic;
+  if (hydraulic) result.min_pressure = result.peak_pressure = plant.state().hydraulics.min_pressure;
   const double cpu_start = thread_cpu_seconds();
   {
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
@@ -168,6 +171,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
       node.end_cycle();
       const plant::PlantState& s = plant.state();
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
+      if (hydraulic) {
+        result.peak_pressure = std::max(result.peak_pressure, s.hydraulics.max_pressure);
+        result.min_pressure = std::min(result.min_pressure, s.hydraulics.min_pressure);
+      }
       if (node.tracking()) {
         metrics.add(s.q_a, node.q_desired());
         const double tt = node.task_time();
@@ -236,6 +243,14 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     for (int j = 0; j < 4; ++j)
       rec.rms_error[j] = rec.samples ? std::sqrt(cycle_sum_sq[c][j] / static_cast<double>(rec.samples)) : 0;
     if (rec.samples > 0) result.cycles.push_back(rec);
+  }
+  if (hydraulic) {
+    const plant::HydraulicReport& h = plant.state().hydraulics;
+    const double step = scene.integrator.step;
+    result.flow_saturated_seconds = static_cast<double>(h.saturated_substeps) * step;
+    result.relief_seconds = static_cast<double>(h.relief_substeps) * step;
+    result.cavitation_seconds = static_cast<double>(h.cavitation_substeps) * step;
+    result.pump_limited_cycles = node.pump_limited_cycles();
   }
   result.task_finished = node.trajectory_finished();
   result.task_finish_time = node.finish_time();

@@ -87,6 +87,15 @@ struct RunRecord {
   std::size_t telemetry_ring_high_water = 0;
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
+  // The hydraulic machine (zeros for force-commanded fidelities), from the plant's true circuit and
+  // the firmware's valve stage.
+  bool hydraulic = false;
+  double peak_pressure = 0;           // Pa, the highest chamber pressure of the run
+  double min_pressure = 0;            // Pa, the lowest (never below the vapour floor: the plant checks)
+  double flow_saturated_seconds = 0;  // s the pumps' demand was above their flow (every function slowed)
+  double relief_seconds = 0;          // s with a relief valve open
+  double cavitation_seconds = 0;      // s with a chamber held at the vapour floor by the make-up
+  std::uint64_t pump_limited_cycles = 0;  // firmware cycles whose openings asked more than the pumps give
   bool task_finished = false;         // the task ran to its end (then the machine held its final pose)
   double task_finish_time = 0;        // s
 };

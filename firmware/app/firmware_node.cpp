@@ -264,6 +264,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
 
 void FirmwareNode::command_valves(const Vec4& q) {
   const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  valves_.set_holding(machine_.mode() == control::Mode::hold, out_.e);
   const control::ValveCommand* v = nullptr;
   if (out_.velocity_command) {
     v = &valves_.from_velocity(out_.velocity, q, p_a, p_b);
@@ -278,7 +279,8 @@ void FirmwareNode::command_valves(const Vec4& q) {
     }
     const Vec4 tau = blender_.apply(time(), out_.tau);
     last_sent_ = tau;
-    v = &valves_.from_force(tau, qd_d_, q, p_a, p_b);
+    const Vec4 v_ff = qd_d_ - valves_.settings().position_gain.cwiseProduct(out_.e);
+    v = &valves_.from_force(tau, v_ff, q, p_a, p_b);
   }
   if (v->pump_limited) ++pump_limited_cycles_;
   command_.mode = hal::CommandMode::pilot;

@@ -89,7 +89,11 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   v.number("force_time_constant", c.valves.force_time_constant, {1e-3, 1}, "s", "T_f: the force loop's time constant");
   v.number("spool_lag_target", c.valves.spool_lag_target, {0, 1}, "s",
            "the spool lag the lead aims for (0: no lead); at most the machine's valve_time_constant");
-  v.number("opening_band", c.valves.opening_band, {1e-4, 0.5}, "", "opening below which the dead-zone inverse is linear");
+  v.number("opening_band", c.valves.opening_band, {0, 0.5}, "", "opening below which the dead-zone inverse is linear");
+  v.numbers("position_gain", c.valves.position_gain, {0, 1e3}, "1/s",
+            "flow feedforward qd_d - position_gain e: the valve stage's own position correction");
+  v.numbers("hold_window", c.valves.hold_window, {0, 0.1}, "",
+            "holding a pose: |e| (rad swing, m) inside which a function's valve stays centred");
   v.finish();
   SectionReader fl = r.section("flow", "flow-based position control (controller.type flow)");
   fl.numbers("kp", c.flow_kp, {0, 1e3}, "1/s", "position gains: u = qd_d - kp e");

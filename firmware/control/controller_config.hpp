@@ -75,9 +75,9 @@ struct ControllerConfig {
   // The bus's command set, and for valves the valve stage's settings (force loop, spool lead).
   CommandInterface command_interface = CommandInterface::effort;
   ValveLoopSettings valves;
-  // Flow-based position control (flow_position_control.hpp): u = qd_d - flow_kp e, 1/s. 3 rad/s
+  // Flow-based position control (flow_position_control.hpp): u = qd_d - flow_kp e, 1/s. 2 rad/s
   // keeps the position loop below a third of the boom's 2-3 Hz oil column (hydraulics.md).
-  Vec4 flow_kp = Vec4::Constant(3);
+  Vec4 flow_kp = Vec4::Constant(2);
 
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop

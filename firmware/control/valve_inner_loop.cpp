@@ -35,7 +35,21 @@ ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSetti
 
 void ValveInnerLoop::reset() {
   spool_lead_.reset(Vec4::Zero());
+  in_position_ = 0;
   command_ = ValveCommand{};
+}
+
+void ValveInnerLoop::set_holding(bool holding, const Vec4& error) {
+  if (!holding) {
+    in_position_ = 0;
+    return;
+  }
+  for (int i = 0; i < kNumActive; ++i) {
+    const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
+    const double e = std::abs(error[i]);
+    if (e < settings_.hold_window[i]) in_position_ |= bit;
+    else if (e > 2 * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
+  }
 }
 
 Vec4 ValveInnerLoop::measured_force(const Vec4& p_a, const Vec4& p_b) const {
@@ -107,6 +121,7 @@ void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
   Vec4 spool;
   const double band = settings_.opening_band;
   for (int i = 0; i < kNumActive; ++i) {
+    if ((in_position_ >> i) & 1u) c.velocity[i] = 0;
     double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], p_a[i], p_b[i]) : 0.0;
     if (std::abs(a) >= 1) {
       a = a > 0 ? 1.0 : -1.0;
@@ -116,7 +131,7 @@ void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
     // Dead-zone inverse, continuous: linear from 0 to the band's edge, then z + (1 - z)|a|.
     const double z = a >= 0 ? model_.hydraulics.dead_zone_extend[i] : model_.hydraulics.dead_zone_retract[i];
     const double m = std::abs(a);
-    const double s = m >= band ? z + (1 - z) * m : (z + (1 - z) * band) * m / band;
+    const double s = m == 0 ? 0.0 : m >= band ? z + (1 - z) * m : (z + (1 - z) * band) * m / band;
     spool[i] = a >= 0 ? s : -s;
     // The meter-in flow this opening asks of the pumps (at the margin).
     const double k_in = a >= 0 ? model_.geometry.meter_in_a[i] : model_.geometry.meter_in_b[i];

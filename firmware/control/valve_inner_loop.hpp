@@ -2,19 +2,27 @@
 // The inner loop between a control law and a hydraulic machine's valves (hydraulics.md, "How
 // published automation closes the loop"). Per function i (swing motor, boom, arm, bucket):
 //
-//   force loop   u = v_ff + (F_d - F) / (K_h(q) T_f)                       (m/s; swing rad/s)
+//   force loop   u = v_ff + (F_d - F) / (K_h(q) T_f),  v_ff = qd_d - K_x e     (m/s; swing rad/s)
 //                F = p_A A_A - p_B A_B from the measured chamber pressures (swing: D (p_A - p_B)),
 //                K_h = beta (A_A^2 / V_A(q) + A_B^2 / V_B(q)), the oil columns' stiffness. With u the
 //                flow the valve passes per piston area, dF/dt = K_h (u - qd): with v_ff = qd the
 //                force follows F_d with the time constant T_f; v_ff is the desired velocity (the
-//                flow feedforward), equal to qd while the machine tracks.
+//                flow feedforward), equal to qd while the machine tracks, with the position error's
+//                correction K_x e (position_gain) that a stiff oil column needs.
 //   (a flow law, FlowPositionControl, gives u directly and skips the force loop)
 //   orifice map  the opening that passes the flow A u: the pressure-compensated meter-in
 //                a_in = A_in |u| / (K_in f(min(margin, p_relief - p_load))) and, for an overrunning
 //                load, the meter-out a_out = A_out |u| / (K_out f(p_out - p_tank)) that holds it
 //                back; a = min(a_in, a_out), at most 1 (the valve's limit: flagged, anti-windup).
 //   dead zone    spool s = sign(a) (z + (1 - z) |a|) with the nominal dead zone z of the direction,
-//                linear through zero over |a| < opening_band so the command stays continuous.
+//                linear through zero over |a| < opening_band (a narrow band above the command's
+//                noise: any continuous inverse leaves the valve shut for |a| below about the band, a
+//                dead band in the loop, so the band stays small).
+//   in position  while the machine holds a pose (mode hold), a function whose error is inside
+//                hold_window is left with its valve centred, the load held by the closed valve as an
+//                operator's machine holds it; it is corrected again once the error exceeds twice the
+//                window. Without it the dead-zone inverse and the spool's lag make a valve hunt
+//                around the pose (docs/control.md: a growing limit cycle of the flow law).
 //   spool lead   the pilot-operated spool's first-order lag T_s made to look like the shorter T_t
 //                (ActuatorLagCompensator on the spool position, limits -1..1).
 //   pilots       p_pilot_A = max(s, 0) p_full, p_pilot_B = max(-s, 0) p_full.
@@ -42,9 +50,16 @@ struct ValveLoopModel {
 ValveLoopModel valve_loop_model(const Machine& nominal);
 
 struct ValveLoopSettings {
-  double force_time_constant = 0.04;  // s, T_f: the force loop's time constant
+  double force_time_constant = 0.03;  // s, T_f: the force loop's time constant (the spool's lag, docs/control.md)
   double spool_lag_target = 0.01;     // s, T_t the spool lead aims for (0: no lead)
-  double opening_band = 0.02;         // opening below which the dead-zone inverse is linear
+  double opening_band = 0.002;        // opening below which the dead-zone inverse is linear
+  // 1/s: the flow feedforward v_ff = qd_d - position_gain e also corrects the position, as the flow
+  // law does: the force loop alone meters flow only in proportion to a force error, so a small
+  // position error of a stiff oil column is left uncorrected (dig: arm 2.4 -> 1.4 mm, bucket
+  // 4.2 -> 1.3 mm RMS with 2/s; docs/control.md).
+  Vec4 position_gain = Vec4::Constant(2);
+  // Holding a pose: |e| below which a function's valve stays centred (rad swing, m cylinders).
+  Vec4 hold_window = Vec4::Constant(1e-3);
 };
 
 // What the valve stage sends and what it found.
@@ -68,6 +83,10 @@ class ValveInnerLoop {
 
   // Spool model and lead restart from the centred spool.
   void reset();
+  // Each cycle before the update: holding a pose (true, with the error e = q - q_d) or moving (false).
+  // Holding, a function inside its window is centred until its error exceeds twice the window.
+  void set_holding(bool holding, const Vec4& error);
+  std::uint8_t in_position() const { return in_position_; }
 
   // Force loop: the desired efforts of the outer law, the flow feedforward v_ff, the measured
   // positions and chamber pressures (per function; swing ports first).
@@ -91,6 +110,7 @@ class ValveInnerLoop {
   ValveLoopModel model_;
   ValveLoopSettings settings_;
   ActuatorLagCompensator spool_lead_;
+  std::uint8_t in_position_ = 0;  // bit i: function i centred, in position
   ValveCommand command_;
 };
 

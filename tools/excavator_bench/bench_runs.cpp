@@ -153,6 +153,13 @@ constexpr std::array<int, 6> kCylinderBodies = {kBoomBarrel, kBoomRod, kArmBarre
 
 }  // namespace
 
+void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators) {
+  const bool hydraulic = actuators.fidelity == plant::ActuatorFidelity::hydraulic;
+  c.command_interface = hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort;
+  c.actuator_lag = actuators.fidelity == plant::ActuatorFidelity::limited ? actuators.lag : 0.0;
+  if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
+}
+
 ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v) {
   plant::Scene scene = s.scene;
   scene.actuators.fidelity = v.fidelity;
@@ -187,6 +194,9 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
   fw.duration = scene.duration;
   control::ControllerConfig& cc = fw.controller;
   cc = s.controller;
+  // The firmware as it is set up for the machine it drives: valves for the hydraulic machine, efforts
+  // (with the lag compensated) for the force-commanded ones.
+  configure_for_fidelity(cc, scene.actuators);
   const double g = v.gain_scale;
   cc.gains.kp *= g * g;
   cc.gains.kv *= g;

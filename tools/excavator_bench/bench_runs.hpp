@@ -91,6 +91,10 @@ struct ClosedLoopResult {
   double tracking_max = 0;        // worst joint, m or rad
 };
 
+// The firmware's settings for the machine it drives: the valve interface for the hydraulic fidelity,
+// efforts otherwise, with the limited actuators' lag compensated (and none for ideal ones).
+void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators);
+
 ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v);
 
 // Thread CPU time in seconds (not disturbed by other processes on the machine).

@@ -36,9 +36,6 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
     add("massless cylinders + ideal + soil", plant::ActuatorFidelity::ideal, true, true);
     add("12-link + ideal + no soil", plant::ActuatorFidelity::ideal, false, false);
     add("massless cylinders + ideal + no soil", plant::ActuatorFidelity::ideal, false, true);
-    // The firmware commands efforts; a hydraulic plant takes valve openings, so with this firmware
-    // its valves stay closed. Its row is shown but it is neither the reference nor a candidate.
-    auto drivable = [&](std::size_t i) { return variants[i].v.fidelity != plant::ActuatorFidelity::hydraulic; };
     std::vector<ClosedLoopResult> results;
     for (const Variant& x : variants) {
       progress("fidelity %s: %s\n", s.name, x.name);
@@ -46,7 +43,7 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
     }
     int ref = -1;
     for (std::size_t i = 0; i < results.size() && ref < 0; ++i)
-      if (results[i].ok && drivable(i)) ref = static_cast<int>(i);
+      if (results[i].ok) ref = static_cast<int>(i);
     double ref_force = 0;
     if (ref >= 0) {
       for (const Vec4& e : results[ref].effort) ref_force += e.tail<3>().squaredNorm();
@@ -58,7 +55,7 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
       row.scene = s.name;
       row.fidelity = variants[i].name;
       row.ok = r.ok;
-      row.failure = drivable(i) ? r.failure : "not driven: the firmware sends efforts, this plant takes valve openings";
+      row.failure = r.failure;
       if (r.ok && ref >= 0) {
         const ClosedLoopResult& R = results[ref];
         row.cpu_per_s = r.cpu_seconds / r.simulated;
@@ -69,7 +66,7 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
         row.force_rel = n ? std::sqrt(sum / static_cast<double>(n)) / std::max(ref_force, 1.0) : NAN;
         row.tracking = worst_tracking(r);
         row.tracking_diff = std::abs(row.tracking - worst_tracking(R));
-        row.within = drivable(i) && row.tip_rms <= kTipTolerance && row.force_rel <= kForceTolerance &&
+        row.within = row.tip_rms <= kTipTolerance && row.force_rel <= kForceTolerance &&
                      row.tracking_diff <= kTrackingTolerance;
       }
       rows.push_back(row);

@@ -24,12 +24,17 @@ std::string describe_setup(const SceneBundle& bundle) {
   std::ostringstream o;
   o << "actuators " << plant::to_string(sc.actuators.fidelity);
   if (sc.actuators.fidelity == plant::ActuatorFidelity::limited) o << " (effort lag " << sc.actuators.lag * 1e3 << " ms)";
-  o << ", firmware lag compensation ";
   const control::ControllerConfig& c = bundle.firmware.controller;
-  if (c.actuator_lag > 0)
-    o << c.actuator_lag * 1e3 << " ms -> " << c.actuator_lag_target * 1e3 << " ms";
-  else
-    o << "off";
+  if (c.command_interface == control::CommandInterface::valve) {
+    o << ", firmware commands the valves (pilot pressures; force loop T_f " << c.valves.force_time_constant * 1e3
+      << " ms, spool lead to " << c.valves.spool_lag_target * 1e3 << " ms)";
+  } else {
+    o << ", firmware commands efforts, lag compensation ";
+    if (c.actuator_lag > 0)
+      o << c.actuator_lag * 1e3 << " ms -> " << c.actuator_lag_target * 1e3 << " ms";
+    else
+      o << "off";
+  }
   if (bundle.firmware.task.timing_scale != 1)
     o << "; task timing scaled by " << bundle.firmware.task.timing_scale << " to fit the actuators' limits";
   o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)

@@ -29,7 +29,7 @@ int main(int argc, char** argv) {
       "  excavator-sim run scenes/dig.yaml            PID and adaptive, summary, log, plots, report\n"
       "  excavator-sim run scenes/dig.yaml --controller adaptive --json out.json\n"
       "  excavator-sim robustness scenes/dig.yaml     the same with wrong masses, noise, delay, stiffer soil\n"
-      "  excavator-sim paper --out out/paper          both shipped scenes and the paper's Figs. 4-12\n"
+      "  excavator-sim paper --out out/paper          the paper's Figs. 4-12, then the dig through the valves\n"
       "  excavator-sim config scenes/dig.yaml         the scene's effective configuration (every default filled in)"};
   app.require_subcommand(1);
   auto* run = app.add_subcommand("run", "run a scene with one or more controllers");
@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
   run->add_option("scene", scene_path, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   run->add_option("--controller", controllers,
                   "controller(s) to run: " + exc::control::kControllerKinds.names() +
-                      " (default: the scene's controller.type, else pid and adaptive)")
+                      " (default: the scene's controller.type, else pid and adaptive, and flow on a valve-commanded scene)")
       ->delimiter(',');
   run->add_option("--out", out_dir, "output directory (default: out/<scene name>)");
   run->add_option("--json", json_path, "also write the summary as JSON to this file");
@@ -76,14 +76,19 @@ int main(int argc, char** argv) {
                      "output directory for robustness.json and robustness.png (default: out/<scene name>-robustness)");
   robust->add_flag("--no-plots", robust_no_plots, "skip robustness.png");
   auto* paper = app.add_subcommand(
-      "paper", "the paper's whole figure set: the free-motion scene (Figs. 4-7) and the digging scene (Figs. 8-12), "
-               "each with PID and adaptive, their reports, and one page with every figure under the paper's number");
-  std::string paper_free = "scenes/free_motion.yaml", paper_dig = "scenes/dig.yaml", paper_out = "out/paper";
+      "paper", "the paper's whole figure set: the free-motion scene (Figs. 4-7) and the digging scene (Figs. 8-12) with "
+               "the paper's force actuators, each with PID and adaptive, then the same dig through a hydraulic "
+               "machine's valves with PID, adaptive and flow-based control; their reports, and one page with every "
+               "figure under the paper's number and the hydraulic machine's figures");
+  std::string paper_free = "scenes/paper_free_motion.yaml", paper_dig = "scenes/paper_dig.yaml",
+              paper_hydraulic = "scenes/dig.yaml", paper_out = "out/paper";
   double paper_duration = 0;
   bool paper_quiet = false;
-  paper->add_option("--free-motion", paper_free, "the free-motion scene (default: scenes/free_motion.yaml)");
-  paper->add_option("--dig", paper_dig, "the digging scene (default: scenes/dig.yaml)");
-  paper->add_option("--out", paper_out, "output directory (default: out/paper): report.md, free_motion/, dig/");
+  paper->add_option("--free-motion", paper_free, "the free-motion scene (default: scenes/paper_free_motion.yaml)");
+  paper->add_option("--dig", paper_dig, "the digging scene (default: scenes/paper_dig.yaml)");
+  paper->add_option("--hydraulic-dig", paper_hydraulic, "the dig through the valves (default: scenes/dig.yaml)");
+  paper->add_option("--out", paper_out,
+                    "output directory (default: out/paper): report.md, free_motion/, dig/, hydraulic_dig/");
   paper->add_option("--duration", paper_duration, "simulated seconds of each scene (default: each scene's)")
       ->check(CLI::PositiveNumber);
   paper->add_flag("--quiet", paper_quiet, "no progress output");
@@ -188,26 +193,29 @@ int main(int argc, char** argv) {
 
   if (paper->parsed()) {
     try {
-      // Both shipped scenes, each into its own folder with its own report, then the paper's page.
+      // The three scenes, each into its own folder with its own report, then the paper's page.
       const fs::path out = paper_out;
       fs::create_directories(out);
-      exc::sim::SceneJob free_job, dig_job;
+      exc::sim::SceneJob free_job, dig_job, hydraulic_job;
       free_job.scene_path = paper_free;
       free_job.out_dir = out / "free_motion";
       dig_job.scene_path = paper_dig;
       dig_job.out_dir = out / "dig";
-      for (exc::sim::SceneJob* job : {&free_job, &dig_job}) {
+      hydraulic_job.scene_path = paper_hydraulic;
+      hydraulic_job.out_dir = out / "hydraulic_dig";
+      for (exc::sim::SceneJob* job : {&free_job, &dig_job, &hydraulic_job}) {
         job->progress = !paper_quiet;
         job->duration = paper_duration;
       }
       const exc::sim::SceneJobResult free_result = exc::sim::run_scene_job(free_job);
       const exc::sim::SceneJobResult dig_result = exc::sim::run_scene_job(dig_job);
-      if (!exc::sim::write_paper_report(out, free_result, dig_result)) {
+      const exc::sim::SceneJobResult hydraulic_result = exc::sim::run_scene_job(hydraulic_job);
+      if (!exc::sim::write_paper_report(out, free_result, dig_result, hydraulic_result)) {
         std::cerr << "excavator-sim: cannot write " << (out / "report.md").string() << "\n";
         return 1;
       }
       std::cout << "paper figures: " << (out / "report.md").string() << "\n";
-      return std::max(free_result.exit_code, dig_result.exit_code);
+      return std::max({free_result.exit_code, dig_result.exit_code, hydraulic_result.exit_code});
     } catch (const std::exception& e) {
       std::cerr << "excavator-sim: " << e.what() << "\n";
       return 2;

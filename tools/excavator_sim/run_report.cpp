@@ -91,6 +91,11 @@ void print_summary(const Summary& summary, std::ostream& out) {
                   static_cast<unsigned long long>(r.heap_allocations_in_loop),
                   static_cast<unsigned long long>(r.telemetry_published), static_cast<unsigned long long>(r.telemetry_dropped),
                   r.simulated_seconds, r.wall_seconds, r.wall_seconds > 0 ? r.simulated_seconds / r.wall_seconds : 0.0);
+    if (r.hydraulic)
+      out << format("%-10s hydraulics: chamber pressures %.2f .. %.1f MPa; pumps short of flow %.2f s (firmware asked more "
+                    "in %llu cycles); reliefs open %.3f s; make-up at the vapour floor %.3f s\n",
+                    "", r.min_pressure * 1e-6, r.peak_pressure * 1e-6, r.flow_saturated_seconds,
+                    static_cast<unsigned long long>(r.pump_limited_cycles), r.relief_seconds, r.cavitation_seconds);
     if (!r.ok) out << "  FAILED: " << r.failure << "\n";
   }
 }
@@ -126,6 +131,13 @@ nlohmann::json to_json(const Summary& summary) {
     run["wall_seconds"] = r.wall_seconds;
     run["safe_stops"] = r.safe_stops;
     run["can_frames_rejected"] = r.rx_rejected;
+    if (r.hydraulic)
+      run["hydraulics"] = {{"peak_pressure", r.peak_pressure},
+                           {"min_pressure", r.min_pressure},
+                           {"flow_saturated_seconds", r.flow_saturated_seconds},
+                           {"pump_limited_cycles", r.pump_limited_cycles},
+                           {"relief_seconds", r.relief_seconds},
+                           {"cavitation_seconds", r.cavitation_seconds}};
     run["task_finished"] = r.task_finished;
     if (r.task_finished) run["task_finish_time"] = r.task_finish_time;
     nlohmann::json cycles = nlohmann::json::array();

@@ -18,7 +18,8 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   options.duration_override = job.duration;
   options.progress = job.progress;
   const SceneBundle bundle = load_scene_bundle(job.scene_path);
-  // Which controllers: --controller, else the scene's controller.type, else the paper's comparison.
+  // Which controllers: --controller, else the scene's controller.type, else the paper's comparison
+  // (and on a valve-commanded machine the industry's flow-based baseline beside it).
   const control::ControllerConfig& cc = bundle.firmware.controller;
   const std::string scene_kind = control::to_string(cc.kind);
   if (!job.controllers.empty() && cc.kind_given && job.controllers != std::vector<std::string>{scene_kind})
@@ -26,7 +27,9 @@ SceneJobResult run_scene_job(const SceneJob& job) {
                                 "; give one of them");
   options.controllers = !job.controllers.empty() ? job.controllers
                         : cc.kind_given          ? std::vector<std::string>{scene_kind}
-                                                 : std::vector<std::string>{"pid", "adaptive"};
+                        : cc.command_interface == control::CommandInterface::valve
+                            ? std::vector<std::string>{"pid", "adaptive", "flow"}
+                            : std::vector<std::string>{"pid", "adaptive"};
   result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   fs::create_directories(result.out_dir);
   // What the run used, every default filled in: it loads back to the same run.

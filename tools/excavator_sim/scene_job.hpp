@@ -13,7 +13,8 @@ namespace exc::sim {
 struct SceneJob {
   std::string scene_path;
   std::filesystem::path out_dir;         // empty: out/<scene name>
-  std::vector<std::string> controllers;  // empty: the scene's controller.type, else pid and adaptive
+  // empty: the scene's controller.type, else pid and adaptive (and flow on a valve-commanded machine)
+  std::vector<std::string> controllers;
   std::string lcm_url;                   // empty: file://<out>/run.lcm?mode=w
   std::string json_path;                 // also write the summary here (optional)
   double duration = 0;                   // s; 0: the scene's
