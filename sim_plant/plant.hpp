@@ -41,6 +41,7 @@ struct PlantState {
   double constraint_residual = 0;  // m, |h(q)|
   int end_stop_events = 0;         // substeps at which an end stop or a speed limit acted
   double end_stop_loss = 0;        // J the end stops' impacts and the speed limits took (inelastic), in the energy balance
+  double friction_loss = 0;        // J the hydraulic machine's seal friction took (in the energy balance)
   int implicit_iterations = 0;     // of the last substep (implicit_midpoint)
 };
 

@@ -154,6 +154,8 @@ void read_hydraulics(SectionReader& h, HydraulicParameters& p, double relief_pre
   h.number("pilot_full_stroke", p.pilot_full_stroke, {1e6, 10e6}, "Pa", "pilot pressure difference for full stroke");
   h.numbers("dead_zone_extend", p.dead_zone_extend, {0, 0.9}, "", "of the spool stroke, swing, boom, arm, bucket");
   h.numbers("dead_zone_retract", p.dead_zone_retract, {0, 0.9}, "", "of the spool stroke, swing, boom, arm, bucket");
+  h.numbers("viscous_friction", p.viscous_friction, {0, 1e7}, "",
+            "seal friction: N m s/rad (swing), N s/m (cylinders); it damps a held machine's oil columns");
   h.finish();
 }
 

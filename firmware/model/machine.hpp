@@ -99,6 +99,11 @@ struct HydraulicParameters {
   // machine and direction). Range [0, 0.9].
   Vec4 dead_zone_extend = Vec4::Constant(0.15);
   Vec4 dead_zone_retract = Vec4::Constant(0.15);
+  // Viscous friction of the cylinders' seals and the swing's drive (N s/m; swing N m s/rad): what
+  // damps a held machine's oil columns (estimate: 2-3 % of their critical damping at the dig pose,
+  // where they ring at 0.4, 3, 7.5 and 23 Hz; a few kN at working speeds, well under the Coulomb
+  // friction of real seals, which this model leaves out). Range [0, 1e7].
+  Vec4 viscous_friction = (Vec4() << 2e4, 1e5, 3e4, 1e4).finished();
 };
 
 struct Machine {

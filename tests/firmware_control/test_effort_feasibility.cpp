@@ -75,7 +75,7 @@ TEST_CASE("firmware/feasibility's time scale is exact: the rescaled path touches
 
 TEST_CASE("firmware/feasibility passes the shipped scenes' tasks and the test tasks") {
   const Model model = build_model(reference_machine());
-  for (const char* scene : {"dig.yaml", "free_motion.yaml"}) {
+  for (const char* scene : {"dig.yaml", "free_motion.yaml", "paper_dig.yaml", "paper_free_motion.yaml", "truck_loading.yaml"}) {
     const app::FirmwareSettings st = app::load_firmware_settings(std::string(EXC_SOURCE_DIR) + "/scenes/" + scene);
     FeasibilityOptions o;
     o.terrain_height = st.terrain_height;

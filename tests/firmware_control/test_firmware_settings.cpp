@@ -46,11 +46,27 @@ TEST_CASE("firmware/settings read the shipped dig scene's firmware sections as w
   CHECK(s.task.type == control::TaskType::dig);
   CHECK(s.task.path.size() == 6);           // six tip poses in the file
   CHECK(s.task.end_time() == doctest::Approx(10.0));
-  CHECK(s.controller.actuator_lag == doctest::Approx(0.02));
+  CHECK(s.controller.command_interface == control::CommandInterface::valve);  // a hydraulic machine
+  CHECK(s.controller.actuator_lag == 0.0);
+  CHECK(s.controller.adaptation_rate[2] == doctest::Approx(3e11));  // a tenth of the force-actuated rate
   CHECK(s.duration == doctest::Approx(10.0));
   CHECK(s.terrain_height == doctest::Approx(0.0));
   CHECK(s.machine_file.empty());  // no 'machine:' key: the built-in reference machine
   CHECK(s.machine.bodies.size() == reference_machine().bodies.size());
+}
+
+TEST_CASE("firmware/settings read the paper's force-actuated dig with the actuators' lag compensated") {
+  const app::FirmwareSettings s = app::load_firmware_settings(std::string(EXC_SOURCE_DIR) + "/scenes/paper_dig.yaml");
+  CHECK(s.name == "paper_dig");
+  CHECK(s.controller.command_interface == control::CommandInterface::effort);
+  CHECK(s.controller.actuator_lag == doctest::Approx(0.02));
+}
+
+TEST_CASE("firmware/settings refuse a flow law on the effort interface, naming both fields") {
+  check_error("name: x\nduration: 2\ncontroller: {type: flow}\n" + std::string(kTask), "controller.type", "flow",
+              "flow commands the valves' flow: it needs command_interface: valve");
+  CHECK(read("name: x\nduration: 2\ncontroller: {type: flow, command_interface: valve}\n" + std::string(kTask))
+            .controller.kind == control::ControllerKind::flow);
 }
 
 TEST_CASE("firmware/settings accept the plant's sections without reading them and refuse unknown ones") {

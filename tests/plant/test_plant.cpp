@@ -133,7 +133,8 @@ TEST_CASE("plant/step time per integrator: the median keeps pace with the 1 kHz 
 TEST_CASE("tools/excavator-plant-replay runs a scene from a CSV of efforts and writes the states") {
   const std::string dir = std::string(EXC_BINARY_DIR) + "/tests/plant";
   const std::string efforts = dir + "/replay_efforts.csv", out = dir + "/replay_out.csv";
-  Plant p(load_scene(std::string(EXC_SOURCE_DIR) + "/scenes/free_motion.yaml"));
+  // Efforts: a force-commanded scene (the hydraulic ones take valve commands).
+  Plant p(load_scene(std::string(EXC_SOURCE_DIR) + "/scenes/paper_free_motion.yaml"));
   const Vec4 hold = p.hold_effort();
   {
     std::ofstream f(efforts);
@@ -143,7 +144,7 @@ TEST_CASE("tools/excavator-plant-replay runs a scene from a CSV of efforts and w
     f << 0.05 << "," << hold[0] + 2000 << "," << hold[1] << "," << hold[2] << "," << hold[3] << "\n";
   }
   const std::string cmd = std::string(EXC_PLANT_REPLAY) + " --scene " + EXC_SOURCE_DIR +
-                          "/scenes/free_motion.yaml --efforts " + efforts + " --out " + out + " --duration 0.1";
+                          "/scenes/paper_free_motion.yaml --efforts " + efforts + " --out " + out + " --duration 0.1";
   REQUIRE(std::system(cmd.c_str()) == 0);
   // The same run through the library: the tool's last line must match it.
   ActuatorCommand c;

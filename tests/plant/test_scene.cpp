@@ -114,7 +114,7 @@ TEST_CASE("plant/scene leaves the firmware's controller and task sections to the
 }
 
 TEST_CASE("plant/scene shipped scenes load and their initial states assemble") {
-  for (const char* name : {"free_motion.yaml", "dig.yaml"}) {
+  for (const char* name : {"free_motion.yaml", "dig.yaml", "paper_free_motion.yaml", "paper_dig.yaml", "truck_loading.yaml"}) {
     CAPTURE(std::string(name));
     const Scene s = load_scene(std::string(EXC_SOURCE_DIR) + "/scenes/" + name);
     CHECK(s.has_task);

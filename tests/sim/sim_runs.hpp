@@ -39,12 +39,15 @@ inline Run run_sim(const std::string& args) {
   return r;
 }
 
+// The shipped dig: the hydraulic machine through its valves; and the paper's force-actuated one.
 inline const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+inline const std::string kPaperDig = std::string(EXC_SOURCE_DIR) + "/scenes/paper_dig.yaml";
 
-// The shipped dig scene with edits (each must apply exactly once), written next to the test's runs
-// under a name of this process; returns its path.
-inline fs::path edited_dig(const std::vector<std::pair<std::string, std::string>>& edits, const std::string& stem) {
-  std::string text = read_text_file(kDig);
+// A shipped scene with edits (each must apply exactly once), written next to the test's runs under a
+// name of this process; returns its path.
+inline fs::path edited_scene(const std::string& scene, const std::vector<std::pair<std::string, std::string>>& edits,
+                             const std::string& stem) {
+  std::string text = read_text_file(scene);
   for (const auto& [from, to] : edits) {
     const auto pos = text.find(from);
     REQUIRE_MESSAGE(pos != std::string::npos, from);
@@ -56,6 +59,10 @@ inline fs::path edited_dig(const std::vector<std::pair<std::string, std::string>
   const fs::path path = dir / (stem + "_" + std::to_string(getpid()) + ".yaml");
   std::ofstream(path) << text;
   return path;
+}
+
+inline fs::path edited_dig(const std::vector<std::pair<std::string, std::string>>& edits, const std::string& stem) {
+  return edited_scene(kDig, edits, stem);
 }
 
 inline fs::path edited_dig(const std::string& from, const std::string& to, const std::string& stem) {

@@ -85,6 +85,8 @@ TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly
   CHECK(names_in_row("scene-schema.md", "controller.regressor_acceleration", 2) ==
         names_of(control::kRegressorAccelerations));
   CHECK(names_in_row("scene-schema.md", "task.type", 2) == names_of(control::kTaskTypes));
+  CHECK(names_in_row("scene-schema.md", "controller.command_interface", 2) == names_of(control::kCommandInterfaces));
+  CHECK(names_in_row("control.md", "command_interface", 3) == names_of(control::kCommandInterfaces));
   CHECK(names_in_row("control.md", "type", 3) == names_of(control::kControllerKinds));
   CHECK(names_in_row("control.md", "regressor_acceleration", 3) == names_of(control::kRegressorAccelerations));
   CHECK(names_in_row("sweeps.md", "sweep.controllers", 2) == names_of(control::kControllerKinds));
