@@ -87,6 +87,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.choice("command_interface", c.command_interface, kCommandInterfaces, "what the firmware commands on the bus");
   SectionReader v = r.section("valves", "the valve stage between the law and a hydraulic machine's valves");
   v.number("force_time_constant", c.valves.force_time_constant, {1e-3, 1}, "s", "T_f: the force loop's time constant");
+  v.number("force_integral_time", c.valves.force_integral_time, {0, 100}, "s",
+           "T_i of the force loop's integral (0: none; docs/control.md)");
   v.number("spool_lag_target", c.valves.spool_lag_target, {0, 1}, "s",
            "the spool lag the lead aims for (0: no lead); at most the machine's valve_time_constant");
   v.number("opening_band", c.valves.opening_band, {0, 0.5}, "", "opening below which the dead-zone inverse is linear");

@@ -31,11 +31,13 @@ ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSetti
     : model_(model),
       settings_(settings),
       spool_lead_(settings.spool_lag_target > 0 ? model.hydraulics.valve_time_constant : 0.0,
-                  settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()) {}
+                  settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()),
+      period_(period) {}
 
 void ValveInnerLoop::reset() {
   spool_lead_.reset(Vec4::Zero());
   in_position_ = 0;
+  force_integral_.setZero();
   command_ = ValveCommand{};
 }
 
@@ -86,12 +88,17 @@ double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) cons
   double a = flow_in > 0 ? area_in * std::abs(u) / flow_in : 2.0;  // stalled at the relief: fully open
   // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills
   // the other side. Only while that side is down at the make-up (within the laminar pressure of
-  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed.
+  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed. Between the
+  // two (up to three laminar pressures above tank) the openings blend, so the map has no step.
   const double p_in = extend ? p_a : p_b, p_out = extend ? p_b : p_a;
   const double k_out = extend ? g.meter_out_b[i] : g.meter_out_a[i];
   const double area_out = extend ? g.area_b[i] : g.area_a[i];
   const double flow_out = k_out * orifice(p_out - h.tank_pressure, h.laminar_pressure);
-  if (flow_out > 0 && p_in < h.tank_pressure + h.laminar_pressure) a = std::min(a, area_out * std::abs(u) / flow_out);
+  if (flow_out > 0) {
+    const double metered_out = std::min(a, area_out * std::abs(u) / flow_out);
+    const double w = std::clamp((p_in - h.tank_pressure - h.laminar_pressure) / (2 * h.laminar_pressure), 0.0, 1.0);
+    a = w * a + (1 - w) * metered_out;
+  }
   return extend ? a : -a;
 }
 
@@ -99,8 +106,15 @@ const ValveCommand& ValveInnerLoop::from_force(const Vec4& force_desired, const 
                                                const Vec4& p_a, const Vec4& p_b) {
   command_.force = measured_force(p_a, p_b);
   const Vec4 k_h = hydraulic_stiffness(q);
-  for (int i = 0; i < kNumActive; ++i)
-    command_.velocity[i] = v_ff[i] + (force_desired[i] - command_.force[i]) / (k_h[i] * settings_.force_time_constant);
+  const double ti = settings_.force_integral_time;
+  for (int i = 0; i < kNumActive; ++i) {
+    const double proportional = (force_desired[i] - command_.force[i]) / (k_h[i] * settings_.force_time_constant);
+    // The integral holds while the valve is fully open or the function is in position (anti-windup).
+    const bool frozen = ((command_.limited | in_position_) >> i) & 1u;
+    if (ti > 0 && !frozen) force_integral_[i] += proportional * period_ / ti;
+    if ((in_position_ >> i) & 1u) force_integral_[i] = 0;
+    command_.velocity[i] = v_ff[i] + proportional + force_integral_[i];
+  }
   finish(q, p_a, p_b);
   return command_;
 }

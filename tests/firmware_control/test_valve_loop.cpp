@@ -49,9 +49,11 @@ ValveLoopModel simple_model() {
   return m;
 }
 
+// The stage's proportional parts alone: no spool lead, no force integral.
 ValveLoopSettings no_lead() {
   ValveLoopSettings s;
   s.spool_lag_target = 0;
+  s.force_integral_time = 0;
   return s;
 }
 
@@ -187,6 +189,30 @@ TEST_CASE("firmware/valve stage's force loop commands the flow that closes the f
   // No error, no feedforward: the valve stays shut.
   const ValveCommand& hold = loop.from_force(force, Vec4::Zero(), kMid, pa, pb);
   CHECK(hold.spool.cwiseAbs().maxCoeff() == 0.0);
+}
+
+TEST_CASE("firmware/valve stage's force integral adds the proportional flow every T_i, and holds at the valve's limit") {
+  const ValveLoopModel m = simple_model();
+  ValveLoopSettings s = no_lead();
+  s.force_integral_time = 0.1;
+  ValveInnerLoop loop(m, s, kPeriod);
+  const Vec4 pa(5e6, 8e6, 4e6, 6e6), pb(5e6, 2e6, 2e6, 1e6);
+  const Vec4 force = loop.measured_force(pa, pb);
+  const Vec4 k = loop.hydraulic_stiffness(kMid);
+  const double error = 1e3, proportional = error / (k[1] * s.force_time_constant);
+  Vec4 f = force;
+  f[1] += error;
+  // After n cycles with the same error: u = P (1 + n dt / T_i).
+  for (int n = 1; n <= 50; ++n) {
+    const ValveCommand& c = loop.from_force(f, Vec4::Zero(), kMid, pa, pb);
+    CHECK(c.velocity[1] == doctest::Approx(proportional * (1 + n * kPeriod / 0.1)));
+  }
+  // A force error the valve cannot meet opens it fully: the integral then stops growing.
+  f[1] = force[1] + 1e9;
+  const double first = loop.from_force(f, Vec4::Zero(), kMid, pa, pb).velocity[1];
+  REQUIRE(loop.last().limited == (1u << 1));
+  const double held = loop.from_force(f, Vec4::Zero(), kMid, pa, pb).velocity[1];
+  CHECK(held == doctest::Approx(first).epsilon(1e-9));
 }
 
 TEST_CASE("firmware/valve stage's spool lead makes the 30 ms spool answer with its 10 ms target") {
