@@ -202,15 +202,18 @@ int main(int argc, char** argv) {
     // The verdict: a run that never tracked, went to its safe state, or missed its deadlines failed.
     const std::uint64_t done = node.cycle();
     const std::uint64_t overruns = sleeper.overruns(), skipped = sleeper.skipped_periods();
+    // Missed deadlines come first when they are there: a loop that cannot hold its period starves
+    // its own sensor watchdog, so the safe stop that follows is their consequence, named after them.
     std::string failure;
+    const auto add = [&failure](const std::string& reason) { failure += (failure.empty() ? "" : "; then ") + reason; };
+    if (realtime && static_cast<double>(overruns + skipped) > max_overrun_fraction * static_cast<double>(done))
+      add(std::to_string(overruns) + " of " + std::to_string(done) + " cycles woke after their deadline and " +
+          std::to_string(skipped) + " periods were skipped (allowed together: " + percent(max_overrun_fraction) +
+          " of the cycles): the loop cannot hold its " + format_ms(period_s) + " period");
     if (node.measured_tracking().samples() == 0)
-      failure = std::string("the firmware never tracked (mode ") + exc::control::to_string(node.mode()) + ")";
+      add(std::string("the firmware never tracked (mode ") + exc::control::to_string(node.mode()) + ")");
     else if (node.safe_stops() > 0)
-      failure = std::string("safe state: ") + node.last_fault_text();
-    else if (realtime && static_cast<double>(overruns + skipped) > max_overrun_fraction * static_cast<double>(done))
-      failure = std::to_string(overruns) + " of " + std::to_string(done) + " cycles woke after their deadline and " +
-                std::to_string(skipped) + " periods were skipped (allowed together: " + percent(max_overrun_fraction) +
-                " of the cycles): the loop cannot hold its " + format_ms(period_s) + " period";
+      add(std::string("safe state: ") + node.last_fault_text());
     const bool ok = failure.empty();
     std::uint64_t telemetry_dropped = 0;
     exc::telemetry::TelemetryCounters tcn;
