@@ -79,10 +79,16 @@ std::vector<StageCount> callgrind_split(const std::string& program, const std::v
   std::vector<StageCount> out;
   char dir[] = "/tmp/loop-bench-XXXXXX";
   if (mkdtemp(dir) == nullptr) return why = "no temporary directory", out;
-  const std::string profile = std::string(dir) + "/callgrind.out";
-  std::vector<std::string> argv = {"valgrind", "--tool=callgrind", "--callgrind-out-file=" + profile, program};
+  const std::string profile = std::string(dir) + "/callgrind.out", stripped = std::string(dir) + "/child";
+  // Without debug information: with it callgrind splits a function by the source file of each inlined
+  // piece (Eigen's headers), and the inclusive counts of the pieces no longer add up.
+  const bool copied = run({"objcopy", "--strip-debug", program, stripped});
+  std::vector<std::string> argv = {"valgrind", "-q", "--tool=callgrind", "--callgrind-out-file=" + profile,
+                                   copied ? stripped : program};
   argv.insert(argv.end(), args.begin(), args.end());
   if (!run(argv)) {
+    std::remove(stripped.c_str());
+    rmdir(dir);
     why = "valgrind --tool=callgrind did not run the child (is valgrind installed?)";
     return out;
   }
@@ -106,6 +112,7 @@ std::vector<StageCount> callgrind_split(const std::string& program, const std::v
   }
   const bool annotated = pclose(pipe) == 0;
   std::remove(profile.c_str());
+  std::remove(stripped.c_str());
   rmdir(dir);
   if (!annotated || !seen[0]) return why = "callgrind_annotate gave no count of run_lockstep", out;
   for (std::size_t s = 0; s < stages().size(); ++s)
