@@ -79,7 +79,7 @@ void TelemetryPublisher::run() {
   const bool paced = starts_with(output_->url(), "udpm");
   const std::size_t burst = paced ? std::max<std::size_t>(1, config_.udpm_burst) : Ring::slot_count;
   while (!stop_requested_.load(std::memory_order_relaxed)) {
-    if (drain(burst) > 0 && !output_->flush()) publish_errors_.fetch_add(1, std::memory_order_relaxed);
+    drain(burst);
     const auto now = std::chrono::steady_clock::now();
     if (now >= next_stats) {
       publish_stats();
@@ -91,7 +91,6 @@ void TelemetryPublisher::run() {
   // still in bursts.
   while (drain(burst) == burst) std::this_thread::sleep_for(config_.wake_period);
   publish_stats();
-  if (!output_->flush()) publish_errors_.fetch_add(1, std::memory_order_relaxed);
 }
 
 std::size_t TelemetryPublisher::drain(std::size_t limit) {
