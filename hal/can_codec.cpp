@@ -1,6 +1,7 @@
 #include "hal/can_codec.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace exc::hal {
 namespace {
@@ -22,6 +23,41 @@ constexpr Crc8Table kCrc8Table;
 
 std::uint64_t mask_of(unsigned length) { return length >= 64 ? ~0ULL : ((1ULL << length) - 1); }
 
+// Eight payload bytes as one little-endian word (the frame's Intel bit order: bit k of the word is
+// bit k % 8 of byte k / 8), on any host.
+std::uint64_t load_word(const std::uint8_t* bytes) {
+  std::uint64_t word;
+  std::memcpy(&word, bytes, sizeof word);
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+  word = __builtin_bswap64(word);
+#endif
+  return word;
+}
+
+void store_word(std::uint8_t* bytes, std::uint64_t word) {
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__
+  word = __builtin_bswap64(word);
+#endif
+  std::memcpy(bytes, &word, sizeof word);
+}
+
+// A field lies in one word: it ends within the 64 bits from its first byte, and that word within the
+// payload. Every signal of the protocol does; the byte loops below take the rest.
+bool in_one_word(unsigned start, unsigned length) {
+  return start % 8 + length <= 64 && start / 8 + 8 <= kCanFdMaxLength;
+}
+
+// std::llround(x), half away from zero, without the library call where |x| < 2^62 (every signal's
+// raw range): x less its truncation is exact there, so the comparison with 0.5 decides as llround does.
+std::int64_t round_half_away(double x) {
+  if (!(std::abs(x) < 0x1p62)) return std::llround(x);
+  auto raw = static_cast<std::int64_t>(x);
+  const double fraction = x - static_cast<double>(raw);
+  if (fraction >= 0.5) ++raw;
+  else if (fraction <= -0.5) --raw;
+  return raw;
+}
+
 }  // namespace
 
 std::uint8_t crc8_sae_j1850(const std::uint8_t* bytes, std::size_t length) {
@@ -40,6 +76,7 @@ std::uint8_t frame_checksum(std::uint32_t id, const std::uint8_t* payload, std::
 
 std::uint64_t read_raw_bits(const CanFrame& frame, unsigned start, unsigned length) {
   if (length == 0 || length > 64 || start + length > 8u * kCanFdMaxLength) return 0;
+  if (in_one_word(start, length)) return (load_word(frame.data + start / 8) >> (start % 8)) & mask_of(length);
   std::uint64_t raw = 0;
   unsigned got = 0;
   while (got < length) {
@@ -55,6 +92,12 @@ std::uint64_t read_raw_bits(const CanFrame& frame, unsigned start, unsigned leng
 
 void write_raw_bits(CanFrame& frame, unsigned start, unsigned length, std::uint64_t raw) {
   if (length == 0 || length > 64 || start + length > 8u * kCanFdMaxLength) return;
+  if (in_one_word(start, length)) {
+    std::uint8_t* bytes = frame.data + start / 8;
+    const std::uint64_t field = mask_of(length) << (start % 8);
+    store_word(bytes, (load_word(bytes) & ~field) | ((raw << (start % 8)) & field));
+    return;
+  }
   unsigned put = 0;
   while (put < length) {
     const unsigned bit = start + put;
@@ -81,7 +124,7 @@ EncodeReport encode_signal(CanFrame& frame, const SignalSpec& signal, double val
     value = signal.max;
     report.saturated = 1;
   }
-  std::int64_t raw = std::llround((value - signal.offset) / signal.factor);
+  std::int64_t raw = round_half_away((value - signal.offset) / signal.factor);
   // Rounding at a range end must not step outside what the field can hold.
   const std::int64_t raw_min = signal.is_signed ? -(std::int64_t{1} << (signal.length - 1)) : 0;
   const std::int64_t raw_max = signal.is_signed ? (std::int64_t{1} << (signal.length - 1)) - 1

@@ -98,8 +98,9 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   HydraulicReport& r = report_;
   HydraulicEnergy& e = r.energy;
   // Spools: lag toward the target, then the dead zone of the direction they moved in.
+  const double lag_gain = spool_lag_gain(hp_.valve_time_constant, dt);
   for (int i = 0; i < kNumActive; ++i) {
-    spool_[i] = spool_lag(spool_[i], target_[i], hp_.valve_time_constant, dt);
+    spool_[i] = spool_lag(spool_[i], target_[i], lag_gain);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);
     r.opening[i] = spool_[i] >= 0 ? a : -a;
   }

@@ -11,10 +11,11 @@ double spool_target_from_pilots(double pilot_a, double pilot_b, double full_stro
   return std::clamp((pilot_a - pilot_b) / full_stroke_pressure, -1.0, 1.0);
 }
 
-double spool_lag(double spool, double target, double time_constant, double dt) {
-  const double a = time_constant > 0 ? 1.0 - std::exp(-dt / time_constant) : 1.0;
-  return spool + a * (target - spool);
+double spool_lag_gain(double time_constant, double dt) {
+  return time_constant > 0 ? 1.0 - std::exp(-dt / time_constant) : 1.0;
 }
+
+double spool_lag(double spool, double target, double gain) { return spool + gain * (target - spool); }
 
 double metering_opening(double spool, double dead_zone_extend, double dead_zone_retract) {
   const double d = spool >= 0 ? dead_zone_extend : dead_zone_retract;

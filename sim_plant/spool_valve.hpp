@@ -10,8 +10,11 @@ namespace exc::plant {
 double spool_target_from_opening(double opening);
 double spool_target_from_pilots(double pilot_a, double pilot_b, double full_stroke_pressure);
 
-// First-order lag toward the target over dt, solved exactly (no step-size limit).
-double spool_lag(double spool, double target, double time_constant, double dt);
+// First-order lag toward the target over dt, solved exactly (no step-size limit): the spool moves
+// the fraction spool_lag_gain(time_constant, dt) = 1 - exp(-dt / time_constant) of the way, a gain
+// computed once per substep for every spool.
+double spool_lag_gain(double time_constant, double dt);
+double spool_lag(double spool, double target, double gain);
 
 // The metering opening 0..1 the spool gives in its direction: zero inside the dead zone of that
 // direction, then linear to full at full stroke.

@@ -73,13 +73,18 @@ class SpscRing {
     }
     slot.header.store(static_cast<std::uint64_t>(tag) << 32 | static_cast<std::uint64_t>(size),
                       std::memory_order_relaxed);
-    const std::size_t words = (size + 7) / 8;
+    // Whole words, then the last one's bytes (zero-padded): fixed-size copies the compiler inlines.
+    const std::size_t whole = size / 8, tail = size % 8;
     const auto* source = static_cast<const std::uint8_t*>(data);
-    for (std::size_t w = 0; w < words; ++w) {
-      std::uint64_t word = 0;
-      const std::size_t n = (w + 1) * 8 <= size ? 8 : size - w * 8;
-      std::memcpy(&word, source + w * 8, n);
+    for (std::size_t w = 0; w < whole; ++w) {
+      std::uint64_t word;
+      std::memcpy(&word, source + w * 8, 8);
       slot.payload[w].store(word, std::memory_order_relaxed);
+    }
+    if (tail != 0) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, source + whole * 8, tail);
+      slot.payload[whole].store(word, std::memory_order_relaxed);
     }
     slot.sequence.store(encode_sequence(position, State::complete), std::memory_order_release);
     head_.store(position + 1, std::memory_order_release);
@@ -111,11 +116,14 @@ class SpscRing {
       const std::uint64_t header = slot.header.load(std::memory_order_relaxed);
       const auto size = static_cast<std::uint32_t>(header & 0xffffffffu);
       if (size > SlotBytes) return false;  // cannot happen with a complete slot; be safe
-      const std::size_t words = (size + 7) / 8;
-      for (std::size_t w = 0; w < words; ++w) {
+      const std::size_t whole = size / 8, tail = size % 8;
+      for (std::size_t w = 0; w < whole; ++w) {
         const std::uint64_t word = slot.payload[w].load(std::memory_order_relaxed);
-        const std::size_t n = (w + 1) * 8 <= size ? 8 : size - w * 8;
-        std::memcpy(out.bytes + w * 8, &word, n);
+        std::memcpy(out.bytes + w * 8, &word, 8);
+      }
+      if (tail != 0) {
+        const std::uint64_t word = slot.payload[whole].load(std::memory_order_relaxed);
+        std::memcpy(out.bytes + whole * 8, &word, tail);
       }
       std::atomic_thread_fence(std::memory_order_acquire);
       std::uint64_t claim = expected;

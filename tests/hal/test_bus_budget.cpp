@@ -197,3 +197,102 @@ TEST_CASE("hal/exact CAN FD frame length: worked frames bit by bit, and every co
   f.brs = true;
   CHECK(exc::hal::frame_time_ns(f) == 30 * 1000 + 96 * 200);
 }
+
+namespace {
+
+// The frame lengths by their definition, bit by bit over an array of the frame's bits (the code
+// can_bus_load.cpp had before its byte tables): the reference the table-driven counts must equal.
+struct ReferenceBits {
+  std::uint8_t bits[22 + 8 * 64 + 15];
+  int n = 0;
+  void put(std::uint32_t value, int width) {
+    for (int b = width - 1; b >= 0; --b) bits[n++] = static_cast<std::uint8_t>((value >> b) & 1u);
+  }
+  // Stuff bits after bits [0, split) and after [split, n).
+  void stuff(int split, int& before, int& after) const {
+    before = after = 0;
+    int run = 0;
+    std::uint8_t last = 2;
+    for (int i = 0; i < n; ++i) {
+      if (bits[i] == last) {
+        ++run;
+      } else {
+        last = bits[i];
+        run = 1;
+      }
+      if (run == 5) {
+        ++(i < split ? before : after);
+        last = static_cast<std::uint8_t>(!last);
+        run = 1;
+      }
+    }
+  }
+};
+
+int reference_classical_bits(std::uint32_t id, int len, const std::uint8_t* data) {
+  ReferenceBits s;
+  s.put(0, 1);
+  s.put(id & 0x7FF, 11);
+  s.put(0, 3);
+  s.put(static_cast<std::uint32_t>(len), 4);
+  for (int i = 0; i < len; ++i) s.put(data[i], 8);
+  s.put(exc::hal::can_crc15(s.bits, s.n), 15);
+  int stuff = 0, unused = 0;
+  s.stuff(s.n, stuff, unused);
+  return s.n + stuff + 13;
+}
+
+exc::hal::CanFdFrameBits reference_fd_bits(std::uint32_t id, int len, const std::uint8_t* data, bool brs) {
+  ReferenceBits s;
+  s.put(0, 1);
+  s.put(id & 0x7FF, 11);
+  s.put(0b0010, 4);  // RRS, IDE, FDF, res
+  s.put(brs ? 1 : 0, 1);
+  s.put(0, 1);
+  s.put(exc::hal::dlc_of_length(static_cast<std::uint8_t>(len)), 4);
+  for (int i = 0; i < len; ++i) s.put(data[i], 8);
+  int before = 0, after = 0;
+  s.stuff(16, before, after);
+  const int arbitration = 17 + before;
+  const int data_phase = s.n - 17 + after + exc::hal::canfd_crc_field_bits(len);
+  if (!brs) return {arbitration + data_phase + 13, 0};
+  return {arbitration + 13, data_phase};
+}
+
+}  // namespace
+
+TEST_CASE("hal/exact frame length: the byte-table stuffing and CRC equal the bit-by-bit definition on 400000 frames") {
+  std::mt19937 random(2024);
+  const int fd_lengths[] = {0, 1, 2, 3, 4, 5, 6, 7, 8, 12, 16, 20, 24, 32, 48, 64};
+  std::uint8_t data[64];
+  int mismatches = 0;
+  for (int trial = 0; trial < 200000; ++trial) {
+    // Random bytes, runs of 0x00 / 0xFF (stuffing every fifth bit), and bytes near a run's end.
+    const int kind = trial % 3;
+    const int len = kind == 2 ? 64 : fd_lengths[random() % 16];
+    for (int i = 0; i < len; ++i) {
+      const std::uint32_t r = random();
+      data[i] = kind == 0 ? static_cast<std::uint8_t>(r) : kind == 1 ? static_cast<std::uint8_t>(r % 2 ? 0xFF : 0x00)
+                                                                     : static_cast<std::uint8_t>(r % 2 ? 0xF0 : 0x07);
+    }
+    const std::uint32_t id = random() & 0x7FF;
+    const bool brs = (trial / 3) % 2 == 0;
+    const exc::hal::CanFdFrameBits got = canfd_frame_bits(id, static_cast<std::uint8_t>(len), data, brs);
+    const exc::hal::CanFdFrameBits want = reference_fd_bits(id, len, data, brs);
+    mismatches += got.nominal != want.nominal || got.data != want.data;
+    const int classical = std::min(len, 8);
+    mismatches += exc::hal::classical_frame_bits(id, static_cast<std::uint8_t>(classical), data) !=
+                  reference_classical_bits(id, classical, data);
+  }
+  CHECK(mismatches == 0);
+  // Every byte after every stuffing state, one at a time behind a prefix that sets the state.
+  for (int prefix = 0; prefix < 256; ++prefix) {
+    for (int byte = 0; byte < 256; ++byte) {
+      const std::uint8_t two[2] = {static_cast<std::uint8_t>(prefix), static_cast<std::uint8_t>(byte)};
+      const exc::hal::CanFdFrameBits got = canfd_frame_bits(0x7FF, 2, two, true);
+      const exc::hal::CanFdFrameBits want = reference_fd_bits(0x7FF, 2, two, true);
+      CHECK_MESSAGE(got.data == want.data, "bytes " << prefix << " " << byte);
+      CHECK(exc::hal::classical_frame_bits(0, 2, two) == reference_classical_bits(0, 2, two));
+    }
+  }
+}

@@ -1,0 +1,253 @@
+// excavator-loop-bench: the closed loop's real-time factor (issue 17, item 3). The dig scene's whole
+// in-process loop (firmware, CAN codec and in-memory bus, plant, lossless telemetry into an LCM log)
+// through the harness every tool uses, medians over repeats; the floor the loop's two model
+// evaluations set (the plant's forward dynamics, the firmware's M_a and h_a) on the same run's
+// states; and, with --split, the per-stage instruction split of one cycle (callgrind). Build Release.
+#include <sched.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "app/firmware_node.hpp"
+#include "callgrind_split.hpp"
+#include "control/controller_kinds.hpp"
+#include "harness/lockstep_run.hpp"
+#include "model/forward_dynamics.hpp"
+#include "sim_plant/plant.hpp"
+#include "telemetry/lcm_output.hpp"
+
+using namespace exc;
+
+namespace {
+
+double cpu_seconds(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+struct Repeat {
+  double loop = 0, process = 0, wall = 0;  // real-time factors: loop thread CPU, all threads' CPU, wall
+};
+
+// One closed-loop run; with telemetry every message goes into an LCM log file (blocking publisher).
+Repeat closed_loop(const sim::SceneBundle& b, const sim::LockstepOptions& base, bool telemetry, const std::string& log) {
+  sim::LockstepOptions o = base;
+  if (telemetry) {
+    std::string error;
+    o.telemetry = telemetry::LcmOutput::open("file://" + log + "?mode=w", &error);
+    if (!o.telemetry) throw std::runtime_error(error);
+  }
+  const double p0 = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID);
+  const auto w0 = std::chrono::steady_clock::now();
+  const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+  o.telemetry.reset();  // closes the log: its last writes are counted
+  const double process = cpu_seconds(CLOCK_PROCESS_CPUTIME_ID) - p0;
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count();
+  if (telemetry) std::remove(log.c_str());
+  if (!r.ok) throw std::runtime_error("the run failed: " + r.failure);
+  if (telemetry && (r.telemetry_dropped != 0 || r.telemetry_published != r.telemetry_enqueued))
+    throw std::runtime_error("telemetry lost messages");
+  return Repeat{r.simulated_seconds / r.cpu_seconds, r.simulated_seconds / process, r.simulated_seconds / wall};
+}
+
+// What one closed-loop run saw, cycle by cycle: the plant's state and the commands it stepped with,
+// the firmware's measured state.
+struct Trace {
+  std::vector<plant::ActuatorCommand> commands;
+  std::vector<Vec4> q_a, qd_a, effort, q_fw, qd_fw;
+};
+
+Trace record(const sim::SceneBundle& b, sim::LockstepOptions o, std::size_t cycles) {
+  Trace t;
+  for (auto* v : {&t.q_a, &t.qd_a, &t.effort, &t.q_fw, &t.qd_fw}) v->reserve(cycles + 1);
+  t.commands.reserve(cycles + 1);
+  plant::ActuatorCommand centred;  // the plant's first step, before any command: valves centred
+  centred.mode = plant::ActuatorCommand::valve;
+  t.commands.push_back(centred);
+  o.observer = [&t](std::int64_t, const plant::Plant& p, const app::FirmwareNode& n) {
+    const plant::PlantState& s = p.state();
+    t.q_a.push_back(s.q_a);
+    t.qd_a.push_back(s.qd_a);
+    t.effort.push_back(s.effort);
+    const hal::SensorState& m = n.sensors();
+    t.q_fw.emplace_back(m.position[0], m.position[1], m.position[2], m.position[3]);
+    t.qd_fw.emplace_back(m.velocity[0], m.velocity[1], m.velocity[2], m.velocity[3]);
+    const hal::CommandState& c = n.last_command();  // what the plant steps with at the next SYNC
+    plant::ActuatorCommand a;
+    a.mode = c.mode == hal::CommandMode::pilot   ? plant::ActuatorCommand::pilot
+             : c.mode == hal::CommandMode::valve ? plant::ActuatorCommand::valve
+                                                 : plant::ActuatorCommand::effort;
+    for (int j = 0; j < 4; ++j) {
+      a.value[j] = c.value[j];
+      a.pilot_a[j] = c.pilot_a[j];
+      a.pilot_b[j] = c.pilot_b[j];
+    }
+    t.commands.push_back(a);
+  };
+  sim::run_lockstep(b.scene, b.firmware, o);
+  return t;
+}
+
+// Thread CPU seconds of `body`, the median of `repeats` runs.
+template <class Body>
+double timed(int repeats, Body&& body) {
+  std::vector<double> s;
+  for (int r = 0; r < repeats; ++r) {
+    const double t0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+    body();
+    s.push_back(cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - t0);
+  }
+  return median(s);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"The closed loop's real-time factor: the dig scene's firmware, CAN and plant in one process with "
+               "every telemetry message recorded, medians over repeats; the floor of its model evaluations; "
+               "--split: the per-stage instruction split of one cycle under callgrind.",
+               "excavator-loop-bench"};
+  std::string scene_path = std::string(EXC_SOURCE_DIR_BENCH) + "/scenes/dig.yaml";
+  std::string controller = "adaptive";
+  double duration = 0, split_duration = 2;
+  int repeats = 7;
+  bool split = false, child = false, pin = true;
+  app.add_option("--scene", scene_path, "scene (default: scenes/dig.yaml)");
+  app.add_option("--controller", controller, "controller kind (default adaptive)");
+  app.add_option("--duration", duration, "simulated seconds per run (default: the scene's)");
+  app.add_option("--repeats", repeats, "runs per figure; medians are printed (default 7)");
+  app.add_flag("--split", split, "also the per-stage instruction split (runs itself under valgrind --tool=callgrind)");
+  app.add_option("--split-duration", split_duration, "simulated seconds of the callgrind run (default 2)");
+  app.add_flag("!--no-pin", pin, "do not pin the process (loop and telemetry thread) to one core");
+  app.add_flag("--child", child, "one run with telemetry and nothing printed (what --split profiles)")->group("");
+  CLI11_PARSE(app, argc, argv);
+
+  const auto kind = control::kControllerKinds.named(controller);
+  if (!kind) {
+    std::fprintf(stderr, "excavator-loop-bench: unknown controller '%s'\n", controller.c_str());
+    return 2;
+  }
+  if (pin) {
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(std::max(0, sched_getcpu()), &one);
+    sched_setaffinity(0, sizeof one, &one);  // every thread started from here on shares the core
+  }
+  try {
+    const double load0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+    const sim::SceneBundle bundle = sim::load_scene_bundle(scene_path);
+    const double load_s = cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - load0;
+    sim::LockstepOptions options;
+    options.controller = *kind;
+    options.duration = duration;
+    const std::string log = "/tmp/loop-bench-" + std::to_string(getpid()) + ".lcm";
+    if (child) {
+      options.duration = split_duration;
+      closed_loop(bundle, options, true, log);
+      return 0;
+    }
+    const double seconds = duration > 0 ? duration : bundle.scene.duration;
+    std::printf("# Closed loop: %s, %s, %.1f s simulated, %d repeats (scene loading, effort-feasibility check "
+                "included: %.2f s CPU, once)\n\n",
+                bundle.name.c_str(), controller.c_str(), seconds, repeats, load_s);
+    std::vector<Repeat> with, without;
+    for (int r = 0; r < repeats; ++r) {  // alternating, so load that comes and goes meets both
+      with.push_back(closed_loop(bundle, options, true, log));
+      without.push_back(closed_loop(bundle, options, false, log));
+    }
+    std::printf("| run | real-time factor, loop thread CPU | all threads' CPU (one core) | wall%s | 1 s simulated in |\n"
+                "|---|---|---|---|---|\n", pin ? ", pinned to one core" : "");
+    for (const auto* set : {&with, &without}) {
+      std::vector<double> loop, process, wall;
+      for (const Repeat& x : *set) {
+        loop.push_back(x.loop);
+        process.push_back(x.process);
+        wall.push_back(x.wall);
+      }
+      std::printf("| %s | %.0fx (%.0f-%.0f) | %.0fx | %.0fx | %.2f ms CPU |\n",
+                  set == &with ? "telemetry, every message in an LCM log" : "no telemetry", median(loop),
+                  *std::min_element(loop.begin(), loop.end()), *std::max_element(loop.begin(), loop.end()),
+                  median(process), median(wall), 1e3 / median(process));
+    }
+
+    // The floor: the loop's two model evaluations per cycle on this run's states, and the plant alone.
+    const auto cycles = static_cast<std::size_t>(std::llround(seconds / bundle.scene.cycle));
+    const Trace t = record(bundle, options, cycles);
+    const std::size_t n = t.q_a.size();
+    const Model plant_model = build_model(bundle.scene.machine), firmware_model = build_model(bundle.firmware.machine);
+    Workspace pw(plant_model), fw(firmware_model);
+    Vec4 sink = Vec4::Zero();
+    const double fd = timed(repeats, [&] {
+      Vec4 qdd;
+      for (std::size_t k = 0; k < n; ++k) {
+        forward_dynamics(plant_model, pw, t.q_a[k], t.qd_a[k], t.effort[k], TipLoad{}, qdd);
+        sink += qdd;
+      }
+    }) / static_cast<double>(n);
+    const double id = timed(repeats, [&] {
+      Mat4 M;
+      Vec4 h;
+      for (std::size_t k = 0; k < n; ++k) {
+        update_closed_chain(firmware_model, fw, t.q_fw[k], t.qd_fw[k]);
+        mass_matrix(firmware_model, fw, M);
+        bias_forces(firmware_model, fw, h);
+        sink += h + M.col(0);
+      }
+    }) / static_cast<double>(n);
+    std::vector<double> replays;
+    for (int r = 0; r < repeats; ++r) {
+      plant::Plant p(bundle.scene);
+      const double t0 = cpu_seconds(CLOCK_THREAD_CPUTIME_ID);
+      for (std::size_t k = 0; k < n; ++k) p.step(t.commands[k]);
+      replays.push_back(cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - t0);
+      sink += p.state().q_a;
+    }
+    const double replay_time = median(replays);
+    const double period = bundle.scene.cycle;
+    std::printf("\n# The floor (medians; the same run's %zu states)\n\n| per cycle | us | bounds the loop at |\n|---|---|---|\n", n);
+    std::printf("| plant: forward dynamics (update, M_a, h_a, solve) | %.2f | %.0fx |\n", fd * 1e6, period / fd);
+    std::printf("| firmware: the law's model (update, M_a, h_a) | %.2f | %.0fx |\n", id * 1e6, period / id);
+    std::printf("| both: the loop's floor on one core | %.2f | %.0fx |\n", (fd + id) * 1e6, period / (fd + id));
+    std::printf("| the plant alone, open loop with the run's commands (Plant::step) | %.2f | %.0fx |\n",
+                replay_time / static_cast<double>(n) * 1e6, period * static_cast<double>(n) / replay_time);
+    if (!sink.allFinite()) std::printf("(non-finite model output)\n");
+
+    if (split) {
+      std::string why;
+      const std::vector<std::string> args = {"--scene", scene_path, "--controller", controller, "--split-duration",
+                                             std::to_string(split_duration), "--child"};
+      const double split_cycles = std::round(split_duration / bundle.scene.cycle);
+      char self[4096] = {};
+      const ssize_t len = readlink("/proc/self/exe", self, sizeof self - 1);
+      const auto counts = bench::callgrind_split(len > 0 ? self : argv[0], args, split_cycles, why);
+      std::printf("\n# Instructions per cycle by stage (callgrind, inclusive, %.0f cycles, %.1f s simulated)\n\n", split_cycles,
+                  split_duration);
+      if (counts.empty()) std::printf("not available: %s\n", why.c_str());
+      else std::printf("| stage | instructions per cycle | of the loop |\n|---|---|---|\n");
+      for (const bench::StageCount& c : counts) {
+        const std::string indent(static_cast<std::size_t>(2 * c.depth), ' ');
+        if (c.per_cycle < 0) std::printf("| %s%s | (inlined) | |\n", indent.c_str(), c.stage.c_str());
+        else std::printf("| %s%s | %.1fk | %.0f %% |\n", indent.c_str(), c.stage.c_str(), c.per_cycle * 1e-3,
+                         100 * c.per_cycle / counts.front().per_cycle);
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "excavator-loop-bench: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
