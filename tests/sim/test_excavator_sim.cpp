@@ -311,6 +311,37 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
   fs::remove(forced);
 }
 
+TEST_CASE("tools/excavator-sim: a run that never tracked (valve commands to a force-actuated plant, which sends no pressures and takes no pilots) says so: ok false, the reason, null tracking figures, exit 1") {
+  // The paper dig's force-actuated plant sends no chamber pressures, so its sensor set never has
+  // what the valve stage's force loop needs (the firmware faults, "no pressures"), and it stops at
+  // the first pilot command it gets: neither controller ever tracks.
+  const fs::path scene = edited_scene(
+      kPaperDig, {{"  actuator_lag: 0.02           # s: the firmware compensates the actuators' lag (target 5 ms)",
+                   "  command_interface: valve"}},
+      "paper_dig_valves");
+  const Run r = run_sim("run " + scene.string() + " --controller pid,adaptive --duration 1 --no-report --quiet --json summary.json --out out");
+  INFO(r.out << r.err);
+  CHECK(r.status == 1);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
+  CHECK_FALSE(j["ok"].get<bool>());
+  for (const char* c : {"pid", "adaptive"}) {
+    INFO("controller " << c);
+    CHECK_FALSE(j[c]["ok"].get<bool>());
+    const std::string failure = j[c]["failure"].get<std::string>();
+    CHECK((failure.find("no pressures") != std::string::npos || failure.find("pilot commands for actuators.fidelity limited") != std::string::npos));
+    CHECK(j[c]["tracking_samples"].get<long long>() == 0);
+    // A metric of no samples is absent, not 0.
+    CHECK(j[c]["rms_error"].is_null());
+    CHECK(j[c]["max_error"].is_null());
+    CHECK(j[c]["tracking"]["rms_error"].is_null());
+    CHECK(j[c]["tracking"]["max_error"].is_null());
+    CHECK(r.out.find("  FAILED: " + j[c]["failure"].get<std::string>() + "\n") != std::string::npos);
+  }
+  CHECK(r.out.find("n/a") != std::string::npos);
+  CHECK(r.out.find("0.000e+00") == std::string::npos);
+  fs::remove(scene);
+}
+
 TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records every message of every cycle of the 10 s dig, every controller the scene runs") {
   // Multicast on the loopback must work: a machine without it fails here with what to run.
   const int port = 17700 + static_cast<int>(getpid() % 200);
