@@ -154,7 +154,7 @@ void FirmwareNode::end_cycle() {
   if (telemetry_ != nullptr) publish_cycle();
   if (telemetry_ != nullptr && transition.changed) {
     exlcm::fault_t f{};
-    f.utime = static_cast<std::int64_t>(t * 1e6);
+    f.utime = utime();
     f.code = static_cast<std::int32_t>(transition.to == control::Mode::safe_stop ? fault_code_ : FirmwareFault::none);
     f.severity = transition.to == control::Mode::safe_stop ? 2 : 0;
     f.active = transition.to == control::Mode::safe_stop;
@@ -292,7 +292,7 @@ void FirmwareNode::command_valves(const Vec4& q) {
 }
 
 void FirmwareNode::publish_cycle() {
-  const auto utime = static_cast<std::int64_t>(time() * 1e6);
+  const std::int64_t utime = this->utime();
   exlcm::command_t c{};
   c.utime = utime;
   c.mode = static_cast<std::int8_t>(machine_.mode());
@@ -333,7 +333,7 @@ void FirmwareNode::publish_cycle() {
 
 void FirmwareNode::publish_counters() {
   if (telemetry_ == nullptr) return;
-  const auto utime = static_cast<std::int64_t>(time() * 1e6);
+  const std::int64_t utime = this->utime();
   // Every stage of the loop (timing_t.stage): 0 the whole end_cycle, 1 read, 2 update (estimate,
   // trajectory, law), 3 write, 6 telemetry encode; 5 the wake-up interval of a real-time loop, whose
   // overruns field carries the deadlines missed (the plant publishes 4, its step).

@@ -7,6 +7,7 @@
 //                  -> telemetry
 // Time is the cycle count times the period, so a run is deterministic and the plant's time is the
 // firmware's. Nothing here allocates, locks or blocks after construction.
+#include <cmath>
 #include <cstdint>
 #include <memory>
 
@@ -79,6 +80,9 @@ class FirmwareNode {
 
   std::uint64_t cycle() const { return cycle_; }
   double time() const { return static_cast<double>(cycle_) * period_; }
+  // time() in whole microseconds, rounded (telemetry's utime): truncating cycle x period x 1e6 gave
+  // 1024999 for cycle 1025 at 1 ms, so consecutive messages were 999 and 1001 us apart.
+  std::int64_t utime() const { return std::llround(time() * 1e6); }
   control::Mode mode() const { return machine_.mode(); }
   bool tracking() const { return machine_.mode() == control::Mode::track; }
   // The trajectory ran to its end (the node then holds its last point until the run ends or a

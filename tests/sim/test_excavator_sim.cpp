@@ -13,6 +13,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 #include <sched.h>
 #include <signal.h>
 #include <spawn.h>
@@ -50,11 +51,13 @@ void write_sweep_spec(const std::string& shipped, int cases, const std::string& 
   std::ofstream(to) << spec << extra;
 }
 
-// Per channel of an LCM log: messages and their sequence numbers. Every exlcm type begins with the
-// 8-byte fingerprint, int64 utime and int64 seq (big-endian, LCM's wire format), so the sequence is
-// read from the bytes as the .lcm files define them, without the generated code.
+// Per channel of an LCM log: messages, their sequence numbers and time stamps. Every exlcm type
+// begins with the 8-byte fingerprint, int64 utime and int64 seq (big-endian, LCM's wire format), so
+// both are read from the bytes as the .lcm files define them, without the generated code.
 struct LogChannel {
-  std::int64_t count = 0, first_seq = -1, last_seq = -1, gaps = 0;
+  std::int64_t count = 0, first_seq = -1, last_seq = -1, seq_gaps = 0;
+  std::int64_t first_utime = -1, last_utime = -1;
+  std::map<std::int64_t, std::int64_t> utime_steps;  // utime difference to the previous message: how often
 };
 std::map<std::string, LogChannel> read_log_channels(const fs::path& path) {
   std::map<std::string, LogChannel> channels;
@@ -64,15 +67,67 @@ std::map<std::string, LogChannel> read_log_channels(const fs::path& path) {
     LogChannel& c = channels[e->channel];
     REQUIRE(e->datalen >= 24);
     const auto* b = static_cast<const std::uint8_t*>(e->data);
-    std::uint64_t seq = 0;
-    for (int i = 16; i < 24; ++i) seq = seq << 8 | b[i];
-    const auto s = static_cast<std::int64_t>(seq);
-    if (c.count == 0) c.first_seq = s;
-    else if (s != c.last_seq + 1) ++c.gaps;
-    c.last_seq = s;
+    const auto field = [b](int at) {
+      std::uint64_t v = 0;
+      for (int i = at; i < at + 8; ++i) v = v << 8 | b[i];
+      return static_cast<std::int64_t>(v);
+    };
+    const std::int64_t utime = field(8), seq = field(16);
+    if (c.count == 0) {
+      c.first_seq = seq;
+      c.first_utime = utime;
+    } else {
+      if (seq != c.last_seq + 1) ++c.seq_gaps;
+      ++c.utime_steps[utime - c.last_utime];
+    }
+    c.last_seq = seq;
+    c.last_utime = utime;
     ++c.count;
   }
   return channels;
+}
+
+// The channels the firmware and the plant publish (firmware/telemetry/telemetry_channels.hpp): the
+// first three every control cycle, the others periodically or on events.
+const char* const kPerCycleChannels[] = {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"};
+const char* const kOtherChannels[] = {"EXC_TIMING", "EXC_CAN_STATS", "EXC_FAULT", "EXC_TELEMETRY_STATS"};
+
+// A log of `controllers` each run for `cycles` cycles of 1 ms: on every per-cycle channel of every
+// controller, one message per cycle, counted by the channel's own sequence numbers (0 .. cycles-1,
+// no gap) and stamped with consecutive cycles (utime 1000, 2000, ... us, each cycle's end: no
+// repeat, no gap);
+// and no channel the list above does not know (a new per-cycle channel must be added there).
+void check_every_cycle_logged(const std::map<std::string, LogChannel>& log, const std::vector<std::string>& controllers,
+                              std::int64_t cycles) {
+  for (const auto& [name, channel] : log) {
+    const std::string base = name.substr(0, name.find('/'));
+    const std::string suffix = name.find('/') == std::string::npos ? "" : name.substr(name.find('/') + 1);
+    INFO("channel " << name << " (" << channel.count << " messages)");
+    bool known = false;
+    for (const char* c : kPerCycleChannels) known = known || base == c;
+    for (const char* c : kOtherChannels) known = known || base == c;
+    CHECK(known);
+    CHECK(std::find(controllers.begin(), controllers.end(), suffix) != controllers.end());
+  }
+  for (const std::string& c : controllers) {
+    for (const char* base : kPerCycleChannels) {
+      const std::string name = std::string(base) + "/" + c;
+      INFO(name);
+      REQUIRE(log.count(name) == 1);
+      const LogChannel& l = log.at(name);
+      CHECK(l.count == cycles);
+      CHECK(l.first_seq == 0);
+      CHECK(l.seq_gaps == 0);
+      CHECK(l.last_seq == cycles - 1);
+      CHECK(l.first_utime == 1000);
+      CHECK(l.last_utime == cycles * 1000);
+      std::string steps;
+      for (const auto& [step, n] : l.utime_steps) steps += " " + std::to_string(n) + " x " + std::to_string(step) + " us;";
+      INFO("utime steps:" << steps);
+      CHECK(l.utime_steps.size() == 1);
+      CHECK(l.utime_steps.count(1000) == 1);
+    }
+  }
 }
 
 }  // namespace
@@ -107,19 +162,11 @@ TEST_CASE("tools/excavator-sim run on the paper's force-actuated dig writes the 
   CHECK(j["control_step_us"]["median"].get<double>() > 0);
 
   // The log holds every message of every cycle: 10 s at 1 kHz = 10,000 per controller on each
-  // per-cycle channel, their sequence numbers 0 .. 9,999 without a gap (counted, not weighed).
+  // per-cycle channel, counted by its sequence numbers 0 .. 9,999 and stamped 1 ms apart (counted,
+  // not weighed).
   const std::map<std::string, LogChannel> log = read_log_channels(r.dir / "out" / "run.lcm");
+  check_every_cycle_logged(log, {"pid", "adaptive"}, 10000);
   for (const char* c : {"pid", "adaptive"}) {
-    for (const char* base : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
-      const std::string channel = std::string(base) + "/" + c;
-      INFO(channel);
-      REQUIRE(log.count(channel) == 1);
-      const LogChannel& l = log.at(channel);
-      CHECK(l.count == 10000);
-      CHECK(l.first_seq == 0);
-      CHECK(l.gaps == 0);
-      CHECK(l.last_seq == 9999);
-    }
     // The report's CSVs (excavator-log export, as the report writes them) have one row per cycle.
     {
       const fs::path csv = r.dir / ("csv_" + std::string(c));
@@ -264,13 +311,47 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
   fs::remove(forced);
 }
 
-TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records every message of the main job") {
+TEST_CASE("tools/excavator-sim: a run that never tracked (valve commands to a force-actuated plant, which sends no pressures and takes no pilots) says so: ok false, the reason, null tracking figures, exit 1") {
+  // The paper dig's force-actuated plant sends no chamber pressures, so its sensor set never has
+  // what the valve stage's force loop needs (the firmware faults, "no pressures"), and it stops at
+  // the first pilot command it gets: neither controller ever tracks.
+  const fs::path scene = edited_scene(
+      kPaperDig, {{"  actuator_lag: 0.02           # s: the firmware compensates the actuators' lag (target 5 ms)",
+                   "  command_interface: valve"}},
+      "paper_dig_valves");
+  const Run r = run_sim("run " + scene.string() + " --controller pid,adaptive --duration 1 --no-report --quiet --json summary.json --out out");
+  INFO(r.out << r.err);
+  CHECK(r.status == 1);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
+  CHECK_FALSE(j["ok"].get<bool>());
+  for (const char* c : {"pid", "adaptive"}) {
+    INFO("controller " << c);
+    CHECK_FALSE(j[c]["ok"].get<bool>());
+    const std::string failure = j[c]["failure"].get<std::string>();
+    CHECK((failure.find("no pressures") != std::string::npos || failure.find("pilot commands for actuators.fidelity limited") != std::string::npos));
+    CHECK(j[c]["tracking_samples"].get<long long>() == 0);
+    // A metric of no samples is absent, not 0.
+    CHECK(j[c]["rms_error"].is_null());
+    CHECK(j[c]["max_error"].is_null());
+    CHECK(j[c]["tracking"]["rms_error"].is_null());
+    CHECK(j[c]["tracking"]["max_error"].is_null());
+    CHECK(r.out.find("  FAILED: " + j[c]["failure"].get<std::string>() + "\n") != std::string::npos);
+  }
+  CHECK(r.out.find("n/a") != std::string::npos);
+  CHECK(r.out.find("0.000e+00") == std::string::npos);
+  fs::remove(scene);
+}
+
+TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records every message of every cycle of the 10 s dig, every controller the scene runs") {
   // Multicast on the loopback must work: a machine without it fails here with what to run.
   const int port = 17700 + static_cast<int>(getpid() % 200);
   const std::string url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
-  const int route = std::system("ip route get 239.255.76.67 2>/dev/null | grep -q ' dev lo '");
-  REQUIRE_MESSAGE(route == 0, "239.255.0.0/16 is not routed to the loopback; as root run: ip link set lo multicast on; "
-                              "ip route add 239.255.0.0/16 dev lo (tools/install-deps test does)");
+  const bool lo_multicast = std::system("ip link show lo 2>/dev/null | grep -q MULTICAST") == 0;
+  const bool routed = std::system("ip route get 239.255.76.67 2>/dev/null | grep -q ' dev lo '") == 0;
+  REQUIRE_MESSAGE((lo_multicast && routed),
+                  "LCM's multicast does not reach the loopback (lo " << std::string(lo_multicast ? "has" : "lacks")
+                  << " MULTICAST, 239.255.0.0/16 " << std::string(routed ? "is" : "is not") << " routed to lo); as root run: "
+                  "ip link set lo multicast on; ip route add 239.255.0.0/16 dev lo (tools/install-deps test does)");
   const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
   fs::create_directories(dir);
   const fs::path log_path = (fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : dir) /
@@ -289,7 +370,8 @@ TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback reco
   // Ready once its file exists (lcm-logger creates it when it starts listening).
   for (int i = 0; i < 250 && !fs::exists(log_path); ++i) usleep(20000);
   usleep(200000);
-  const Run r = run_sim("run " + kDig + " --duration 1 --quiet --no-report --lcm '" + url + "' --out out");
+  // The main job's shipped dig, 10 s, with the controllers the scene runs by default.
+  const Run r = run_sim("run " + kDig + " --quiet --no-report --json summary.json --lcm '" + url + "' --out out");
   usleep(500000);  // the tail reaches the logger
   kill(logger, SIGINT);
   int status = 0;
@@ -297,16 +379,17 @@ TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback reco
   INFO(r.err);
   REQUIRE(r.status == 0);
   REQUIRE(fs::exists(log_path));
-  const std::map<std::string, LogChannel> log = read_log_channels(log_path);
-  for (const char* c : {"pid", "adaptive"}) {
-    for (const char* base : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
-      const std::string channel = std::string(base) + "/" + c;
-      INFO(channel);
-      REQUIRE(log.count(channel) == 1);
-      CHECK(log.at(channel).count == 1000);
-      CHECK(log.at(channel).gaps == 0);
-      CHECK(log.at(channel).first_seq == 0);
-    }
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
+  CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.0).epsilon(1e-3));
+  std::vector<std::string> controllers;
+  for (const auto& [key, value] : j.items())
+    if (value.is_object() && value.contains("telemetry")) controllers.push_back(key);
+  CHECK(controllers == std::vector<std::string>{"adaptive", "flow", "pid"});  // the JSON's keys, sorted
+  check_every_cycle_logged(read_log_channels(log_path), controllers, 10000);
+  for (const std::string& c : controllers) {
+    INFO(c);
+    CHECK(j[c]["telemetry"]["dropped"].get<long long>() == 0);
+    CHECK(j[c]["telemetry"]["published"].get<long long>() == j[c]["telemetry"]["enqueued"].get<long long>());
   }
   fs::remove(log_path);
 }

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   CLI::App app{"excavator-plant: the simulated excavator on a SocketCAN interface (see README)."};
   std::string iface, scene_path, lcm_url;
   double duration = 0, silence_ms = 500, startup_s = 120;
+  bool realtime = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--scene", scene_path, "scene file")->required();
   app.add_option("--duration", duration, "exit after this many simulated seconds (default: the scene's)")
@@ -34,15 +35,21 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber);
   app.add_option("--startup-timeout", startup_s, "give up if no SYNC arrives within this many seconds")
       ->check(CLI::PositiveNumber);
+  app.add_flag("--realtime", realtime,
+               "the firmware runs --realtime: a full telemetry ring drops and counts messages instead of "
+               "delaying the answer to SYNC past the firmware's deadline (default: wait, lose nothing)");
   CLI11_PARSE(app, argc, argv);
 
   try {
     exc::plant::Plant plant(exc::plant::load_scene(scene_path));
     exc::app::NodeIo io;
     std::string error;
-    // No deadline on the plant's side (it steps on SYNC): telemetry waits rather than drops.
-    if (const int code = exc::app::open_node_io(exc::hal::Node::plant, iface, lcm_url,
-                                                exc::telemetry::OverflowPolicy::block, io, error)) {
+    // The plant steps on SYNC and has no clock of its own, but its answer is part of the firmware's
+    // cycle: in lockstep the firmware waits for it, so telemetry waits too and records everything;
+    // against a real-time firmware a late answer misses the firmware's deadline (its sensor wait ends
+    // 10 % of the period before it), so a full ring drops and counts, as the firmware's does.
+    const auto overflow = realtime ? exc::telemetry::OverflowPolicy::drop_newest : exc::telemetry::OverflowPolicy::block;
+    if (const int code = exc::app::open_node_io(exc::hal::Node::plant, iface, lcm_url, overflow, io, error)) {
       std::cerr << "excavator-plant: " << error << "\n";
       return code;
     }
@@ -92,10 +99,17 @@ int main(int argc, char** argv) {
       }
     }
     node.publish_counters();
-    if (publisher) publisher->stop();
-    std::printf("excavator-plant: %llu steps, %.3f s simulated, %llu holds, CAN rejects %llu\n",
+    exc::telemetry::TelemetryCounters tc;
+    if (publisher) {
+      publisher->stop();
+      tc = publisher->counters();
+    }
+    std::printf("excavator-plant: %llu steps, %.3f s simulated, %llu holds, CAN rejects %llu; telemetry (%s) %llu "
+                "messages, %llu dropped, ring high water %zu of %zu\n",
                 static_cast<unsigned long long>(node.steps()), plant.state().time,
-                static_cast<unsigned long long>(node.holds()), static_cast<unsigned long long>(port.rx_stats().rejected()));
+                static_cast<unsigned long long>(node.holds()), static_cast<unsigned long long>(port.rx_stats().rejected()),
+                exc::telemetry::to_string(overflow), static_cast<unsigned long long>(tc.published),
+                static_cast<unsigned long long>(tc.dropped_full_total), tc.ring_high_water, tc.ring_capacity);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "excavator-plant: " << e.what() << "\n";

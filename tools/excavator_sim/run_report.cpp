@@ -21,6 +21,11 @@ nlohmann::json per_joint(const double (&v)[4]) {
   return j;
 }
 
+// A tracking figure of a run: null when the run never tracked (a metric of no samples is not 0).
+nlohmann::json tracked(const RunResult& r, const double (&v)[4]) {
+  return r.tracking_samples > 0 ? per_joint(v) : nlohmann::json(nullptr);
+}
+
 // printf into a string of any length (a failure reason may be long).
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 std::string format(const char* fmt, ...) {
@@ -69,7 +74,9 @@ void print_summary(const Summary& summary, std::ostream& out) {
   out << "\n";
   for (int j = 0; j < 4; ++j) {
     out << format("  %-7s (%-3s)                     ", kJoints[j], kUnits[j]);
-    for (const RunResult& r : summary.runs) out << format("| %10.3e %10.3e    ", r.rms_error[j], r.max_error[j]);
+    for (const RunResult& r : summary.runs)
+      out << (r.tracking_samples > 0 ? format("| %10.3e %10.3e    ", r.rms_error[j], r.max_error[j])
+                                     : format("| %10s %10s    ", "n/a", "n/a"));
     out << "\n";
   }
   print_cycles(summary, out);
@@ -112,9 +119,10 @@ nlohmann::json to_json(const Summary& summary) {
     nlohmann::json run;
     run["ok"] = r.ok;
     if (!r.ok) run["failure"] = r.failure;
-    run["rms_error"] = per_joint(r.rms_error);
-    run["max_error"] = per_joint(r.max_error);
-    run["tracking"] = {{"rms_error", per_joint(r.measured_rms_error)}, {"max_error", per_joint(r.measured_max_error)}};
+    run["rms_error"] = tracked(r, r.rms_error);
+    run["max_error"] = tracked(r, r.max_error);
+    run["tracking"] = {{"rms_error", tracked(r, r.measured_rms_error)}, {"max_error", tracked(r, r.measured_max_error)}};
+    run["tracking_samples"] = r.tracking_samples;
     nlohmann::json theta_hat, theta_true;
     for (int i = 0; i < 6; ++i) {
       theta_hat[kTheta[i]] = r.theta_hat[i];

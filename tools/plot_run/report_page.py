@@ -20,10 +20,12 @@ SIM_JOINTS = (("swing", "mrad"), ("boom", "mm"), ("arm", "mm"), ("bucket", "mm")
 
 
 def sim_runs(summary):
-    """The per-controller runs of an excavator-sim summary (objects with an rms_error per joint)."""
+    """The per-controller runs of an excavator-sim summary (objects with an rms_error per joint, or null
+    for a run that never tracked: its figures are then n/a)."""
     if not isinstance(summary, dict):
         return {}
-    runs = {k: v for k, v in summary.items() if isinstance(v, dict) and isinstance(v.get("rms_error"), dict)}
+    runs = {k: v for k, v in summary.items()
+            if isinstance(v, dict) and "rms_error" in v and (v["rms_error"] is None or isinstance(v["rms_error"], dict))}
     order = ["pid", "adaptive", "slotine_li"]  # the baseline first, as in the paper's figures
     return dict(sorted(runs.items(), key=lambda kv: (order.index(kv[0]) if kv[0] in order else len(order), kv[0])))
 
