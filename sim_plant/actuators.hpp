@@ -44,8 +44,10 @@ const char* to_string(ActuatorCommand::Mode m);
 class ActuatorModel {
  public:
   ActuatorModel() = default;
-  // Throws SettingsError when machine.hydraulics is outside its ranges (hydraulic fidelity).
-  ActuatorModel(const Machine& machine, const ActuatorParameters& params);
+  // Throws SettingsError when machine.hydraulics is outside its ranges (hydraulic fidelity);
+  // `pressures` integrates the chambers (chamber.hpp).
+  ActuatorModel(const Machine& machine, const ActuatorParameters& params,
+                PressureMethod pressures = PressureMethod::backward_euler);
 
   const ActuatorParameters& parameters() const { return params_; }
 

@@ -10,7 +10,8 @@
 
 namespace exc::plant {
 
-HydraulicCircuit::HydraulicCircuit(const Machine& machine) : hp_(machine.hydraulics) {
+HydraulicCircuit::HydraulicCircuit(const Machine& machine, PressureMethod pressures)
+    : hp_(machine.hydraulics), pressures_(pressures) {
   validate_hydraulics(machine);
   main_relief_ = hp_.supply_pressure > 0 ? hp_.supply_pressure : hp_.main_relief_pressure;
   q_min_ = machine.q_min();
@@ -124,7 +125,8 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     scale[g] = flow_share_scale(demand[g], pump_limit);
     saturated = saturated || scale[g] < 1;
   }
-  // Chambers: backward Euler each (chamber.hpp), the piston's sweep from this substep's velocity.
+  // Chambers: backward Euler each (or forward, chamber.hpp), the piston's sweep from this substep's
+  // velocity.
   Vec4 mean_a, mean_b, meter_in;
   bool relief = false, cavitation = false;
   r.solver_iterations = 0;
@@ -149,8 +151,9 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     }
     const double va1 = volume_a(i, q_a), vb1 = volume_b(i, q_a);
     const double swept_a = g_.area_a[i] * qd_a[i] * dt, swept_b = -g_.area_b[i] * qd_a[i] * dt;
-    const ChamberStep sa = step_chamber(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
-    const ChamberStep sb = step_chamber(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);
+    const auto step = pressures_ == PressureMethod::backward_euler ? &step_chamber : &step_chamber_explicit;
+    const ChamberStep sa = step(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
+    const ChamberStep sb = step(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);
     r.solver_iterations += sa.iterations + sb.iterations;
     // Energy, with trapezoidal pressures (HydraulicEnergy closes exactly with them).
     const ChamberStep* steps[2] = {&sa, &sb};

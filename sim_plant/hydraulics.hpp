@@ -23,6 +23,7 @@
 
 #include "model/hydraulic_geometry.hpp"
 #include "model/machine.hpp"
+#include "sim_plant/chamber.hpp"
 
 namespace exc::plant {
 
@@ -69,8 +70,9 @@ struct HydraulicReport {
 class HydraulicCircuit {
  public:
   HydraulicCircuit() = default;
-  // Throws SettingsError naming the field when machine.hydraulics is outside its ranges.
-  explicit HydraulicCircuit(const Machine& machine);
+  // Throws SettingsError naming the field when machine.hydraulics is outside its ranges. The
+  // chamber pressures are integrated by `pressures` (chamber.hpp).
+  explicit HydraulicCircuit(const Machine& machine, PressureMethod pressures = PressureMethod::backward_euler);
 
   // Chamber pressures that hold 'hold' (the lower side at twice tank pressure), spools centred.
   void reset(const Vec4& q_a, const Vec4& hold);
@@ -105,6 +107,7 @@ class HydraulicCircuit {
   void update_pump_report(const Vec4& load_a, const Vec4& load_b);
 
   HydraulicParameters hp_;
+  PressureMethod pressures_ = PressureMethod::backward_euler;
   double main_relief_ = 0;
   Vec4 q_min_ = Vec4::Zero(), q_max_ = Vec4::Zero();
   HydraulicGeometry g_;  // areas and fully open orifice gains (model/hydraulic_geometry.hpp)
