@@ -49,6 +49,7 @@ double HydraulicCircuit::stored_energy(const Vec4& q_a) const {
 void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
   target_.setZero();
   spool_.setZero();
+  stuck_ = -1;
   const double low = 2.0 * hp_.tank_pressure;
   for (int i = 0; i < kNumActive; ++i) {
     const double f = hold[i];
@@ -71,6 +72,11 @@ void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
 
 void HydraulicCircuit::command_opening(const Vec4& opening) {
   for (int i = 0; i < kNumActive; ++i) target_[i] = spool_target_from_opening(opening[i]);
+}
+
+void HydraulicCircuit::stick_spool(int function, double spool) {
+  stuck_ = std::clamp(function, 0, kNumActive - 1);
+  stuck_spool_ = std::clamp(spool, -1.0, 1.0);
 }
 
 void HydraulicCircuit::command_pilots(const Vec4& pilot_a, const Vec4& pilot_b) {
@@ -100,7 +106,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   HydraulicEnergy& e = r.energy;
   // Spools: lag toward the target, then the dead zone of the direction they moved in.
   for (int i = 0; i < kNumActive; ++i) {
-    spool_[i] = spool_lag(spool_[i], target_[i], hp_.valve_time_constant, dt);
+    spool_[i] = i == stuck_ ? stuck_spool_ : spool_lag(spool_[i], target_[i], hp_.valve_time_constant, dt);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);
     r.opening[i] = spool_[i] >= 0 ? a : -a;
   }
