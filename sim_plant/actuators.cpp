@@ -14,13 +14,14 @@ const char* to_string(ActuatorCommand::Mode m) {
   return "?";
 }
 
-ActuatorModel::ActuatorModel(const Machine& machine, const ActuatorParameters& params) : params_(params) {
+ActuatorModel::ActuatorModel(const Machine& machine, const ActuatorParameters& params, PressureMethod pressures)
+    : params_(params) {
   effort_min_ = machine.effort_min();
   effort_max_ = machine.effort_max();
   // Only the hydraulic fidelity validates and uses the circuit; the others keep the cylinder areas
   // (for the sensors' pressure channels) from a circuit with the default hydraulics.
   if (params.fidelity == ActuatorFidelity::hydraulic) {
-    circuit_ = HydraulicCircuit(machine);
+    circuit_ = HydraulicCircuit(machine, pressures);
   } else {
     Machine areas_only = machine;
     areas_only.hydraulics = HydraulicParameters{};

@@ -44,8 +44,10 @@ const char* to_string(ActuatorCommand::Mode m);
 class ActuatorModel {
  public:
   ActuatorModel() = default;
-  // Throws SettingsError when machine.hydraulics is outside its ranges (hydraulic fidelity).
-  ActuatorModel(const Machine& machine, const ActuatorParameters& params);
+  // Throws SettingsError when machine.hydraulics is outside its ranges (hydraulic fidelity);
+  // `pressures` integrates the chambers (chamber.hpp).
+  ActuatorModel(const Machine& machine, const ActuatorParameters& params,
+                PressureMethod pressures = PressureMethod::backward_euler);
 
   const ActuatorParameters& parameters() const { return params_; }
 
@@ -66,6 +68,9 @@ class ActuatorModel {
   void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
 
   const HydraulicCircuit& hydraulics() const { return circuit_; }
+  // Fault injection (hydraulic): a spool stuck whatever the command (HydraulicCircuit::stick_spool).
+  void stick_spool(int function, double spool) { circuit_.stick_spool(function, spool); }
+  void release_spool() { circuit_.release_spool(); }
   const Vec4& spool() const { return circuit_.spool(); }
   const Vec4& pressure_a() const { return circuit_.pressure_a(); }  // cylinder bore side; swing: port A
   const Vec4& pressure_b() const { return circuit_.pressure_b(); }

@@ -36,6 +36,26 @@ ChamberFlows chamber_flows(const ChamberValves& v, double p, double& dnet_dp) {
   return q;
 }
 
+namespace {
+
+// The flows at p, and the end pressure that satisfies the discrete balance with exactly these flows,
+// so that the volume (and energy) bookkeeping closes to round-off; below the floor the make-up could
+// not keep up and the missing oil is a vapour void.
+void close_balance(const ChamberValves& v, double p, double p0, double c, double dt, double swept, double floor,
+                   bool may_void, ChamberStep& out) {
+  double unused;
+  const ChamberFlows q = chamber_flows(v, p, unused);
+  double p1 = p0 + (dt * q.net() - swept) / c;
+  if (p1 < floor && may_void) {
+    out.void_volume = c * (floor - p1);
+    p1 = floor;
+  }
+  out.pressure = p1;
+  out.flows = q;
+}
+
+}  // namespace
+
 ChamberStep step_chamber(const ChamberValves& v, double p0, double volume, double bulk_modulus, double dt,
                          double swept, double floor) {
   const double c = volume / bulk_modulus;  // m^3/Pa, the chamber's capacitance
@@ -74,17 +94,16 @@ ChamberStep step_chamber(const ChamberValves& v, double p0, double volume, doubl
   // Below the floor the make-up could not keep up: the chamber stays at the floor and the missing
   // oil is a vapour void, with the flows of the floor pressure.
   if (p < floor) p = floor;
-  double unused;
-  q = chamber_flows(v, p, unused);
-  // The end pressure that satisfies the discrete balance with exactly these flows, so that the
-  // volume (and energy) bookkeeping closes to round-off.
-  double p1 = p0 + (dt * q.net() - swept) / c;
-  if (p1 < floor) {
-    out.void_volume = c * (floor - p1);
-    p1 = floor;
-  }
-  out.pressure = p1;
-  out.flows = q;
+  close_balance(v, p, p0, c, dt, swept, floor, true, out);
+  return out;
+}
+
+ChamberStep step_chamber_explicit(const ChamberValves& v, double p0, double volume, double bulk_modulus, double dt,
+                                  double swept, double floor) {
+  ChamberStep out;
+  // A void opens only where the step saw the make-up valve open (p0 below tank); from above it the
+  // pressure is left below the floor for the plant's pressure check (chamber.hpp).
+  close_balance(v, p0, p0, volume / bulk_modulus, dt, swept, floor, p0 < v.tank, out);
   return out;
 }
 

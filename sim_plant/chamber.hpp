@@ -8,9 +8,25 @@
 // non-increasing in p, so the left side minus the right is strictly increasing in p1: one root,
 // found by Newton's method safeguarded by bisection once bracketed. Unconditionally stable, no
 // overshoot past a relief setting or below the make-up valve's tank pressure.
+// The alternative (integrator.pressure_method forward_euler) takes the flows at the start pressure:
+//   V1 / beta (p1 - p0) = dt Q(p0) - dV
+// one flow evaluation, no solve. It overshoots a valve that opens within the step (a make-up valve
+// below tank, a relief above its setting): bounded where the valve is one-sided, but a chamber that
+// falls from above tank to below the vapour floor in one step jumped the make-up valve it never saw.
+// That is no vapour void but an unresolved step: the pressure is left below the floor, and the
+// plant's pressure check stops the run (docs/bench.md has where on which input).
 #include "model/hydraulic_geometry.hpp"
+#include "settings/enum_table.hpp"
 
 namespace exc::plant {
+
+enum class PressureMethod { backward_euler, forward_euler };
+// The names a scene's integrator.pressure_method takes.
+inline constexpr settings::EnumTable<PressureMethod, 2> kPressureMethods{{{
+    {PressureMethod::backward_euler, "backward_euler", "implicit per chamber and substep, unconditionally stable (the default)"},
+    {PressureMethod::forward_euler, "forward_euler", "explicit: each chamber's flows at the substep's start; overshoots the valves above a step the input sets"},
+}}};
+inline const char* to_string(PressureMethod m) { return kPressureMethods.name_of(m); }
 
 // The valves connected to one chamber during a substep (all gains already include the opening).
 struct ChamberValves {
@@ -49,5 +65,8 @@ struct ChamberStep {
 // motor's) motion grew the chamber during the substep (m^3, negative when it shrank it).
 ChamberStep step_chamber(const ChamberValves& v, double p0, double volume, double bulk_modulus, double dt,
                          double swept, double floor);
+// The same balance with the flows at p0 (forward Euler): one evaluation, iterations = 0.
+ChamberStep step_chamber_explicit(const ChamberValves& v, double p0, double volume, double bulk_modulus, double dt,
+                                  double swept, double floor);
 
 }  // namespace exc::plant

@@ -10,7 +10,8 @@
 
 namespace exc::plant {
 
-HydraulicCircuit::HydraulicCircuit(const Machine& machine) : hp_(machine.hydraulics) {
+HydraulicCircuit::HydraulicCircuit(const Machine& machine, PressureMethod pressures)
+    : hp_(machine.hydraulics), pressures_(pressures) {
   validate_hydraulics(machine);
   main_relief_ = hp_.supply_pressure > 0 ? hp_.supply_pressure : hp_.main_relief_pressure;
   q_min_ = machine.q_min();
@@ -48,6 +49,7 @@ double HydraulicCircuit::stored_energy(const Vec4& q_a) const {
 void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
   target_.setZero();
   spool_.setZero();
+  stuck_ = -1;
   const double low = 2.0 * hp_.tank_pressure;
   for (int i = 0; i < kNumActive; ++i) {
     const double f = hold[i];
@@ -70,6 +72,11 @@ void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
 
 void HydraulicCircuit::command_opening(const Vec4& opening) {
   for (int i = 0; i < kNumActive; ++i) target_[i] = spool_target_from_opening(opening[i]);
+}
+
+void HydraulicCircuit::stick_spool(int function, double spool) {
+  stuck_ = std::clamp(function, 0, kNumActive - 1);
+  stuck_spool_ = std::clamp(spool, -1.0, 1.0);
 }
 
 void HydraulicCircuit::command_pilots(const Vec4& pilot_a, const Vec4& pilot_b) {
@@ -100,7 +107,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // Spools: lag toward the target, then the dead zone of the direction they moved in.
   const double lag_gain = spool_lag_gain(hp_.valve_time_constant, dt);
   for (int i = 0; i < kNumActive; ++i) {
-    spool_[i] = spool_lag(spool_[i], target_[i], lag_gain);
+    spool_[i] = i == stuck_ ? stuck_spool_ : spool_lag(spool_[i], target_[i], lag_gain);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);
     r.opening[i] = spool_[i] >= 0 ? a : -a;
   }
@@ -125,7 +132,8 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     scale[g] = flow_share_scale(demand[g], pump_limit);
     saturated = saturated || scale[g] < 1;
   }
-  // Chambers: backward Euler each (chamber.hpp), the piston's sweep from this substep's velocity.
+  // Chambers: backward Euler each (or forward, chamber.hpp), the piston's sweep from this substep's
+  // velocity.
   Vec4 mean_a, mean_b, meter_in;
   bool relief = false, cavitation = false;
   r.solver_iterations = 0;
@@ -150,8 +158,9 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     }
     const double va1 = volume_a(i, q_a), vb1 = volume_b(i, q_a);
     const double swept_a = g_.area_a[i] * qd_a[i] * dt, swept_b = -g_.area_b[i] * qd_a[i] * dt;
-    const ChamberStep sa = step_chamber(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
-    const ChamberStep sb = step_chamber(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);
+    const auto step = pressures_ == PressureMethod::backward_euler ? &step_chamber : &step_chamber_explicit;
+    const ChamberStep sa = step(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
+    const ChamberStep sb = step(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);
     r.solver_iterations += sa.iterations + sb.iterations;
     // Energy, with trapezoidal pressures (HydraulicEnergy closes exactly with them).
     const ChamberStep* steps[2] = {&sa, &sb};

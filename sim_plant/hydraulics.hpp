@@ -23,6 +23,7 @@
 
 #include "model/hydraulic_geometry.hpp"
 #include "model/machine.hpp"
+#include "sim_plant/chamber.hpp"
 
 namespace exc::plant {
 
@@ -69,14 +70,22 @@ struct HydraulicReport {
 class HydraulicCircuit {
  public:
   HydraulicCircuit() = default;
-  // Throws SettingsError naming the field when machine.hydraulics is outside its ranges.
-  explicit HydraulicCircuit(const Machine& machine);
+  // Throws SettingsError naming the field when machine.hydraulics is outside its ranges. The
+  // chamber pressures are integrated by `pressures` (chamber.hpp).
+  explicit HydraulicCircuit(const Machine& machine, PressureMethod pressures = PressureMethod::backward_euler);
 
-  // Chamber pressures that hold 'hold' (the lower side at twice tank pressure), spools centred.
+  // Chamber pressures that hold 'hold' (the lower side at twice tank pressure), spools centred and
+  // free.
   void reset(const Vec4& q_a, const Vec4& hold);
   // Spool targets: a signed opening per function (-1..1) or pilot pressures on each spool end (Pa).
   void command_opening(const Vec4& opening);
   void command_pilots(const Vec4& pilot_a, const Vec4& pilot_b);
+  // Fault injection: the spool of `function` (0 swing .. 3 bucket) stuck at `spool` (-1..1) whatever
+  // its target, until release_spool(). Nothing else changes: the pumps feed it and its chambers fill
+  // and drain through the opening it is stuck at, with every other valve centred too.
+  void stick_spool(int function, double spool);
+  void release_spool() { stuck_ = -1; }
+  int stuck_function() const { return stuck_; }  // -1: none
 
   // Advance spools, pumps and chambers over dt; q_a is the position at the end, qd_a the velocity
   // over the substep (the piston sweeps A qd_a dt).
@@ -105,6 +114,9 @@ class HydraulicCircuit {
   void update_pump_report(const Vec4& load_a, const Vec4& load_b);
 
   HydraulicParameters hp_;
+  PressureMethod pressures_ = PressureMethod::backward_euler;
+  int stuck_ = -1;
+  double stuck_spool_ = 0;
   double main_relief_ = 0;
   Vec4 q_min_ = Vec4::Zero(), q_max_ = Vec4::Zero();
   HydraulicGeometry g_;  // areas and fully open orifice gains (model/hydraulic_geometry.hpp)

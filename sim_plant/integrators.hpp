@@ -10,6 +10,7 @@
 // The efforts are held over a step. Nothing here allocates.
 #include "settings/enum_table.hpp"
 #include "model/closed_chain.hpp"
+#include "sim_plant/chamber.hpp"
 #include "sim_plant/soil.hpp"
 
 namespace exc::plant {
@@ -39,6 +40,8 @@ struct IntegratorSettings {
   double baumgarte_beta = 20.0;    // 1/s
   int implicit_max_iterations = 12;
   double implicit_tolerance = 1e-10;  // on the midpoint velocity residual (m/s, rad/s)
+  // Hydraulic: how the chamber pressures are integrated over each substep (chamber.hpp).
+  PressureMethod pressure_method = PressureMethod::backward_euler;
 };
 
 // Position and velocity in both coordinate sets. The independent formulation integrates q_a, qd_a

@@ -14,7 +14,7 @@ Plant::Plant(const Scene& scene)
       model_(build_model(scene.machine)),
       ws_(model_),
       soil_(scene.terrain, scene.soil),
-      actuators_(scene.machine, scene.actuators),
+      actuators_(scene.machine, scene.actuators, scene.integrator.pressure_method),
       sensors_(scene.sensors),
       integrator_(model_, scene.integrator) {
   q_min_ = scene.machine.q_min();

@@ -54,6 +54,10 @@ class Plant {
 
   // Fault injection (the fault campaign): the soil stiffer by `scale` from now on (1: the scene's).
   void set_soil_stiffness_scale(double scale) { soil_.set_stiffness_scale(scale, scene_.soil); }
+  // Fault injection (hydraulic fidelity): the spool of `function` (0 swing .. 3 bucket) stuck at
+  // `spool` (-1..1) whatever is commanded, from the next step until release_spool() or reset().
+  void stick_spool(int function, double spool) { actuators_.stick_spool(function, spool); }
+  void release_spool() { actuators_.release_spool(); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.

@@ -43,10 +43,14 @@ void unstable(PlantStatus& status, PlantFailure failure, const CheckInputs& in, 
               double limit) {
   const IntegratorSettings& s = *in.integrator;
   const char* other = s.method == IntegrationMethod::implicit_midpoint ? "rk4" : "implicit_midpoint";
+  // Explicit pressures of a hydraulic machine are the first suspect.
+  const bool explicit_pressures = in.pressure_a != nullptr && s.pressure_method == PressureMethod::forward_euler;
   set_failure(status, failure, in.time, in.cycle,
-              "%s (%.4g, limit %.4g) with integrator %s / %s at step %.4g s: the integration is unstable here; "
-              "use a smaller integrator.step (try %.4g s) or another integrator.method (%s)",
-              what, value, limit, to_string(s.method), to_string(s.formulation), s.step, 0.5 * s.step, other);
+              "%s (%.4g, limit %.4g) with integrator %s / %s%s at step %.4g s: the integration is unstable here; "
+              "use a smaller integrator.step (try %.4g s) or another integrator.%s (%s)",
+              what, value, limit, to_string(s.method), to_string(s.formulation),
+              explicit_pressures ? " / pressures forward_euler" : "", s.step, 0.5 * s.step,
+              explicit_pressures ? "pressure_method" : "method", explicit_pressures ? "backward_euler" : other);
 }
 
 }  // namespace
@@ -95,13 +99,24 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
       for (int side = 0; side < 2; ++side) {
         const double p = side == 0 ? (*in.pressure_a)[i] : (*in.pressure_b)[i];
         if (p >= in.pressure_min && p <= in.pressure_max) continue;
+        const char* chamber =
+            side == 0 ? (i == 0 ? "port A" : "bore-side") : (i == 0 ? "port B" : "rod-side");
+        if (integ.pressure_method == PressureMethod::forward_euler) {
+          set_failure(status, PlantFailure::pressure_range, in.time, in.cycle,
+                      "the %s %s pressure is %.6g MPa, outside [%.4g, %.4g] MPa (vapour .. highest relief + "
+                      "checks.pressure_check_margin) with integrator.pressure_method forward_euler at step %.4g s: "
+                      "the explicit update overshoots at this step (past a valve that opens in between: a make-up "
+                      "valve, a relief); use pressure_method backward_euler or a smaller integrator.step (try %.4g s)",
+                      kActiveNames[i], chamber, p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6, integ.step,
+                      0.5 * integ.step);
+          return false;
+        }
         set_failure(status, PlantFailure::pressure_range, in.time, in.cycle,
                     "the %s %s pressure is %.6g MPa, outside [%.4g, %.4g] MPa (vapour .. highest relief + "
                     "checks.pressure_check_margin): a relief passes more than its override allows (a load the "
                     "reliefs cannot hold) or the pressures were integrated wrongly; check the reliefs and "
                     "hydraulics.bulk_modulus",
-                    kActiveNames[i], side == 0 ? (i == 0 ? "port A" : "bore-side") : (i == 0 ? "port B" : "rod-side"),
-                    p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6);
+                    kActiveNames[i], chamber, p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6);
         return false;
       }
     }

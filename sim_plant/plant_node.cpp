@@ -160,8 +160,12 @@ void PlantNode::publish_counters() {
 }
 
 void PlantNode::set_fault(const InjectedFault& fault) {
+  if (fault_.kind == InjectedFault::Kind::valve_stuck) plant_.release_spool();
   fault_ = fault;
   fault_started_ = false;
+  // A stuck spool is the circuit's own state: no command moves it (hydraulic plants; the others have
+  // no spools and ignore it).
+  if (fault.kind == InjectedFault::Kind::valve_stuck) plant_.stick_spool(fault.joint, fault.magnitude);
 }
 
 void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {

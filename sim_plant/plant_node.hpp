@@ -21,10 +21,12 @@ namespace exc::app {
 // A fault injected into the simulated machine (the fault campaign): what a real machine's sensor or
 // actuator can do while the firmware cannot tell from the frames alone.
 struct InjectedFault {
-  enum class Kind : std::uint8_t { none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam };
+  enum class Kind : std::uint8_t { none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, valve_stuck };
   Kind kind = Kind::none;
   int joint = 0;          // 0 swing .. 3 bucket
-  double magnitude = 0;   // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost
+  // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; valve_stuck: the spool
+  // position (-1..1) it sticks at, whatever is commanded (the hydraulic plant's circuit holds it).
+  double magnitude = 0;
 };
 
 struct PlantNodeConfig {

@@ -47,6 +47,7 @@ void read_integrator(SectionReader& integ, Scene& s) {
   integ.number("baumgarte_beta", i.baumgarte_beta, {0, 1e4}, "1/s", "augmented_baumgarte position gain");
   integ.whole("implicit_max_iterations", i.implicit_max_iterations, 1, 100, "", "implicit midpoint iterations");
   integ.number("implicit_tolerance", i.implicit_tolerance, {1e-14, 1e-3}, "", "on the midpoint velocity residual");
+  integ.choice("pressure_method", i.pressure_method, kPressureMethods, "hydraulic: the chamber pressures' integration");
   integ.finish();
 }
 

@@ -38,6 +38,7 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::model: return "model";
     case FirmwareFault::tracking_error: return "tracking error";
     case FirmwareFault::no_pressures: return "no pressures";
+    case FirmwareFault::pump_limited: return "pumps short of flow";
   }
   return "unknown";
 }
@@ -153,16 +154,11 @@ void FirmwareNode::end_cycle() {
   if (machine_.mode() == control::Mode::track) measured_.add(to_vec(sensors_.position), q_d_);
   if (telemetry_ != nullptr) publish_cycle();
   if (telemetry_ != nullptr && transition.changed) {
-    exlcm::fault_t f{};
-    f.utime = utime();
-    f.code = static_cast<std::int32_t>(transition.to == control::Mode::safe_stop ? fault_code_ : FirmwareFault::none);
-    f.severity = transition.to == control::Mode::safe_stop ? 2 : 0;
-    f.active = transition.to == control::Mode::safe_stop;
-    std::snprintf(reinterpret_cast<char*>(f.text), sizeof(f.text), "%s -> %s: %s%s%s", control::to_string(transition.from),
-                  control::to_string(transition.to), transition.reason,
-                  transition.to == control::Mode::safe_stop ? ": " : "",
-                  transition.to == control::Mode::safe_stop ? fault_text_ : "");
-    telemetry_->publish(telemetry::Channel::fault, f);
+    const bool stop = transition.to == control::Mode::safe_stop;
+    char text[sizeof(exlcm::fault_t::text)];
+    std::snprintf(text, sizeof text, "%s -> %s: %s%s%s", control::to_string(transition.from),
+                  control::to_string(transition.to), transition.reason, stop ? ": " : "", stop ? fault_text_ : "");
+    publish_fault(stop ? fault_code_ : FirmwareFault::none, stop ? 2 : 0, stop, text);
   }
   // The cycle's scope (stated once, in firmware_node.hpp): read to telemetry encoded, the periodic
   // counter messages included.
@@ -170,6 +166,40 @@ void FirmwareNode::end_cycle() {
   const std::int64_t end_ns = hal::monotonic_now_ns();
   if (telemetry_ != nullptr) telemetry_timing_.record_ns(end_ns - write_end_ns);
   cycle_timing_.record_ns(end_ns - start_ns);
+}
+
+void FirmwareNode::publish_fault(FirmwareFault code, std::int8_t severity, bool active, const char* text) {
+  if (telemetry_ == nullptr) return;
+  exlcm::fault_t f{};
+  f.utime = static_cast<std::int64_t>(time() * 1e6);
+  f.code = static_cast<std::int32_t>(code);
+  f.severity = severity;
+  f.active = active;
+  std::snprintf(reinterpret_cast<char*>(f.text), sizeof(f.text), "%s", text);
+  telemetry_->publish(telemetry::Channel::fault, f);
+}
+
+void FirmwareNode::update_pump_warning(bool limited, double demanded_flow) {
+  if (pump_warning_) pump_warning_peak_ = std::max(pump_warning_peak_, demanded_flow);
+  pump_run_ = limited != pump_warning_ ? pump_run_ + 1 : 0;
+  if (pump_run_ < kPumpWarningCycles) return;
+  pump_run_ = 0;
+  pump_warning_ = limited;
+  const double pumps = model_.machine.hydraulics.pump_flow, t = time();
+  if (limited) {
+    ++pump_warnings_;
+    pump_warning_start_ = t;
+    pump_warning_peak_ = demanded_flow;
+    std::snprintf(warning_text_, sizeof warning_text_,
+                  "pumps short of flow: the valves ask %.0f L/min of their %.0f L/min, every function slows to %.0f %% "
+                  "(t = %.3f s)",
+                  demanded_flow * 60000, pumps * 60000, 100 * pumps / demanded_flow, t);
+  } else {
+    std::snprintf(warning_text_, sizeof warning_text_,
+                  "pumps within their flow again after %.2f s (at most %.0f L/min asked of %.0f; t = %.3f s)",
+                  t - pump_warning_start_, pump_warning_peak_ * 60000, pumps * 60000, t);
+  }
+  publish_fault(FirmwareFault::pump_limited, 1, limited, warning_text_);
 }
 
 void FirmwareNode::record_wakeup(std::int64_t interval_ns, std::uint64_t overruns, std::uint64_t skipped) {
@@ -188,6 +218,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     command_.mode = hal::CommandMode::valve;
     command_.value = {0, 0, 0, 0};
     last_sent_.setZero();
+    update_pump_warning(false, 0);  // centred valves ask nothing
     return;
   }
   const std::int64_t start_ns = hal::monotonic_now_ns();
@@ -283,6 +314,7 @@ void FirmwareNode::command_valves(const Vec4& q) {
     v = &valves_.from_force(tau, v_ff, q, p_a, p_b);
   }
   if (v->pump_limited) ++pump_limited_cycles_;
+  update_pump_warning(v->pump_limited, v->demanded_flow);
   command_.mode = hal::CommandMode::pilot;
   for (int j = 0; j < 4; ++j) {
     command_.value[j] = v->spool[j];

@@ -51,7 +51,11 @@ enum class FirmwareFault : std::uint16_t {
   model = 2,           // the closed-chain model refused the state (no assembly, toggle)
   tracking_error = 3,  // a joint's |q_a - q_d| exceeded controller.tracking_error_limit
   no_pressures = 4,    // the valve stage's force loop needs chamber pressures the sensor frame lacks
+  // A warning (EXC_FAULT severity 1, no safe stop): the valves ask the pumps for more than their flow
+  // for kPumpWarningCycles in a row, so every function slows; cleared after as many within it.
+  pump_limited = 5,
 };
+inline constexpr int kPumpWarningCycles = 20;
 const char* to_string(FirmwareFault fault);
 
 class FirmwareNode {
@@ -104,6 +108,9 @@ class FirmwareNode {
   // openings asked the pumps for more flow than they give.
   const control::ValveCommand& last_valve_command() const { return valves_.last(); }
   std::uint64_t pump_limited_cycles() const { return pump_limited_cycles_; }
+  // Pump-limited warnings raised so far, and the text of the last one raised or cleared.
+  std::uint64_t pump_warnings() const { return pump_warnings_; }
+  const char* last_warning_text() const { return warning_text_; }
   bool valve_interface() const { return config_.controller.command_interface == control::CommandInterface::valve; }
   const hal::CommandState& last_command() const { return command_; }
   // Time of the control computation (estimate + trajectory + control law), and of the whole
@@ -129,6 +136,9 @@ class FirmwareNode {
   // spools' pilot pressures.
   void command_valves(const Vec4& q);
   void publish_cycle();
+  // The pump-limited warning's debounce, raise and clear (FirmwareFault::pump_limited).
+  void update_pump_warning(bool limited, double demanded_flow);
+  void publish_fault(FirmwareFault code, std::int8_t severity, bool active, const char* text);
 
   const Model& model_;
   const control::Task& task_;
@@ -142,6 +152,11 @@ class FirmwareNode {
   control::ActuatorLagCompensator lag_compensator_;
   control::ValveInnerLoop valves_;
   std::uint64_t pump_limited_cycles_ = 0;
+  bool pump_warning_ = false;
+  int pump_run_ = 0;  // cycles in a row the pumps' state has differed from the warning's
+  double pump_warning_start_ = 0, pump_warning_peak_ = 0;
+  std::uint64_t pump_warnings_ = 0;
+  char warning_text_[160] = "";
   control::PerfCounter control_timing_;
   control::PerfCounter cycle_timing_;
   control::PerfCounter read_timing_, write_timing_, telemetry_timing_, interval_timing_;

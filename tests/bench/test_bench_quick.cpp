@@ -57,6 +57,37 @@ void check_convergence_orders(const fs::path& csv) {
   CHECK(order("rk4/independent", 1e-2, 1e-3) > 2.3);
 }
 
+// The pressure-integration chart: both inputs, both methods, every listed substep; backward Euler runs
+// every one, forward Euler's 10 ms run of the four-function profile is stopped by the plant's pressure
+// check naming the method (never a NaN), and the JSON names each input's boundary.
+void check_pressure_integration(const fs::path& csv, const nlohmann::json& j) {
+  std::ifstream f(csv);
+  std::string line;
+  std::getline(f, line);
+  int rows = 0, backward_ok = 0, backward = 0;
+  bool stopped = false;
+  while (std::getline(f, line)) {
+    if (line.empty()) continue;
+    ++rows;
+    std::vector<std::string> c;  // input, method, step_s, ok (the names hold no comma)
+    std::stringstream ss(line);
+    for (std::string cell; c.size() < 4 && std::getline(ss, cell, ',');) c.push_back(cell);
+    REQUIRE(c.size() == 4);
+    if (c[1] == "backward_euler") {
+      ++backward;
+      backward_ok += c[3] == "1";
+    }
+    if (c[0] == "four functions" && c[1] == "forward_euler" && c[2] == "0.01" && c[3] == "0")
+      stopped = line.find("pressure_method forward_euler at step 0.01 s") != std::string::npos;
+  }
+  CHECK(rows >= 2 * 2 * 3);
+  CHECK(backward == 2 * 3);
+  CHECK(backward_ok == backward);
+  CHECK(stopped);
+  REQUIRE(j.contains("pressure_integration"));
+  CHECK(j["pressure_integration"].size() == 2);
+}
+
 // One recommended fidelity per scene: within tolerance, the cheapest up to the timing noise (15 %), and
 // no simpler model (a later row) within tolerance at an equal cost.
 void check_recommendations(const fs::path& csv) {
@@ -164,6 +195,7 @@ TEST_CASE("tools/excavator-bench --quick writes its json and csvs and recommends
     INFO(csv);
     CHECK(data_lines(out / csv) > 0);
   }
+  check_pressure_integration(out / "pressure_integration.csv", j);
   check_convergence_orders(out / "work_precision.csv");
   check_recommendations(out / "fidelity.csv");
 }

@@ -16,21 +16,24 @@
 using namespace exc;
 using namespace exc::plant;
 
-TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, formulation, fidelity)") {
+TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, formulation, fidelity, pressure method)") {
   REQUIRE(exc::test::allocation_counting_works());
   struct Config {
-    const char *method, *formulation, *actuators;
+    const char *method, *formulation, *actuators, *integrator = "";
   };
   std::vector<Config> configs;
   for (const char* m : exc::plant::test::kMethods)
     for (const char* f : exc::plant::test::kFormulations) configs.push_back({m, f, "fidelity: ideal"});
   configs.push_back({"semi_implicit_euler", "independent", "fidelity: limited"});
   configs.push_back({"semi_implicit_euler", "independent", "fidelity: hydraulic"});
+  configs.push_back({"semi_implicit_euler", "independent", "fidelity: hydraulic", "pressure_method: forward_euler"});
   for (const Config& c : configs) {
     CAPTURE(std::string(c.method));
     CAPTURE(std::string(c.formulation));
     CAPTURE(std::string(c.actuators));
+    CAPTURE(std::string(c.integrator));
     exc::plant::test::SceneText t;
+    t.extra_integrator = c.integrator;
     t.method = c.method;
     t.formulation = c.formulation;
     t.actuators = c.actuators;

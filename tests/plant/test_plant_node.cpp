@@ -121,3 +121,28 @@ TEST_CASE("plant/node: a force-commanded plant sends PressureValid 0, and stops 
   CHECK(why.find("pilot commands for actuators.fidelity ideal") != std::string::npos);
   CHECK_FALSE(bench.firmware.read(seen));
 }
+
+TEST_CASE("plant/node: a valve_stuck fault holds a spool at its opening whatever CMD_PILOT asks, the others follow their pilots, and its end frees it") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  NodeBench bench(t.scene());
+  app::InjectedFault stuck;
+  stuck.kind = app::InjectedFault::Kind::valve_stuck;
+  stuck.joint = 1;
+  stuck.magnitude = -0.4;
+  bench.node.set_fault(stuck);
+  hal::CommandState c = boom_pilots(3e6, 0);  // the boom asked to extend ...
+  c.pilot_a[hal::kArm] = 2e6;                 // ... and the arm too
+  hal::SensorState seen;
+  const double l0 = t.scene().q_a0[1];
+  for (std::uint64_t k = 0; k < 300; ++k) REQUIRE(bench.cycle(k, c, seen));
+  const PlantState& s = bench.plant.state();
+  const double full = t.scene().machine.hydraulics.pilot_full_stroke;
+  CHECK(s.spool[1] == -0.4);                                              // stuck, lowering the boom
+  CHECK(s.q_a[1] < l0 - 0.01);
+  CHECK(s.spool[2] == doctest::Approx(2e6 / full).epsilon(1e-3));         // the arm's spool follows
+  bench.node.set_fault(app::InjectedFault{});
+  for (std::uint64_t k = 300; k < 600; ++k) REQUIRE(bench.cycle(k, c, seen));
+  CHECK(bench.plant.state().spool[1] == doctest::Approx(3e6 / full).epsilon(1e-3));  // free again
+  CHECK_FALSE(bench.node.failed());
+}

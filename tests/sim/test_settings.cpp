@@ -81,6 +81,7 @@ TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly
   CHECK(names_in_row("scene-schema.md", "actuators.fidelity", 2) == names_of(plant::kActuatorFidelities));
   CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::kIntegrationMethods));
   CHECK(names_in_row("scene-schema.md", "integrator.formulation", 2) == names_of(plant::kFormulations));
+  CHECK(names_in_row("scene-schema.md", "integrator.pressure_method", 2) == names_of(plant::kPressureMethods));
   CHECK(names_in_row("scene-schema.md", "controller.type", 2) == names_of(control::kControllerKinds));
   CHECK(names_in_row("scene-schema.md", "controller.regressor_acceleration", 2) ==
         names_of(control::kRegressorAccelerations));

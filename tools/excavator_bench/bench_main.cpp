@@ -1,6 +1,6 @@
-// excavator-bench: speed against accuracy (issue 8). One run writes the work-precision chart, the
-// fidelity chart, the stability maps and the MuJoCo comparison (CSV + PNG each), a summary table on
-// stdout and --json FILE. `excavator-bench export-mjcf` writes the machine as MJCF.
+// excavator-bench: speed against accuracy (issues 8 and 14). One run writes the work-precision chart,
+// the pressure-integration chart, the fidelity chart, the stability maps and the MuJoCo comparison
+// (CSV + PNG each), a summary table on stdout and --json FILE. `excavator-bench export-mjcf` writes the machine as MJCF.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -17,6 +17,7 @@
 #include "bench_runs.hpp"
 #include "fidelity_chart.hpp"
 #include "peer_comparison.hpp"
+#include "pressure_integration.hpp"
 #include "stability_map.hpp"
 #include "work_precision.hpp"
 #include "mjcf_export.hpp"
@@ -63,6 +64,16 @@ int run_bench(const Options& o) {
 
   const std::vector<PeerResult> peers = peer_comparison(scenes, references, o.out);
   write_peer_csvs(o.out, peers);
+
+  // How the hydraulic machine's pressures are integrated: the dig's commands from a closed-loop run
+  // and a four-function valve profile, replayed open loop, against backward Euler at 10 us.
+  const std::vector<double> pressure_steps =
+      o.quick ? std::vector<double>{1e-2, 1e-3, 2.5e-4}
+              : std::vector<double>{1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2.5e-4, 1e-4, 5e-5, 2.5e-5};
+  const PressureChart pressures = pressure_integration(
+      {recorded_dig(scenes[1], o.quick ? 1.0 : 10.0), four_functions(scenes[1], o.quick ? 1.0 : 4.0)},
+      pressure_steps, 1e-5);
+  write_pressure_csv(o.out + "/pressure_integration.csv", pressures);
 
   const double closed_duration = o.quick ? 1.0 : 0.0;  // 0: the scenes' own durations
   const std::vector<FidelityRow> fidelity = fidelity_chart(scenes, closed_duration);
@@ -116,6 +127,13 @@ int run_bench(const Options& o) {
                            {"inverse_dynamics_us", number_or_null(p.inverse_dynamics_us)},
                            {"plant_dynamics_step_us", number_or_null(p.dynamics_step_us)},
                            {"mujoco_inverse_us", number_or_null(p.mujoco_inverse_us)}});
+  j["pressure_integration"] = json::array();
+  for (const ExplicitBoundary& b : pressures.boundaries)
+    j["pressure_integration"].push_back({{"input", b.input},
+                                         {"reference_step_s", pressures.reference_step},
+                                         {"forward_euler_largest_passing_step_s", b.stable > 0 ? json(b.stable) : json()},
+                                         {"forward_euler_smallest_failing_step_s", b.failing > 0 ? json(b.failing) : json()},
+                                         {"forward_euler_failure", b.failure}});
   j["recommended_fidelity"] = json::object();
   for (const FidelityRow& r : fidelity)
     if (r.recommended) j["recommended_fidelity"][r.scene] = r.fidelity;
@@ -149,6 +167,15 @@ int run_bench(const Options& o) {
     if (p.pareto)
       std::printf("  %-12s %-40s %-8s %10.3g s/s %12.3g m\n", p.scene.c_str(), p.method.c_str(), step_label(p.step).c_str(),
                   p.cpu_per_s, p.tip_rms);
+  std::printf("\nPressure integration (open loop, valve commands held 10 ms; against backward Euler at %s):\n",
+              step_label(pressures.reference_step).c_str());
+  for (const PressurePoint& p : pressures.points)
+    std::printf("  %-18s %-15s %-8s %s cpu %8.3g s/s tip %9.3g m pressures %9.3g MPa %5.1f iterations %s\n",
+                p.input.c_str(), p.method.c_str(), step_label(p.step).c_str(), p.ok ? "ok  " : "FAIL", p.cpu_per_s,
+                p.tip_rms, p.pressure_rms * 1e-6, p.iterations, p.failure.substr(p.failure.find(": ") + 1, 60).c_str());
+  for (const ExplicitBoundary& b : pressures.boundaries)
+    std::printf("  %-18s forward_euler: largest substep passed %s, smallest stopped by the checks %s\n", b.input.c_str(),
+                b.stable > 0 ? step_label(b.stable).c_str() : "none", b.failing > 0 ? step_label(b.failing).c_str() : "none");
   std::printf("\nFidelity (closed loop, adaptive; tolerance: tip %.0f mm, forces %.0f %%, tracking %.0f mm):\n",
               kTipTolerance * 1e3, kForceTolerance * 100, kTrackingTolerance * 1e3);
   for (const FidelityRow& r : fidelity)
@@ -201,7 +228,8 @@ int export_command(const std::string& machine_file, const std::string& out, std:
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "excavator-bench: work-precision chart, fidelity chart, stability maps and MuJoCo as a peer.\n"
+      "excavator-bench: work-precision chart, pressure-integration chart, fidelity chart, stability maps and MuJoCo as "
+      "a peer.\n"
       "Without a subcommand it runs the whole benchmark (about 10 min; --quick: under 1 min)."};
   exc::bench::Options o;
   app.add_flag("--quick", o.quick, "CI mode: fewer step sizes and shorter horizons (< 1 min)");

@@ -160,6 +160,26 @@ void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorP
   if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
 }
 
+app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene, double model_mass_error) {
+  // The firmware's model: the full machine, with its masses off by the given error.
+  Machine fw_machine = s.scene.machine;
+  for (BodyInertia& b : fw_machine.bodies) {
+    b.mass *= 1 + model_mass_error;
+    b.inertia *= 1 + model_mass_error;
+  }
+  app::FirmwareSettings fw;
+  fw.name = s.name;
+  fw.machine = fw_machine;
+  fw.task = s.task;
+  fw.terrain_height = scene.terrain.height;
+  fw.duration = scene.duration;
+  fw.controller = s.controller;
+  // The firmware as it is set up for the machine it drives: valves for the hydraulic machine, efforts
+  // (with the lag compensated) for the force-commanded ones.
+  configure_for_fidelity(fw.controller, scene.actuators);
+  return fw;
+}
+
 ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v) {
   plant::Scene scene = s.scene;
   scene.actuators.fidelity = v.fidelity;
@@ -180,23 +200,8 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
   scene.q_a0 = q0;
   scene.qd_a0 = qd0;
 
-  // The firmware's model: the full machine, with its masses off by the given error.
-  Machine fw_machine = s.scene.machine;
-  for (BodyInertia& b : fw_machine.bodies) {
-    b.mass *= 1 + v.model_mass_error;
-    b.inertia *= 1 + v.model_mass_error;
-  }
-  app::FirmwareSettings fw;
-  fw.name = s.name;
-  fw.machine = fw_machine;
-  fw.task = s.task;
-  fw.terrain_height = scene.terrain.height;
-  fw.duration = scene.duration;
+  app::FirmwareSettings fw = bench_firmware(s, scene, v.model_mass_error);
   control::ControllerConfig& cc = fw.controller;
-  cc = s.controller;
-  // The firmware as it is set up for the machine it drives: valves for the hydraulic machine, efforts
-  // (with the lag compensated) for the force-commanded ones.
-  configure_for_fidelity(cc, scene.actuators);
   const double g = v.gain_scale;
   cc.gains.kp *= g * g;
   cc.gains.kv *= g;

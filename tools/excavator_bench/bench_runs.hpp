@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "app/firmware_settings.hpp"
 #include "control/controller_config.hpp"
 #include "control/task.hpp"
 #include "sim_plant/scene.hpp"
@@ -94,6 +95,10 @@ struct ClosedLoopResult {
 // The firmware's settings for the machine it drives: the valve interface for the hydraulic fidelity,
 // efforts otherwise, with the limited actuators' lag compensated (and none for ideal ones).
 void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators);
+
+// The firmware's settings for a closed-loop run of `scene` (the plant's side of s, changed): the
+// bench scene's task and controller set for the scene's actuators, its model's masses x (1 + error).
+app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene, double model_mass_error = 0);
 
 ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v);
 

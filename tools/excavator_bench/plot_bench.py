@@ -126,6 +126,38 @@ def stability(out):
     save(fig, out, "stability_control.png")
 
 
+def step_text(h):
+    return f"{h * 1e3:g} ms" if h >= 1e-3 else f"{h * 1e6:g} us"
+
+
+def pressure_integration(out):
+    """Tip path and chamber-pressure error against CPU time, per input and pressure method; the runs
+    the plant's checks stopped are named in the legend."""
+    data = rows(os.path.join(out, "pressure_integration.csv"))
+    inputs = list(dict.fromkeys(r["input"] for r in data))
+    metrics = [("tip_rms_m", 1.0, "tip path RMS against the reference (m)"),
+               ("pressure_rms_Pa", 1e-6, "chamber pressure RMS against the reference (MPa)")]
+    fig, axes = plt.subplots(len(inputs), 2, figsize=(13, 4.8 * len(inputs)), squeeze=False)
+    for i, name in enumerate(inputs):
+        for j, (key, scale, label) in enumerate(metrics):
+            ax = axes[i][j]
+            for method in sorted({r["method"] for r in data if r["input"] == name}):
+                sel = sorted((r for r in data if r["input"] == name and r["method"] == method),
+                             key=lambda r: -num(r["step_s"]))
+                ok = [(num(r["cpu_s_per_sim_s"]), max(num(r[key]) * scale, 1e-12), num(r["step_s"]))
+                      for r in sel if r["ok"] == "1"]
+                stopped = [step_text(num(r["step_s"])) for r in sel if r["ok"] != "1"]
+                text = method + (f" (stopped by the plant's checks at {', '.join(stopped)})" if stopped else "")
+                if ok:
+                    ax.loglog([p[0] for p in ok], [p[1] for p in ok], marker="o", ms=4, label=text)
+                    for x, y, h in ok:
+                        ax.annotate(step_text(h), (x, y), fontsize=6, xytext=(3, 3), textcoords="offset points")
+                else:
+                    ax.plot([], [], "x", label=text)
+            decorate(ax, "CPU time per simulated second (s)", label, f"{name}: {label}", legend=7)
+    save(fig, out, "pressure_integration.png")
+
+
 def peer(out):
     data = rows(os.path.join(out, "peer_tip.csv"))
     scenes = sorted({r["scene"] for r in data})
@@ -149,7 +181,7 @@ def main():
         print(__doc__.strip())
         return 0 if len(sys.argv) == 2 else 2
     out = sys.argv[1]
-    for chart in (work_precision, fidelity, stability, peer):
+    for chart in (work_precision, pressure_integration, fidelity, stability, peer):
         chart(out)
     print(f"plots: {', '.join(n for n in sorted(os.listdir(out)) if n.endswith('.png'))} in {out}")
     return 0
