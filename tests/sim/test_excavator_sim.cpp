@@ -465,7 +465,7 @@ TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the ca
       "  stop_at_safe_state: true\n  grid:\n"
       "    - controller.valves.force_time_constant: [0.01, 0.03]\n"
       "      machine.hydraulics.valve_time_constant: [0.03, 0.2]\n"
-      "    - gain_scale: [1, 8]\n  record: [table, failures, stability]\n";
+      "    - gain_scale: [1, 8]\n  record: [failures, stability]\n";
   const std::string in_dir = "cd '" + dir.string() + "' && ";
   REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --shard 1/2 --out b.jsonl > /dev/null 2>&1").c_str()) == 0);
   REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --shard 0/2 --out a.jsonl > /dev/null 2>&1").c_str()) == 0);

@@ -18,7 +18,7 @@
 //       - {name: delay2, delay_cycles: 2, description: "sensor frames 2 cycles late"}
 //     search: {integrator.step: [1e-2, 1e-3]}   # per case: the first value whose run passes
 //     faults: [bus_burst, ...]        # the fault campaign: one fault per case
-//     record: [table, failures, robustness, stability]   # the merge's outputs (default: table, failures)
+//     record: [failures, robustness, stability]   # the merge's outputs besides the table (default: failures)
 //
 // Case id = ((scene * variants + variant) * grid points + point) * cases + draw; a case's draws depend
 // on (seed, id) only, so a shard computes exactly the cases a single process would, and any set of
@@ -79,7 +79,7 @@ struct SweepSpec {
   std::vector<SweepGrid> grids;     // run one after the other
   std::vector<SweepVariant> variants;
   SweepAxis search;                 // knob empty: none
-  std::vector<std::string> record{"table", "failures"};
+  std::vector<std::string> record{"failures"};
 
   int grid_points() const;  // over all grids (1 without a grid)
   int total_cases() const;

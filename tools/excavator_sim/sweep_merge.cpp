@@ -201,8 +201,12 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
     csv << "\n";
   }
   json summary = {{"spec", spec.file}, {"cases", spec.total_cases()}, {"merged", cases.size()}, {"missing", missing},
-                  {"missing_shard_files", absent_files}, {"failures", failures}, {"failure_kinds", kinds},
-                  {"failures_by_value", by_value}, {"campaign", campaign}};
+                  {"missing_shard_files", absent_files}, {"campaign", campaign}};
+  if (spec.records("failures")) {
+    summary["failures"] = failures;
+    summary["failure_kinds"] = kinds;
+    summary["failures_by_value"] = by_value;
+  }
   // What the charts read: the runs' columns and the grids' axes.
   json grids = json::array();
   for (const SweepGrid& g : spec.grids) {

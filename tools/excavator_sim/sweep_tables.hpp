@@ -15,10 +15,10 @@ inline constexpr settings::EnumTable<SweepRun, 2> kSweepRuns{{{
     {SweepRun::open_loop, "open_loop", "the plant alone under excavator-bench's effort profile (its step map)"},
 }}};
 
-enum class SweepRecord : std::uint8_t { table, failures, robustness, stability };
-inline constexpr settings::EnumTable<SweepRecord, 4> kSweepRecords{{{
-    {SweepRecord::table, "table", "sweep.csv, a row per case"},
-    {SweepRecord::failures, "failures", "sweep.json's failures by region (and missing cases, always)"},
+// sweep.csv (a row per case) and sweep.json's missing cases are always written.
+enum class SweepRecord : std::uint8_t { failures, robustness, stability };
+inline constexpr settings::EnumTable<SweepRecord, 3> kSweepRecords{{{
+    {SweepRecord::failures, "failures", "sweep.json's failed runs by region, by set value and by kind"},
     {SweepRecord::robustness, "robustness", "robustness.png: RMS error per variant (or the draws' spread)"},
     {SweepRecord::stability, "stability", "stability.png: ok / failed and tracking over the grid's axes"},
 }}};
