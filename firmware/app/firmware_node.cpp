@@ -171,7 +171,7 @@ void FirmwareNode::end_cycle() {
 void FirmwareNode::publish_fault(FirmwareFault code, std::int8_t severity, bool active, const char* text) {
   if (telemetry_ == nullptr) return;
   exlcm::fault_t f{};
-  f.utime = static_cast<std::int64_t>(time() * 1e6);
+  f.utime = utime();
   f.code = static_cast<std::int32_t>(code);
   f.severity = severity;
   f.active = active;

@@ -528,6 +528,62 @@ TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to t
   CHECK(partial != 0);
   const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "partial" / "sweep.json"));
   CHECK(j["missing"] == nlohmann::json::array({1, 5}));
+  // A shard file that is not there (its task died before writing): named with its cases, the rest merged.
+  const int absent = std::system((in_dir + tool + " sweep-merge spec.yaml shard0.jsonl nowhere/shard1.jsonl shard2.jsonl shard3.jsonl --out absent > absent.out 2> absent.err").c_str());
+  CHECK(absent != 0);
+  const nlohmann::json a = nlohmann::json::parse(read_text_file(dir / "absent" / "sweep.json"));
+  CHECK(a["missing"] == nlohmann::json::array({1, 5}));
+  REQUIRE(a["missing_shard_files"].size() == 1);
+  CHECK(a["missing_shard_files"][0]["shard"] == "1/4");
+  CHECK(a["missing_shard_files"][0]["cases"] == nlohmann::json::array({1, 5}));
+  CHECK(read_text_file(dir / "absent.err").find("nowhere/shard1.jsonl is not there (shard 1/4") != std::string::npos);
+  CHECK(a["merged"].get<int>() == 6);
+}
+
+TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the cases deterministically; variants and a second grid follow; the merge writes the table, the failures by value and the stability chart") {
+  const Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  // Two grids (2 x 2 on the valve stage against the plant's spool lag, then 2 gain scales), 0.3 s runs.
+  std::ofstream(dir / "spec.yaml") << "sweep:\n  scene: " << kDig << "\n  controllers: [adaptive]\n  duration: 0.3\n"
+      "  stop_at_safe_state: true\n  grid:\n"
+      "    - controller.valves.force_time_constant: [0.01, 0.03]\n"
+      "      machine.hydraulics.valve_time_constant: [0.03, 0.2]\n"
+      "    - gain_scale: [1, 8]\n  record: [failures, stability]\n";
+  const std::string in_dir = "cd '" + dir.string() + "' && ";
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --shard 1/2 --out b.jsonl > /dev/null 2>&1").c_str()) == 0);
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --shard 0/2 --out a.jsonl > /dev/null 2>&1").c_str()) == 0);
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep-merge spec.yaml a.jsonl b.jsonl --out merged > merge.out 2>&1").c_str()) == 0);
+  const std::string csv = read_text_file(dir / "merged" / "sweep.csv");
+  INFO(csv);
+  CHECK(csv.rfind("case,controller.valves.force_time_constant,machine.hydraulics.valve_time_constant,gain_scale,adaptive_ok,"
+                  "adaptive_rms_swing,adaptive_rms_boom,adaptive_rms_arm,adaptive_rms_bucket,adaptive_failure\n", 0) == 0);
+  // The first grid's last key fastest, then the second grid.
+  for (const char* row : {"\n0,0.01,0.03,,", "\n1,0.01,0.2,,", "\n2,0.03,0.03,,", "\n3,0.03,0.2,,", "\n4,,,1,", "\n5,,,8,"})
+    CHECK(csv.find(row) != std::string::npos);
+  CHECK(std::count(csv.begin(), csv.end(), '\n') == 1 + 6);
+  CHECK(csv.find("nan") == std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "merged" / "sweep.json"));
+  CHECK(j["missing"].empty());
+  CHECK(j["failures_by_value"]["adaptive"]["machine.hydraulics.valve_time_constant"]["0.2"]["runs"].get<int>() == 2);
+  CHECK(j["failures_by_value"]["adaptive"]["gain_scale"]["8"]["runs"].get<int>() == 1);
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' 2>/dev/null") == 0) {
+    CHECK(fs::file_size(dir / "merged" / "stability.png") > 20000);
+  }
+  // Variants with random draws: each variant gets `cases` draws, case = variant * cases + draw.
+  std::ofstream(dir / "variants.yaml") << "sweep:\n  scenes: [" << kDig << "]\n  controllers: [pid]\n  duration: 0.2\n"
+      "  cases: 2\n  perturbations: {model_mass: [-0.1, 0.1]}\n"
+      "  variants:\n    - {name: nominal}\n    - {name: late, delay_cycles: 2}\n";
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep variants.yaml --quiet --out v.jsonl > /dev/null 2>&1").c_str()) == 0);
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep-merge variants.yaml v.jsonl --out v > /dev/null 2>&1").c_str()) == 0);
+  const std::string v = read_text_file(dir / "v" / "sweep.csv");
+  CHECK(v.rfind("case,variant,model_mass,delay_cycles,pid_ok,", 0) == 0);
+  for (const char* row : {"\n0,nominal,", "\n1,nominal,", "\n2,late,", "\n3,late,"}) CHECK(v.find(row) != std::string::npos);
+  // A knob set twice, or unknown, is refused with the file, line and field.
+  std::ofstream(dir / "bad.yaml") << "sweep:\n  scene: " << kDig << "\n  grid:\n    bulk_modulus: [1e9]\n";
+  const Run bad = run_sim("sweep " + (dir / "bad.yaml").string() + " --quiet");
+  CHECK(bad.status == 2);
+  CHECK(bad.err.find("bad.yaml") != std::string::npos);
+  CHECK(bad.err.find("bulk_modulus") != std::string::npos);
 }
 
 TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a random fault ends tracking within its limits or in the safe state, none otherwise, every fault kind drawn") {

@@ -19,6 +19,7 @@
 #include "control/task.hpp"
 #include "harness/lockstep_run.hpp"
 #include "settings/section_reader.hpp"
+#include "sweep_tables.hpp"
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -92,6 +93,8 @@ TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly
   CHECK(names_in_row("control.md", "regressor_acceleration", 3) == names_of(control::kRegressorAccelerations));
   CHECK(names_in_row("sweeps.md", "sweep.controllers", 2) == names_of(control::kControllerKinds));
   CHECK(names_in_row("sweeps.md", "sweep.faults", 2) == names_of(sim::kFaultKinds));
+  CHECK(names_in_row("sweeps.md", "sweep.run", 2) == names_of(sim::kSweepRuns));
+  CHECK(names_in_row("sweeps.md", "sweep.record", 2) == names_of(sim::kSweepRecords));
 }
 
 TEST_CASE("tools/settings: a shipped scene's effective configuration fills every default and loads back to itself") {

@@ -79,20 +79,10 @@ int run_bench(const Options& o) {
   const std::vector<FidelityRow> fidelity = fidelity_chart(scenes, closed_duration);
   write_fidelity_csv(o.out + "/fidelity.csv", fidelity);
 
-  BenchScene dig_window = scenes[1];
-  dig_window.start = o.quick ? 3.0 : 2.5;  // in the soil from the start
-  dig_window.horizon = o.quick ? 0.2 : 1.0;
-  BenchScene free_window = scenes[0];
-  free_window.horizon = o.quick ? 0.2 : 1.0;
-  // Loose sand (2e4 N/m) to loads far past stiff clay (2e7 N/m: a full bucket pressed on rock): the
-  // map has to reach the failures. Steps stop at the effort profile's 10 ms hold.
-  const std::vector<double> stiffness = o.quick ? std::vector<double>{2e4, 2e7}
-                                                : std::vector<double>{2e4, 7e4, 2e5, 9e5, 4e6, 2e7};
-  const std::vector<double> map_steps = o.quick ? std::vector<double>{1e-2, 1e-3, 1e-4}
-                                                : std::vector<double>{1e-2, 5e-3, 2e-3, 1e-3, 5e-4, 2e-4, 1e-4, 5e-5};
-  const std::vector<double> speeds = o.quick ? std::vector<double>{1, 3} : std::vector<double>{0.5, 1, 2, 3};
-  const std::vector<StepStability> step_map = step_stability_map(dig_window, free_window, map_steps, stiffness, speeds);
-  const std::vector<ControlStability> control_map = control_stability_map(scenes[1], o.quick ? 1.0 : 0.0);
+  // The stability maps: sweep specs (sweeps/stability_*.yaml) through the sweep's shard and merge.
+  const StabilityMaps maps = stability_maps(EXC_SOURCE_DIR "/sweeps", o.scenes_dir, o.out, o.quick);
+  const std::vector<StepStability>& step_map = maps.step;
+  const std::vector<ControlStability>& control_map = maps.control;
   write_stability_csvs(o.out, step_map, control_map);
 
   // Headline numbers: the free-motion scene (the dig scene's figures are in peer.csv).
@@ -190,6 +180,12 @@ int run_bench(const Options& o) {
   for (const ControlStability& r : control_map)
     std::printf("  %-10s %-18s %10.3g  %-4s tracking %9.3g %s\n", r.controller.c_str(), r.axis.c_str(), r.value,
                 r.ok ? "ok" : "FAIL", r.tracking, r.failure.substr(0, 70).c_str());
+
+  for (const HydraulicMap& m : maps.hydraulic) {
+    std::printf("\nHydraulic map %s (%s: sweep.csv, stability.png): %d of %d runs failed\n", m.name.c_str(),
+                m.dir.c_str(), m.failed, m.runs);
+    for (const std::string& line : m.lines) std::printf("  %s\n", line.c_str());
+  }
 
   if (o.plots) {
     const std::string cmd = std::string("/usr/bin/python3 '") + EXC_BENCH_PLOT_SCRIPT + "' '" + o.out + "'";

@@ -2,105 +2,182 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
-
-#include "fidelity_chart.hpp"
+#include <map>
+#include <tuple>
 
 #include "bench_common.hpp"
+#include "sweep.hpp"
 
 namespace exc::bench {
 
 namespace {
 
-// Largest step of 'steps' (descending) at which the run passes the plant's own checks.
-StepStability largest_stable_step(const BenchScene& s, const EffortProfile& profile, plant::IntegrationMethod m,
-                                  plant::Formulation f, const std::vector<double>& steps, double soil_scale) {
-  StepStability out;
-  out.method = method_name(m, f);
-  for (double h : steps) {
-    OpenLoopSettings st;
-    st.integrator = settings_of(m, f, h);
-    st.soil_stiffness_scale = soil_scale;
-    st.constraint_tolerance = 1e-4;  // the plant's default check
-    const OpenLoopResult r = run_open_loop(s, profile, st);
+namespace fs = std::filesystem;
+using sim::SweepCase;
+using sim::SweepSpec;
+using sim::SweepValue;
+
+// The open loop as a sweep's run: the case's integrator, soil and task speed; with a search over the
+// step, the first step (largest first) at which the plant's own checks pass.
+json run_open_loop_case(const SweepSpec& spec, const SweepCase& c) {
+  static std::map<std::string, BenchScene> scenes;
+  static std::map<std::pair<std::string, double>, EffortProfile> profiles;
+  const std::string& path = spec.scenes[static_cast<std::size_t>(c.scene)];
+  auto it = scenes.find(path);
+  if (it == scenes.end()) it = scenes.emplace(path, load_bench_scene(path, spec.window_start, spec.window_horizon)).first;
+  const BenchScene& s = it->second;
+  const double speed = c.value("profile.speed") ? c.value("profile.speed")->number : 1.0;
+  auto p = profiles.find({path, speed});
+  if (p == profiles.end()) p = profiles.emplace(std::make_pair(path, speed), effort_profile(s, speed)).first;
+  OpenLoopSettings st;
+  const std::string name = c.value("integrator") ? c.value("integrator")->name : method_name(s.scene.integrator.method, s.scene.integrator.formulation);
+  st.integrator = s.scene.integrator;
+  st.integrator.method = *plant::kIntegrationMethods.named(name.substr(0, name.find('/')));
+  st.integrator.formulation = *plant::kFormulations.named(name.substr(name.find('/') + 1));
+  const double base_k = s.scene.soil.stiffness.x() > 0 ? s.scene.soil.stiffness.x() : 7e4;
+  if (c.value("soil.stiffness")) st.soil_stiffness_scale = c.value("soil.stiffness")->number / base_k;
+  st.constraint_tolerance = 1e-4;  // the plant's default check
+  std::vector<SweepValue> steps = spec.search.values;
+  if (spec.search.knob.empty()) steps = {c.value("integrator.step") ? *c.value("integrator.step") : SweepValue{}};
+  if (spec.search.knob.empty() && !c.value("integrator.step")) steps.front().number = s.scene.integrator.step;
+  json run = {{"ok", false}, {"search_value", nullptr}};
+  for (const SweepValue& h : steps) {
+    st.integrator.step = h.number;
+    const OpenLoopResult r = run_open_loop(s, p->second, st);
     if (r.ok) {
-      out.largest_stable_step = h;
+      if (run.contains("failure")) run["failure_before"] = run["failure"];
+      run.erase("failure");
+      run["ok"] = true;
+      run["search_value"] = h.number;
       break;
     }
-    out.failure_above = r.failure;
+    run["failure"] = r.failure;
   }
-  return out;
+  json line = {{"case", c.id}, {"set", json::object()}, {"plant", run}};
+  for (const sim::SweepSetting& v : c.set) line["set"][v.first] = v.second.to_json();
+  return line;
+}
+
+// Runs a spec as one shard in this process and merges it into out/<name>/; returns its case lines.
+std::vector<json> run_spec(const SweepSpec& spec, const std::string& out, const sim::SweepRunner& runner) {
+  const std::string name = fs::path(spec.file).stem().string();
+  const fs::path dir = fs::path(out) / name;
+  progress("stability %s: %s\n", name, std::to_string(spec.total_cases()) + " cases");
+  sim::run_sweep_shard(spec, 0, 1, dir / "shard-0.jsonl", false, runner);
+  sim::merge_sweep(spec, {dir / "shard-0.jsonl"}, dir);
+  std::vector<json> lines;
+  std::ifstream in(dir / "shard-0.jsonl");
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) lines.push_back(json::parse(line));
+  return lines;
+}
+
+// A spec of sweeps_dir with its scenes taken from scenes_dir (same file names).
+SweepSpec load_spec(const std::string& sweeps_dir, const std::string& name, const std::string& scenes_dir) {
+  SweepSpec spec = sim::load_sweep_spec(sweeps_dir + "/" + name);
+  for (std::string& s : spec.scenes) s = (fs::path(scenes_dir) / fs::path(s).filename()).string();
+  return spec;
+}
+
+// The CI cut: each axis named here keeps only these values.
+void cut(SweepSpec& spec, const std::string& knob, const std::vector<double>& values) {
+  for (sim::SweepGrid& g : spec.grids)
+    for (sim::SweepAxis& a : g)
+      if (a.knob == knob) {
+        a.values.clear();
+        for (double v : values) a.values.push_back(SweepValue{SweepValue::Type::number, v, {}, ""});
+      }
+  if (spec.search.knob == knob) {
+    spec.search.values.clear();
+    for (double v : values) spec.search.values.push_back(SweepValue{SweepValue::Type::number, v, {}, ""});
+  }
+}
+
+std::vector<StepStability> step_rows(const std::vector<json>& lines, const std::string& knob, const char* axis) {
+  std::vector<StepStability> rows;
+  for (const json& j : lines) {
+    StepStability r;
+    r.method = j["set"]["integrator"].get<std::string>();
+    r.axis = axis;
+    r.value = j["set"][knob].get<double>();
+    const json& p = j["plant"];
+    if (p["ok"].get<bool>()) r.largest_stable_step = p["search_value"].get<double>();
+    r.failure_above = p.value("failure_before", p.value("failure", ""));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+double worst_rms(const json& run) {
+  double w = 0;
+  for (const auto& [joint, v] : run["rms_error"].items()) w = std::max(w, v.is_number() ? v.get<double>() : NAN);
+  return w;
 }
 
 }  // namespace
 
-std::vector<StepStability> step_stability_map(const BenchScene& dig, const BenchScene& free,
-                                              const std::vector<double>& steps, const std::vector<double>& stiffness,
-                                              const std::vector<double>& speeds) {
-  std::vector<StepStability> rows;
-  const EffortProfile dig_profile = effort_profile(dig);
-  const double base_k = dig.scene.soil.stiffness.x() > 0 ? dig.scene.soil.stiffness.x() : 7e4;
-  for (plant::IntegrationMethod m : kMethods)
-    for (plant::Formulation f : kFormulations) {
-      progress("stability %s: %s\n", method_name(m, f), "soil stiffness and joint speed");
-      for (double k : stiffness) {
-        StepStability r = largest_stable_step(dig, dig_profile, m, f, steps, k / base_k);
-        r.axis = "soil_stiffness_N_per_m";
-        r.value = k;
-        rows.push_back(r);
-      }
-      for (double v : speeds) {
-        const EffortProfile p = effort_profile(free, v);
-        StepStability r = largest_stable_step(free, p, m, f, steps, 1.0);
-        r.axis = "joint_speed_factor";
-        r.value = v;
-        rows.push_back(r);
-      }
+StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& scenes_dir, const std::string& out,
+                             bool quick) {
+  StabilityMaps maps;
+  SweepSpec soil = load_spec(sweeps_dir, "stability_step_soil.yaml", scenes_dir);
+  SweepSpec speed = load_spec(sweeps_dir, "stability_step_speed.yaml", scenes_dir);
+  SweepSpec control = load_spec(sweeps_dir, "stability_control.yaml", scenes_dir);
+  if (quick) {
+    for (SweepSpec* s : {&soil, &speed}) {
+      cut(*s, "integrator.step", {1e-2, 1e-3, 1e-4});
+      s->window_horizon = 0.2;
     }
-  return rows;
-}
-
-
-std::vector<ControlStability> control_stability_map(const BenchScene& dig, double duration) {
-  std::vector<ControlStability> rows;
-  const control::ControllerKind kinds[] = {control::ControllerKind::pid, control::ControllerKind::adaptive,
-                                           control::ControllerKind::slotine_li};
-  struct Axis {
-    const char* name;
-    std::vector<double> values;
-  };
-  const std::vector<Axis> axes = {{"gain_scale", {0.5, 1, 2, 4, 8, 16}},
-                                  {"adaptation_scale", {0.01, 1, 100, 1e4}},
-                                  {"position_noise", {0, 1e-5, 1e-4, 1e-3}},
-                                  {"delay_cycles", {0, 1, 2, 3}},
-                                  {"model_mass_error", {-0.3, -0.1, 0, 0.1, 0.3}}};
-  for (control::ControllerKind kind : kinds) {
-    progress("stability %s: gain, adaptation, noise, delay, mass error%s\n", control::to_string(kind));
-    for (const Axis& a : axes)
-      for (double value : a.values) {
-        if (kind == control::ControllerKind::pid && std::string(a.name) == "adaptation_scale") continue;
-        ClosedLoopVariant v;
-        v.controller = kind;
-        v.fidelity = dig.scene.actuators.fidelity;  // the scene's own actuators, which its firmware config expects
-        v.duration = duration;
-        const std::string n = a.name;
-        if (n == "gain_scale") v.gain_scale = value;
-        if (n == "adaptation_scale") v.adaptation_scale = value;
-        if (n == "position_noise") v.position_noise = value;
-        if (n == "delay_cycles") v.delay_cycles = static_cast<int>(value);
-        if (n == "model_mass_error") v.model_mass_error = value;
-        const ClosedLoopResult r = run_closed_loop(dig, v);
-        ControlStability row;
-        row.controller = control::to_string(kind);
-        row.axis = n;
-        row.value = value;
-        row.ok = r.ok;
-        row.failure = r.failure;
-        row.tracking = worst_tracking(r);
-        rows.push_back(row);
-      }
+    soil.window_start = 3.0;
+    cut(soil, "soil.stiffness", {2e4, 2e7});
+    cut(speed, "profile.speed", {1, 3});
+    control.duration = 1.0;
   }
-  return rows;
+  for (const auto& [spec, knob, axis] : {std::make_tuple(&soil, "soil.stiffness", "soil_stiffness_N_per_m"),
+                                         std::make_tuple(&speed, "profile.speed", "joint_speed_factor")}) {
+    const std::vector<StepStability> rows = step_rows(run_spec(*spec, out, run_open_loop_case), knob, axis);
+    maps.step.insert(maps.step.end(), rows.begin(), rows.end());
+  }
+  for (const json& j : run_spec(control, out, sim::run_closed_loop_case)) {
+    const auto& [knob, value] = *j["set"].items().begin();
+    for (const std::string& c : control.controllers) {
+      if (c == "pid" && knob == "adaptation_scale") continue;  // PID adapts nothing
+      ControlStability row;
+      row.controller = c;
+      row.axis = knob == "model_mass" ? "model_mass_error" : knob;
+      row.value = value.get<double>();
+      row.ok = j[c]["ok"].get<bool>();
+      row.failure = j[c].value("failure", "");
+      row.tracking = worst_rms(j[c]);
+      maps.control.push_back(row);
+    }
+  }
+  if (quick) return maps;
+  for (const char* name : {"stability_valves.yaml", "stability_hydraulic_gains.yaml"}) {
+    const SweepSpec spec = load_spec(sweeps_dir, name, scenes_dir);
+    HydraulicMap m;
+    m.name = fs::path(name).stem().string();
+    m.dir = (fs::path(out) / m.name).string();
+    std::map<std::string, std::map<std::string, int>> failures;  // "controller knob=value" -> kind -> runs
+    for (const json& j : run_spec(spec, out, sim::run_closed_loop_case))
+      for (const std::string& c : spec.controllers) {
+        ++m.runs;
+        if (j[c]["ok"].get<bool>()) continue;
+        ++m.failed;
+        std::string where = c;
+        for (const auto& [k, v] : j["set"].items()) where += " " + k.substr(k.rfind('.') + 1) + "=" + v.dump();
+        const std::string f = j[c].value("failure", "");
+        ++failures[where][f.rfind("plant stopped", 0) == 0 ? "plant" : "firmware"];
+      }
+    for (const auto& [where, kinds] : failures) {
+      std::string line = where + ":";
+      for (const auto& [kind, n] : kinds) line += " " + kind + " " + std::to_string(n);
+      m.lines.push_back(line);
+    }
+    maps.hydraulic.push_back(m);
+  }
+  return maps;
 }
 
 void write_stability_csvs(const std::string& dir, const std::vector<StepStability>& steps,

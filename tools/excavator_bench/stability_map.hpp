@@ -1,6 +1,9 @@
 #pragma once
 // The stability maps: the largest stable step of every integrator against soil stiffness and joint
-// speed, and each controller's stability against gains, adaptation, noise, delay and mass error.
+// speed, each controller's stability against gains, adaptation, noise, delay and mass error, and the
+// hydraulic maps (the valve stage's gains and the outer law's against the plant's spool lag and bulk
+// modulus). Each is a sweep spec (sweeps/stability_*.yaml) run in this process through the sweep's
+// shard and merge (tools/excavator_sim/sweep.hpp); the merge's files are in OUT/<spec name>/.
 #include <string>
 #include <vector>
 
@@ -22,10 +25,23 @@ struct ControlStability {
   std::string failure;
 };
 
-std::vector<StepStability> step_stability_map(const BenchScene& dig, const BenchScene& free,
-                                              const std::vector<double>& steps, const std::vector<double>& stiffness,
-                                              const std::vector<double>& speeds);
-std::vector<ControlStability> control_stability_map(const BenchScene& dig, double duration);
+// One hydraulic map: its spec, runs and failures (failure kind -> runs) per controller.
+struct HydraulicMap {
+  std::string name, dir;
+  int runs = 0, failed = 0;
+  std::vector<std::string> lines;  // per controller and axis value with failures, for the summary table
+};
+
+struct StabilityMaps {
+  std::vector<StepStability> step;
+  std::vector<ControlStability> control;
+  std::vector<HydraulicMap> hydraulic;  // empty with --quick
+};
+
+// Runs sweeps/stability_*.yaml from `sweeps_dir` on the scenes of `scenes_dir` (quick: the CI cut,
+// fewer values, shorter runs, no hydraulic maps), each into out/<spec name>/.
+StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& scenes_dir, const std::string& out,
+                             bool quick);
 void write_stability_csvs(const std::string& dir, const std::vector<StepStability>& steps,
                           const std::vector<ControlStability>& control);
 

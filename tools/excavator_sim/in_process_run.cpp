@@ -17,6 +17,8 @@ control::ControllerKind parse_kind(const std::string& name) {
                               control::kControllerKinds.names() + ")");
 }
 
+}  // namespace
+
 // The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of it,
 // the integrator.
 std::string describe_setup(const SceneBundle& bundle) {
@@ -41,8 +43,6 @@ std::string describe_setup(const SceneBundle& bundle) {
     << " at " << sc.integrator.step * 1e3 << " ms";
   return o.str();
 }
-
-}  // namespace
 
 Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
   Summary summary;

@@ -26,6 +26,10 @@ struct Summary {
   bool all_ok = true;
 };
 
+// The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of
+// it, the integrator.
+std::string describe_setup(const SceneBundle& bundle);
+
 Summary run_all(const SceneBundle& bundle, const RunOptions& options);
 
 }  // namespace exc::sim

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
       "  excavator-sim run scenes/dig.yaml            PID and adaptive, summary, log, plots, report\n"
       "  excavator-sim run scenes/dig.yaml --controller adaptive --json out.json\n"
       "  excavator-sim robustness scenes/dig.yaml     the same with wrong masses, noise, delay, stiffer soil\n"
+      "  excavator-sim sweep SPEC --shard I/N         one shard of a sweep; sweep-merge SPEC FILES: its table and charts\n"
       "  excavator-sim paper --out out/paper          the paper's Figs. 4-12, then the dig through the valves\n"
       "  excavator-sim config scenes/dig.yaml         the scene's effective configuration (every default filled in)"};
   app.require_subcommand(1);
@@ -57,16 +58,18 @@ int main(int argc, char** argv) {
   run->add_flag("--quiet", quiet, "no progress output");
 
   auto* robust = app.add_subcommand(
-      "robustness", "run a scene with the controller's model, sensors or soil made wrong on purpose: model "
-                    "mass -20 % and +20 %, sensor noise, 2 cycles of sensor delay, 3x stiffer soil, all at once");
-  std::string robust_scene, robust_json, robust_out;
+      "robustness", "run a scene with the controller's model, sensors or soil made wrong on purpose: the variants of "
+                    "a sweep spec (default sweeps/robustness.yaml: model mass -20 % and +20 %, sensor noise, 2 cycles "
+                    "of sensor delay, 3x stiffer soil, all at once)");
+  std::string robust_scene, robust_json, robust_out, robust_spec = EXC_ROBUSTNESS_SPEC;
   bool robust_no_plots = false;
   std::vector<std::string> robust_controllers;
   double robust_duration = 0;
   bool robust_quiet = false;
-  robust->add_option("scene", robust_scene, "scene file (YAML), e.g. scenes/dig.yaml")->required();
+  robust->add_option("scene", robust_scene, "scene file (YAML), e.g. scenes/dig.yaml (default: the spec's)");
+  robust->add_option("--spec", robust_spec, "the sweep spec whose variants run")->capture_default_str();
   robust->add_option("--controller", robust_controllers,
-                     "controller(s): " + exc::control::kControllerKinds.names() + " (default: pid and adaptive)")
+                     "controller(s): " + exc::control::kControllerKinds.names() + " (default: the spec's, pid and adaptive)")
       ->delimiter(',');
   robust->add_option("--json", robust_json, "write the table as JSON to this file");
   robust->add_option("--duration", robust_duration, "simulated seconds per run (default: the scene's duration)")
@@ -101,12 +104,14 @@ int main(int argc, char** argv) {
   sweep->add_option("--shard", sweep_shard, "I/N: run cases I, I+N, I+2N, ... (default 0/1: every case)");
   sweep->add_option("--out", sweep_out, "the shard's result file (default: out/sweep/shard-I-of-N.jsonl)");
   sweep->add_flag("--quiet", sweep_quiet, "no progress output");
-  auto* merge = app.add_subcommand("sweep-merge", "merge shard files into sweep.csv and sweep.json; names missing cases");
+  auto* merge = app.add_subcommand("sweep-merge", "merge shard files into sweep.csv, sweep.json and the spec's charts; names missing cases and shard files");
   std::string merge_spec, merge_out = "out/sweep";
   std::vector<std::string> merge_files;
   merge->add_option("spec", merge_spec, "the sweep spec the shards ran")->required();
   merge->add_option("shards", merge_files, "shard result files")->required();
   merge->add_option("--out", merge_out, "output directory (default out/sweep)");
+  bool merge_no_charts = false;
+  merge->add_flag("--no-charts", merge_no_charts, "the table and summary only (no robustness or stability chart)");
   auto* config = app.add_subcommand(
       "config", "print the scene's effective configuration as YAML: both sides' sections with every default filled in "
                 "(the machine as an absolute path); it loads back to the same run");
@@ -129,7 +134,7 @@ int main(int argc, char** argv) {
       if (merge->parsed()) {
         const exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(merge_spec);
         std::vector<fs::path> files(merge_files.begin(), merge_files.end());
-        const bool complete = exc::sim::merge_sweep(spec, files, merge_out);
+        const bool complete = exc::sim::merge_sweep(spec, files, merge_out, !merge_no_charts);
         std::cout << "sweep: " << (fs::path(merge_out) / "sweep.csv").string() << (complete ? "" : " (cases missing)") << "\n";
         return complete ? 0 : 1;
       }
@@ -139,6 +144,10 @@ int main(int argc, char** argv) {
         return 2;
       }
       const exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(sweep_spec);
+      if (spec.run != exc::sim::SweepRun::closed_loop) {
+        std::cerr << "excavator-sim sweep: " << sweep_spec << ": an open-loop sweep runs in excavator-bench (its step map)\n";
+        return 2;
+      }
       if (sweep_out.empty())
         sweep_out = (fs::path("out/sweep") / ("shard-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl")).string();
       const int n = exc::sim::run_sweep_shard(spec, shard, shards, sweep_out, !sweep_quiet);
@@ -152,14 +161,14 @@ int main(int argc, char** argv) {
 
   if (robust->parsed()) {
     try {
+      exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(robust_spec);
+      if (!robust_scene.empty()) spec.scenes = {robust_scene};
       exc::sim::RunOptions options;
-      options.scene_path = robust_scene;
-      options.controllers =
-          robust_controllers.empty() ? std::vector<std::string>{"pid", "adaptive"} : robust_controllers;
+      options.controllers = robust_controllers.empty() ? spec.controllers : robust_controllers;
       options.duration_override = robust_duration;
       options.progress = !robust_quiet;
-      const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(robust_scene);
-      const auto rows = exc::sim::run_robustness(bundle, options, exc::sim::standard_robustness_variants());
+      const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(spec.scenes.front());
+      const auto rows = exc::sim::run_robustness(spec, options);
       exc::sim::print_robustness(rows, std::cout);
       if (robust_out.empty()) robust_out = (fs::path("out") / (bundle.name + "-robustness")).string();
       fs::create_directories(robust_out);

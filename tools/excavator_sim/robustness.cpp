@@ -3,6 +3,9 @@
 #include <cmath>
 #include <cstdio>
 
+#include <stdexcept>
+
+#include "control/controller_kinds.hpp"
 #include "run_report.hpp"
 
 namespace exc::sim {
@@ -24,54 +27,37 @@ bool pid_over_adaptive(const Summary& s, double& arm, double& bucket) {
   return true;
 }
 
-// The single faults; the "all" variant applies every one of them (mass +20 %).
-// The firmware's model has every link's mass and inertia scaled while the plant keeps the true machine.
-void scale_model_masses(SceneBundle& b, double scale) {
-  for (BodyInertia& body : b.firmware.machine.bodies) {
-    body.mass *= scale;
-    body.inertia *= scale;
-  }
-}
-void heavier_model(SceneBundle& b, RunOptions&) { scale_model_masses(b, 1.2); }
-void lighter_model(SceneBundle& b, RunOptions&) { scale_model_masses(b, 0.8); }
-// Noise of the order of a good encoder chain: 0.1 mm on a stroke, 0.2 mrad on the swing, and a
-// velocity signal (differentiated in the drive) ten times noisier than a clean one.
-void sensor_noise(SceneBundle& b, RunOptions&) {
-  b.scene.sensors.position_noise = Vec4(2e-4, 1e-4, 1e-4, 1e-4);
-  b.scene.sensors.velocity_noise = Vec4(5e-3, 5e-3, 5e-3, 5e-3);
-}
-void sensor_delay(SceneBundle& b, RunOptions&) { b.scene.sensors.latency_cycles = 2; }
-void stiffer_soil(SceneBundle& b, RunOptions&) { b.scene.soil.stiffness *= 3.0; }
-
 }  // namespace
 
-std::vector<RobustnessVariant> standard_robustness_variants() {
-  return {
-      {"nominal", "exact model, the scene's sensors and soil", [](SceneBundle&, RunOptions&) {}},
-      {"mass-20%", "controller's model: every link 20 % lighter than the plant", lighter_model},
-      {"mass+20%", "controller's model: every link 20 % heavier than the plant", heavier_model},
-      {"noise", "sensor noise: position 0.2 mrad / 0.1 mm, velocity 5 mrad/s / 5 mm/s (1 sigma)", sensor_noise},
-      {"delay2", "sensor frames 2 cycles late (2 ms)", sensor_delay},
-      {"soil-K x3", "plant's soil 3x stiffer than the controller's initial estimate", stiffer_soil},
-      {"all", "mass+20%, noise, 2-cycle delay and 3x stiffer soil at once",
-       [](SceneBundle& b, RunOptions& o) {
-         for (auto* fault : {heavier_model, sensor_noise, sensor_delay, stiffer_soil}) fault(b, o);
-       }},
-  };
-}
-
-std::vector<RobustnessRow> run_robustness(const SceneBundle& nominal, const RunOptions& options,
-                                          const std::vector<RobustnessVariant>& variants) {
+std::vector<RobustnessRow> run_robustness(const SweepSpec& spec, const RunOptions& options) {
   std::vector<RobustnessRow> rows;
-  for (std::size_t i = 0; i < variants.size(); ++i) {
-    SceneBundle bundle = nominal;
-    RunOptions o = options;
-    o.lcm_url.clear();  // no telemetry: the figures are in the summary
-    variants[i].apply(bundle, o);
+  std::vector<SceneBundle> scenes;
+  for (const std::string& path : spec.scenes) scenes.push_back(load_scene_bundle(path));
+  SweepSpec s = spec;
+  s.duration = options.duration_override;
+  const int total = s.total_cases();
+  for (int id = 0; id < total; ++id) {
+    const SweepCase c = sweep_case(s, id);
+    const SceneBundle& bundle = scenes[static_cast<std::size_t>(c.scene)];
+    RobustnessRow row;
+    row.variant = std::to_string(id);
+    if (c.variant >= 0) {
+      row.variant = s.variants[static_cast<std::size_t>(c.variant)].name;
+      row.description = s.variants[static_cast<std::size_t>(c.variant)].description;
+    }
     if (options.progress)
-      std::fprintf(stderr, "excavator-sim robustness: variant %zu/%zu %s (%s)\n", i + 1, variants.size(),
-                   variants[i].name.c_str(), variants[i].description.c_str());
-    rows.push_back({variants[i].name, variants[i].description, run_all(bundle, o)});
+      std::fprintf(stderr, "excavator-sim robustness: variant %d/%d %s (%s)\n", id + 1, total, row.variant.c_str(),
+                   row.description.c_str());
+    row.summary.scene = bundle.name;
+    row.summary.setup = describe_setup(bundle);
+    for (const std::string& name : options.controllers) {
+      if (!control::kControllerKinds.named(name))
+        throw std::invalid_argument("--controller: unknown controller '" + name + "' (allowed: " +
+                                    control::kControllerKinds.names() + ")");
+      row.summary.runs.push_back(run_sweep_case(bundle, s, c, name));
+      row.summary.all_ok = row.summary.all_ok && row.summary.runs.back().ok;
+    }
+    rows.push_back(row);
   }
   return rows;
 }

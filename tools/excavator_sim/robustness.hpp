@@ -1,8 +1,8 @@
 #pragma once
 // Robustness of the controllers on one scene: the same run with the controller's model, the sensors
 // or the soil made wrong on purpose (issue 5: +-20 % model mass, sensor noise and delay, a soil three
-// times stiffer than the controller's nominal estimate), PID against adaptive in each.
-#include <functional>
+// times stiffer than the controller's nominal estimate), PID against adaptive in each. The variants
+// are a sweep spec's (sweeps/robustness.yaml), run through the sweep's cases.
 #include <ostream>
 #include <string>
 #include <vector>
@@ -10,26 +10,18 @@
 #include <nlohmann/json.hpp>
 
 #include "in_process_run.hpp"
+#include "sweep.hpp"
 
 namespace exc::sim {
-
-struct RobustnessVariant {
-  std::string name;         // short key, e.g. "mass+20%"
-  std::string description;  // what is wrong, in words
-  // Makes this variant's scene and options from the nominal ones.
-  std::function<void(SceneBundle&, RunOptions&)> apply;
-};
-
-// The shipped set, in the order they are run: nominal first (the reference for the others).
-std::vector<RobustnessVariant> standard_robustness_variants();
 
 struct RobustnessRow {
   std::string variant, description;
   Summary summary;  // one run per controller
 };
 
-std::vector<RobustnessRow> run_robustness(const SceneBundle& nominal, const RunOptions& options,
-                                          const std::vector<RobustnessVariant>& variants);
+// Runs a sweep spec's cases (sweeps/robustness.yaml: one variant each) in this process, each with
+// options.controllers on the spec's scenes, keeping every run's whole record.
+std::vector<RobustnessRow> run_robustness(const SweepSpec& spec, const RunOptions& options);
 
 // Table: per variant and controller, RMS error of each joint, and the PID / adaptive ratio of arm and
 // bucket when both ran.

@@ -1,25 +1,19 @@
 #include "sweep.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <iostream>
-#include <map>
-#include <optional>
-#include <nlohmann/json.hpp>
+#include <cstdlib>
 #include <random>
-#include <sstream>
 #include <stdexcept>
 
 #include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
-#include "harness/lockstep_run.hpp"
+#include "sweep_tables.hpp"
 
 namespace exc::sim {
 namespace {
 
-namespace fs = std::filesystem;
 using settings::Need;
 using settings::SectionReader;
 
@@ -36,25 +30,143 @@ double draw(std::mt19937_64& rng, const SweepRange& r, double fallback) {
   return r.min + (r.max - r.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
 }
 
-nlohmann::json per_joint(const double (&v)[4]) {
-  return {{"swing", v[0]}, {"boom", v[1]}, {"arm", v[2]}, {"bucket", v[3]}};
+bool parse_number(const std::string& s, double& x) {
+  char* end = nullptr;
+  x = std::strtod(s.c_str(), &end);
+  return !s.empty() && end == s.c_str() + s.size() && std::isfinite(x);
+}
+
+// One value of a knob from its node: a number, four numbers where the knob takes one per joint, or a
+// name where it takes names; range-checked. Errors at the key (index >= 0: at the list's element).
+SweepValue read_value(const SectionReader& r, const std::string& key, long index, const YAML::Node& n, const KnobInfo& k) {
+  auto fail = [&](const std::string& why) {
+    if (index >= 0) r.fail(key, static_cast<std::size_t>(index), why);
+    r.fail(key, why);
+  };
+  const std::string range = "in " + settings::format_number(k.lo) + ".." + settings::format_number(k.hi);
+  auto checked = [&](double x) {
+    if (x < k.lo || x > k.hi) fail("is " + settings::format_number(x) + "; must be " + range + " (" + k.what + ")");
+    return x;
+  };
+  SweepValue v;
+  if (n.IsSequence() && k.joints) {
+    if (n.size() != 4) fail("must be one number or four (swing, boom, arm, bucket)");
+    v.type = SweepValue::Type::joints;
+    for (std::size_t j = 0; j < 4; ++j) {
+      double x = 0;
+      if (!n[j].IsScalar() || !parse_number(n[j].Scalar(), x)) fail("must be four numbers " + range);
+      v.joints[j] = checked(x);
+    }
+    return v;
+  }
+  if (!n.IsScalar()) fail(std::string("must be ") + (k.names ? "a name" : "a number " + range) + " (" + k.what + ")");
+  if (k.names) {
+    if (!k.names(n.Scalar())) fail("is '" + n.Scalar() + "'; " + k.what);
+    v.type = SweepValue::Type::name;
+    v.name = n.Scalar();
+    return v;
+  }
+  if (!parse_number(n.Scalar(), v.number)) fail("is '" + n.Scalar() + "'; must be a number " + range + " (" + k.what + ")");
+  checked(v.number);
+  return v;
+}
+
+// The knobs given in a mapping (a grid, the search): each a list of values.
+std::vector<SweepAxis> read_axes(SectionReader& r, const YAML::Node& node, SweepRun run) {
+  std::vector<SweepAxis> axes;
+  for (const KnobInfo& k : knob_table(run)) {
+    if (!r.given(k.name)) continue;
+    const YAML::Node list = node[k.name];
+    if (!list.IsSequence() || list.size() == 0) r.fail(k.name, "must be a list of values (" + std::string(k.what) + ")");
+    SweepAxis a{k.name, {}};
+    for (std::size_t i = 0; i < list.size(); ++i) a.values.push_back(read_value(r, k.name, static_cast<long>(i), list[i], k));
+    axes.push_back(a);
+  }
+  r.finish();
+  return axes;
 }
 
 }  // namespace
 
+std::string SweepValue::text() const {
+  if (type == Type::name) return name;
+  if (type == Type::number) return settings::format_number(number);
+  std::string s;
+  for (double x : joints) s += (s.empty() ? "" : " ") + settings::format_number(x);
+  return s;
+}
+
+nlohmann::json SweepValue::to_json() const {
+  if (type == Type::name) return name;
+  if (type == Type::number) return number;
+  return joints;
+}
+
+int SweepSpec::grid_points() const {
+  int n = 0;
+  for (const SweepGrid& g : grids) {
+    int p = 1;
+    for (const SweepAxis& a : g) p *= static_cast<int>(a.values.size());
+    n += p;
+  }
+  return grids.empty() ? 1 : n;
+}
+
+int SweepSpec::total_cases() const {
+  return static_cast<int>(scenes.size()) * std::max<int>(1, static_cast<int>(variants.size())) * grid_points() * cases;
+}
+
+bool SweepSpec::records(const std::string& what) const { return std::find(record.begin(), record.end(), what) != record.end(); }
+
+std::vector<std::string> SweepSpec::set_knobs() const {
+  std::vector<std::string> knobs;
+  auto add = [&knobs](const std::string& k) {
+    if (std::find(knobs.begin(), knobs.end(), k) == knobs.end()) knobs.push_back(k);
+  };
+  for (const SweepGrid& g : grids)
+    for (const SweepAxis& a : g) add(a.knob);
+  for (const SweepVariant& v : variants)
+    for (const SweepSetting& s : v.values) add(s.first);
+  return knobs;
+}
+
+const SweepValue* SweepCase::value(const std::string& knob) const {
+  for (const SweepSetting& s : set)
+    if (s.first == knob) return &s.second;
+  return nullptr;
+}
+
 SweepSpec load_sweep_spec(const std::string& path) {
   const settings::Document doc = settings::Document::load(path);
+  const YAML::Node raw = doc.root()["sweep"];
   SectionReader top(doc);
   SectionReader s = top.section("sweep", "the sweep's mapping", Need::required);
   SweepSpec spec;
   spec.file = path;
   std::string scene;
-  s.text("scene", scene, "the scene file, relative to the spec", Need::required);
-  spec.scene_path = doc.resolve(scene);
+  if (s.given("scene")) {
+    s.text("scene", scene, "the scene file, relative to the spec");
+    spec.scenes.push_back(doc.resolve(scene));
+  }
+  if (s.given("scenes")) {
+    const YAML::Node list = raw["scenes"];
+    if (!list.IsSequence() || list.size() == 0) s.fail("scenes", "must be a list of scene files");
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (!list[i].IsScalar()) s.fail("scenes", i, "must be a scene file");
+      spec.scenes.push_back(doc.resolve(list[i].Scalar()));
+    }
+  }
+  if (s.given("scene") == s.given("scenes")) s.fail_here("name the scenes: scene: FILE or scenes: [FILE, ...] (one of them)");
+  s.choice("run", spec.run, kSweepRuns, "what one run of a case is");
   s.choices("controllers", spec.controllers, control::kControllerKinds, 1, "the controllers each case runs");
-  s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws, case i from seed + i");
+  s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws per grid point and variant, case i from (seed, i)");
   s.whole("seed", spec.seed, 0, 4e9, "", "the draws' seed");
   if (s.given("duration")) s.number("duration", spec.duration, {1e-3, 3600}, "s", "per run (absent: the scene's)");
+  s.flag("stop_at_safe_state", spec.stop_at_safe_state, "end each run at the firmware's first safe stop");
+  SectionReader w = s.section("window", "open loop: the task's window the effort profile covers");
+  w.number("start", spec.window_start, {0, 3600}, "s", "of the task where the window starts");
+  w.number("horizon", spec.window_horizon, {0.01, 3600}, "s", "simulated");
+  w.finish();
   SectionReader p = s.section("perturbations", "each drawn uniformly in [min, max] per case");
   read_range(p, "model_mass", spec.model_mass, {-0.9, 9}, "the firmware's link masses x (1 + value)");
   read_range(p, "soil_stiffness", spec.soil_stiffness, {0.01, 100}, "the plant's soil K x value");
@@ -62,6 +174,48 @@ SweepSpec load_sweep_spec(const std::string& path) {
   read_range(p, "delay_cycles", spec.delay_cycles, {0, 100}, "whole cycles, drawn as integers");
   p.finish();
   s.choices("faults", spec.faults, kFaultKinds, 0, "one fault per case, its kind drawn from the list");
+  if (s.given("grid")) {
+    if (raw["grid"].IsSequence()) {
+      s.sections("grid", 1, 1000, "grids run one after the other", [&](SectionReader& g, std::size_t i) {
+        spec.grids.push_back(read_axes(g, raw["grid"][i], spec.run));
+      });
+    } else {
+      SectionReader g = s.section("grid", "lists of values, crossed");
+      spec.grids.push_back(read_axes(g, raw["grid"], spec.run));
+    }
+    for (const SweepGrid& g : spec.grids)
+      if (g.empty()) s.fail("grid", "a grid names no knob; allowed: " + knob_names(spec.run));
+  }
+  s.sections("variants", 0, 10000, "named cases", [&](SectionReader& v, std::size_t i) {
+    SweepVariant variant;
+    v.text("name", variant.name, "the variant's short name", Need::required);
+    v.text("description", variant.description, "what is changed, in words");
+    for (const KnobInfo& k : knob_table(spec.run))
+      if (v.given(k.name)) variant.values.push_back({k.name, read_value(v, k.name, -1, raw["variants"][i][k.name], k)});
+    spec.variants.push_back(variant);
+  });
+  if (s.given("search")) {
+    SectionReader q = s.section("search", "one knob: per case, the first of its values whose run passes");
+    const std::vector<SweepAxis> axes = read_axes(q, raw["search"], spec.run);
+    if (axes.size() != 1) s.fail("search", "must name exactly one knob; allowed: " + knob_names(spec.run));
+    spec.search = axes.front();
+  }
+  s.choices("record", spec.record, kSweepRecords, 1, "what the merge writes");
+  // A knob is either drawn or set, and set by one of grid, variants and search.
+  const std::vector<std::string> set = spec.set_knobs();
+  for (const std::string& k : set) {
+    const bool drawn = (k == "model_mass" && spec.model_mass.given) || (k == "soil_stiffness" && spec.soil_stiffness.given) ||
+                       (k == "position_noise" && spec.position_noise.given) || (k == "delay_cycles" && spec.delay_cycles.given);
+    if (drawn) s.fail("perturbations", "'" + k + "' is drawn here and set by the grid or a variant: choose one");
+    if (k == spec.search.knob) s.fail("search", "'" + k + "' is searched and set by the grid or a variant: choose one");
+    if (!spec.grids.empty() && !spec.variants.empty())
+      for (const SweepVariant& v : spec.variants)
+        for (const SweepSetting& vs : v.values)
+          for (const SweepGrid& g : spec.grids)
+            for (const SweepAxis& a : g)
+              if (a.knob == vs.first) s.fail("variants", "'" + vs.first + "' is set by the grid and by variant " + v.name);
+  }
+  if (spec.total_cases() > 10'000'000) s.fail_here("more than 10 million cases");
   s.finish();
   top.finish();
   return spec;
@@ -73,6 +227,30 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
   std::mt19937_64 rng(seq);
   SweepCase c;
   c.id = id;
+  // id = ((scene * variants + variant) * points + point) * cases + draw.
+  int rest = id / spec.cases;
+  const int points = spec.grid_points(), variants = std::max<int>(1, static_cast<int>(spec.variants.size()));
+  int point = rest % points;
+  rest /= points;
+  c.variant = spec.variants.empty() ? -1 : rest % variants;
+  c.scene = rest / variants;
+  for (std::size_t g = 0; g < spec.grids.size(); ++g) {
+    int size = 1;
+    for (const SweepAxis& a : spec.grids[g]) size *= static_cast<int>(a.values.size());
+    if (point >= size) {
+      point -= size;
+      continue;
+    }
+    c.grid = static_cast<int>(g);
+    for (auto a = spec.grids[g].rbegin(); a != spec.grids[g].rend(); ++a) {  // the last axis fastest
+      const int n = static_cast<int>(a->values.size());
+      c.set.insert(c.set.begin(), {a->knob, a->values[static_cast<std::size_t>(point % n)]});
+      point /= n;
+    }
+    break;
+  }
+  if (c.variant >= 0)
+    for (const SweepSetting& v : spec.variants[static_cast<std::size_t>(c.variant)].values) c.set.push_back(v);
   c.model_mass = draw(rng, spec.model_mass, 0);
   c.soil_stiffness = draw(rng, spec.soil_stiffness, 1);
   c.position_noise = draw(rng, spec.position_noise, 0);
@@ -94,138 +272,6 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
                                                                     : 0;
   }
   return c;
-}
-
-int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path& out, bool progress) {
-  const SceneBundle nominal = load_scene_bundle(spec.scene_path);
-  if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
-  std::ofstream file(out);
-  if (!file) throw std::runtime_error("cannot write " + out.string());
-  int done = 0;
-  for (int id = shard; id < spec.cases; id += shards) {
-    const SweepCase c = sweep_case(spec, id);
-    SceneBundle b = nominal;
-    for (BodyInertia& body : b.firmware.machine.bodies) {
-      body.mass *= 1 + c.model_mass;
-      body.inertia *= 1 + c.model_mass;
-    }
-    b.scene.soil.stiffness *= c.soil_stiffness;
-    b.scene.sensors.position_noise = Vec4::Constant(c.position_noise);
-    b.scene.sensors.latency_cycles = c.delay_cycles;
-    nlohmann::json line = {{"case", id},
-                           {"model_mass", c.model_mass},
-                           {"soil_stiffness", c.soil_stiffness},
-                           {"position_noise", c.position_noise},
-                           {"delay_cycles", c.delay_cycles}};
-    if (c.fault != "none")
-      line["fault"] = {{"kind", c.fault}, {"start", c.fault_start}, {"duration", c.fault_duration},
-                       {"joint", c.fault_joint}, {"magnitude", c.fault_magnitude}};
-    for (const std::string& name : spec.controllers) {
-      LockstepOptions o;
-      o.controller = *control::kControllerKinds.named(name);
-      o.duration = spec.duration;
-      if (c.fault != "none") {
-        o.fault.kind = *kFaultKinds.named(c.fault);
-        o.fault.start = c.fault_start;
-        o.fault.duration = c.fault_duration;
-        o.fault.joint = c.fault_joint;
-        o.fault.magnitude = c.fault_magnitude;
-        o.fault.seed = spec.seed * 1000003ull + static_cast<std::uint64_t>(id);
-      }
-      const RunRecord r = run_lockstep(b.scene, b.firmware, o);
-      nlohmann::json run = {{"ok", r.ok}, {"rms_error", per_joint(r.rms_error)}, {"max_error", per_joint(r.max_error)}};
-      if (!r.ok) run["failure"] = r.failure;
-      // The outcome the campaign counts: tracked, safe state (and when), or neither.
-      const bool plant_failed = r.failure.rfind("plant stopped", 0) == 0;
-      run["outcome"] = r.ok ? "tracked" : r.first_safe_stop_time >= 0 && !plant_failed ? "safe_state" : "neither";
-      if (r.first_safe_stop_time >= 0) run["safe_state_time"] = r.first_safe_stop_time;
-      line[name] = run;
-    }
-    file << line.dump() << "\n";
-    file.flush();  // a shard that dies keeps the cases it finished
-    ++done;
-    if (progress && done % 10 == 0)
-      std::fprintf(stderr, "sweep shard %d/%d: %d cases done\n", shard, shards, done);
-  }
-  return done;
-}
-
-bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files, const fs::path& out_dir) {
-  std::map<int, nlohmann::json> cases;
-  for (const fs::path& f : shard_files) {
-    std::ifstream in(f);
-    if (!in) throw std::runtime_error("cannot read shard file " + f.string());
-    std::string line;
-    int n = 0;
-    while (std::getline(in, line)) {
-      ++n;
-      if (line.empty()) continue;
-      nlohmann::json j;
-      try {
-        j = nlohmann::json::parse(line);
-      } catch (const nlohmann::json::exception&) {
-        // A shard killed mid-write leaves a torn last line: that case counts as missing.
-        std::fprintf(stderr, "sweep merge: %s line %d: not a complete record, ignored\n", f.string().c_str(), n);
-        continue;
-      }
-      cases[j["case"].get<int>()] = j;
-    }
-  }
-  fs::create_directories(out_dir);
-  std::ofstream csv(out_dir / "sweep.csv");
-  csv << "case,model_mass,soil_stiffness,position_noise,delay_cycles";
-  for (const std::string& c : spec.controllers)
-    csv << ',' << c << "_ok," << c << "_rms_boom," << c << "_rms_arm," << c << "_rms_bucket";
-  csv << "\n";
-  csv.precision(17);
-  std::vector<int> missing;
-  std::map<std::string, std::map<std::string, int>> failures;  // controller -> region -> count
-  nlohmann::json campaign = nlohmann::json::object();           // controller -> fault kind -> outcomes
-  for (int id = 0; id < spec.cases; ++id) {
-    const auto it = cases.find(id);
-    if (it == cases.end()) {
-      missing.push_back(id);
-      continue;
-    }
-    const nlohmann::json& j = it->second;
-    csv << id << ',' << j["model_mass"].get<double>() << ',' << j["soil_stiffness"].get<double>() << ','
-        << j["position_noise"].get<double>() << ',' << j["delay_cycles"].get<int>();
-    for (const std::string& c : spec.controllers) {
-      const nlohmann::json& r = j[c];
-      csv << ',' << (r["ok"].get<bool>() ? 1 : 0) << ',' << r["rms_error"]["boom"].get<double>() << ','
-          << r["rms_error"]["arm"].get<double>() << ',' << r["rms_error"]["bucket"].get<double>();
-      if (j.contains("fault")) {
-        const std::string kind = j["fault"]["kind"].get<std::string>();
-        nlohmann::json& k = campaign[c][kind];
-        if (k.is_null()) k = {{"runs", 0}, {"tracked", 0}, {"safe_state", 0}, {"neither", 0}, {"worst_time_to_safe_state", nullptr}};
-        k["runs"] = k["runs"].get<int>() + 1;
-        const std::string outcome = r.value("outcome", r["ok"].get<bool>() ? "tracked" : "neither");
-        k[outcome] = k[outcome].get<int>() + 1;
-        if (outcome == "safe_state" && r.contains("safe_state_time")) {
-          const double dt = r["safe_state_time"].get<double>() - j["fault"]["start"].get<double>();
-          if (k["worst_time_to_safe_state"].is_null() || dt > k["worst_time_to_safe_state"].get<double>())
-            k["worst_time_to_safe_state"] = dt;
-        }
-      }
-      if (!r["ok"].get<bool>()) {
-        // The region of a failure: the perturbation that was largest relative to its range.
-        const double stiff = j["soil_stiffness"].get<double>(), mass = std::abs(j["model_mass"].get<double>());
-        const std::string region = stiff >= 2 ? "soil stiffness >= 2x" : mass >= 0.15 ? "model mass error >= 15 %"
-                                   : j["delay_cycles"].get<int>() >= 2 ? "delay >= 2 cycles" : "elsewhere";
-        ++failures[c][region];
-      }
-    }
-    csv << "\n";
-  }
-  nlohmann::json summary = {{"spec", spec.file}, {"cases", spec.cases}, {"merged", cases.size()},
-                            {"missing", missing}, {"failures", failures}, {"campaign", campaign}};
-  std::ofstream(out_dir / "sweep.json") << summary.dump(2) << "\n";
-  if (!missing.empty()) {
-    std::fprintf(stderr, "sweep merge: %zu of %d cases missing (first: %d); rerun their shards\n", missing.size(),
-                 spec.cases, missing.front());
-    return false;
-  }
-  return true;
 }
 
 }  // namespace exc::sim

@@ -1,26 +1,34 @@
 #pragma once
-// Sweeps: many closed-loop runs of one scene, numbered deterministically, run in shards that any
-// engine can schedule (GNU parallel, Slurm job arrays, a plain loop) and merged afterwards.
+// Sweeps: many runs of one or more scenes, numbered deterministically, run in shards that any engine
+// can schedule (GNU parallel, Slurm job arrays, a plain loop) and merged afterwards (docs/sweeps.md).
 //
 //   sweep:
-//     scene: scenes/dig.yaml          # relative to the spec file
-//     controllers: [pid, adaptive]
-//     cases: 1000                     # seeded random draws, case i from seed + i
+//     scenes: [../scenes/dig.yaml]    # relative to the spec file (or scene: one file)
+//     controllers: [pid, adaptive]    # each case runs with each
+//     run: closed_loop                # or open_loop: excavator-bench's effort profile, plant alone
+//     cases: 1000                     # seeded random draws per grid point and variant
 //     seed: 1
 //     duration: 10                    # s per run (default: the scene's)
-//     perturbations:                  # each drawn uniformly in [min, max] per case
-//       model_mass: [-0.2, 0.2]       # the firmware's link masses x (1 + value)
-//       soil_stiffness: [0.5, 3]      # the plant's soil K x value
-//       position_noise: [0, 1e-4]     # m (rad on the swing), 1 sigma
-//       delay_cycles: [0, 2]          # whole cycles, drawn as integers
-//     faults: [bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock]
-//                                     # the fault campaign: one fault per case, its kind drawn from
-//                                     # the list, its start, length, joint and size drawn too
+//     perturbations:                  # drawn uniformly in [min, max] per case
+//       model_mass: [-0.2, 0.2]
+//     grid:                           # lists of values, crossed (first key slowest); a list of such
+//       gain_scale: [0.5, 1, 2]       #   mappings runs each one after the other
+//     variants:                       # named cases, each a set of values
+//       - {name: nominal}
+//       - {name: delay2, delay_cycles: 2, description: "sensor frames 2 cycles late"}
+//     search: {integrator.step: [1e-2, 1e-3]}   # per case: the first value whose run passes
+//     faults: [bus_burst, ...]        # the fault campaign: one fault per case
+//     record: [failures, robustness, stability]   # the merge's outputs besides the table (default: failures)
 //
-// Case i's perturbation depends on (seed, i) only, so a shard computes exactly the cases a single
-// process would, and any set of shard files merges into the same table.
+// Case id = ((scene * variants + variant) * grid points + point) * cases + draw; a case's draws depend
+// on (seed, id) only, so a shard computes exactly the cases a single process would, and any set of
+// shard files merges into the same table.
+#include <array>
 #include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "harness/lockstep_run.hpp"
@@ -32,15 +40,52 @@ struct SweepRange {
   double min = 0, max = 0;
 };
 
+// One value of a knob: a number, four numbers (swing, boom, arm, bucket) or a name.
+struct SweepValue {
+  enum class Type { number, joints, name } type = Type::number;
+  double number = 0;
+  std::array<double, 4> joints{};
+  std::string name;
+  std::string text() const;  // as the table writes it
+  nlohmann::json to_json() const;
+};
+using SweepSetting = std::pair<std::string, SweepValue>;  // knob, value
+
+struct SweepAxis {
+  std::string knob;
+  std::vector<SweepValue> values;
+};
+using SweepGrid = std::vector<SweepAxis>;  // crossed, the first axis slowest
+
+struct SweepVariant {
+  std::string name, description;
+  std::vector<SweepSetting> values;
+};
+
+enum class SweepRun : std::uint8_t { closed_loop, open_loop };
+
 struct SweepSpec {
   std::string file;
-  std::string scene_path;
+  std::vector<std::string> scenes;  // absolute paths
+  SweepRun run = SweepRun::closed_loop;
   std::vector<std::string> controllers{"pid", "adaptive"};
-  int cases = 1;
+  int cases = 1;  // random draws per grid point and variant
   unsigned seed = 1;
   double duration = 0;
+  bool stop_at_safe_state = false;  // end a run at the firmware's first safe stop (maps)
+  double window_start = 0, window_horizon = 1;  // open loop: s of the task, s simulated
   SweepRange model_mass, soil_stiffness, position_noise, delay_cycles;
   std::vector<std::string> faults;  // fault kinds to draw from (empty: no fault)
+  std::vector<SweepGrid> grids;     // run one after the other
+  std::vector<SweepVariant> variants;
+  SweepAxis search;                 // knob empty: none
+  std::vector<std::string> record{"failures"};
+
+  int grid_points() const;  // over all grids (1 without a grid)
+  int total_cases() const;
+  bool records(const std::string& what) const;
+  // The knobs a case sets (grid axes, then variants' keys, in first-seen order): the table's columns.
+  std::vector<std::string> set_knobs() const;
 };
 
 // Reads a sweep spec (opened and parsed once; errors name file, line, column and field).
@@ -48,21 +93,36 @@ SweepSpec load_sweep_spec(const std::string& path);
 
 struct SweepCase {
   int id = 0;
+  int scene = 0, variant = -1, grid = -1;  // indices into the spec (-1: none)
+  std::vector<SweepSetting> set;           // the grid point's and the variant's values
   double model_mass = 0, soil_stiffness = 1, position_noise = 0;
   int delay_cycles = 0;
   std::string fault = "none";
   double fault_start = 0, fault_duration = 0, fault_magnitude = 0;
   int fault_joint = 0;
+  const SweepValue* value(const std::string& knob) const;  // null when the case does not set it
 };
 SweepCase sweep_case(const SweepSpec& spec, int id);
 
-// Runs the cases id = shard, shard + shards, ... and writes one JSON line per case to `out`.
-// Returns the number of cases run.
-int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const std::filesystem::path& out, bool progress);
+// One case's runs as its shard line: {"case", the draws, "set", and per controller (open loop: "plant")
+// {"ok", "failure", "rms_error", "max_error", "outcome", "search_value", ...}}.
+using SweepRunner = std::function<nlohmann::json(const SweepSpec&, const SweepCase&)>;
+// The closed loop: each controller through run_lockstep on the case's scene and settings.
+nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c);
+// The same run, its whole record (the robustness table keeps every figure).
+RunRecord run_sweep_case(const SceneBundle& nominal, const SweepSpec& spec, const SweepCase& c,
+                         const std::string& controller);
+nlohmann::json record_json(const RunRecord& r);
 
-// Merges shard files into out_dir/sweep.csv and out_dir/sweep.json (failures by region, missing
-// cases). Returns false when cases are missing (named in the JSON and on stderr).
+// Runs the cases id = shard, shard + shards, ... and writes one JSON line per case to `out` (flushed
+// as each finishes). Returns the number of cases run.
+int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const std::filesystem::path& out, bool progress,
+                    const SweepRunner& runner = run_closed_loop_case);
+
+// Merges shard files (absent ones reported with their cases) into out_dir: sweep.csv, sweep.json
+// (missing cases, failures by region) and the charts the spec records. Returns false when cases are
+// missing (named in the JSON and on stderr).
 bool merge_sweep(const SweepSpec& spec, const std::vector<std::filesystem::path>& shard_files,
-                 const std::filesystem::path& out_dir);
+                 const std::filesystem::path& out_dir, bool charts = true);
 
 }  // namespace exc::sim
