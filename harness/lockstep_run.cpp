@@ -87,6 +87,7 @@ SceneBundle load_scene_bundle(const std::string& path) {
   b.scene = plant::read_scene(scene);
   b.firmware = app::read_firmware_settings(scene);
   b.name = b.scene.name;
+  b.scene.duration = b.firmware.duration;  // longer when task.efforts.fit_timing stretched the path
   b.effective = YAML::Clone(b.scene.effective);
   settings::merge_effective(b.effective, b.firmware.effective);
   return b;
