@@ -193,7 +193,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         rec.peak_soil_force = std::max(rec.peak_soil_force, s.soil_force.norm());
         for (int i = 0; i < 6; ++i) rec.theta_hat[i] = node.last_output().theta_hat[i];
       }
-      if (result.first_safe_stop_time < 0 && node.safe_stops() > 0) result.first_safe_stop_time = s.time;
+      if (result.first_safe_stop_time < 0 && node.safe_stops() > 0) {
+        // The firmware's clock (the schedule's): the plant's lags it by every SYNC a burst dropped.
+        result.first_safe_stop_time = node.time();
+        result.first_fault_detected_time = node.fault_detected_time();
+      }
       if (options.observer) options.observer(k, plant, node);
       if (plant_node.failed()) break;
       if (options.stop_at_safe_state && node.safe_stops() > 0) break;

@@ -87,6 +87,7 @@ struct RunRecord {
   std::size_t telemetry_ring_high_water = 0;
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
+  double first_fault_detected_time = -1;  // s its fault was detected (FirmwareNode::fault_detected_time)
   // The hydraulic machine (zeros for force-commanded fidelities), from the plant's true circuit and
   // the firmware's valve stage.
   bool hydraulic = false;
