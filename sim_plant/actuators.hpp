@@ -66,6 +66,7 @@ class ActuatorModel {
   void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
 
   const HydraulicCircuit& hydraulics() const { return circuit_; }
+  void set_pump_flow_scale(double scale) { circuit_.set_pump_flow_scale(scale); }
   const Vec4& spool() const { return circuit_.spool(); }
   const Vec4& pressure_a() const { return circuit_.pressure_a(); }  // cylinder bore side; swing: port A
   const Vec4& pressure_b() const { return circuit_.pressure_b(); }

@@ -54,6 +54,8 @@ class Plant {
 
   // Fault injection (the fault campaign): the soil stiffer by `scale` from now on (1: the scene's).
   void set_soil_stiffness_scale(double scale) { soil_.set_stiffness_scale(scale, scene_.soil); }
+  // The hydraulic machine's pumps deliver `scale` of their flow from now on (1: the machine's).
+  void set_pump_flow_scale(double scale) { actuators_.set_pump_flow_scale(scale); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.
