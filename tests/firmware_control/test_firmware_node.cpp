@@ -296,7 +296,7 @@ TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated
   CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::tracking_error));
 }
 
-TEST_CASE("firmware/node: the shipped tasks never trip the tracking-error fault with any controller") {
+TEST_CASE("firmware/node: the reference dig and free-motion tasks on the force-actuated model never trip the tracking-error fault with any effort law") {
   const Model model = build_model(reference_machine());
   for (const char* task : {sim::kDigTask, sim::kFreeMotionTask}) {
     for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {
