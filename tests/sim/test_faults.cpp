@@ -40,6 +40,22 @@ fs::path fast_swing(const std::string& efforts, const std::string& stem,
   return edited_scene(scene, edits, stem);
 }
 
+// The swing forced and left to run saturated to the end (the tracking-error fault out of the way)
+// in `scene`, PID and adaptive; the summary.
+nlohmann::json saturated_swing(const std::string& scene, const std::string& stem,
+                               std::vector<std::pair<std::string, std::string>> edits = {}) {
+  const std::string limits = "tracking_error_limit: [10, 10, 10, 10]";
+  if (read_text_file(scene).find("\ncontroller:\n") != std::string::npos)
+    edits.emplace_back("\ncontroller:\n", "\ncontroller:\n  " + limits + "\n");
+  else
+    edits.emplace_back("\ntask:\n", "\ncontroller: {" + limits + "}\ntask:\n");
+  const fs::path edited = fast_swing("{check: false}", stem, edits, scene);
+  const Run r = run_sim("run " + edited.string() + " --controller pid,adaptive --quiet --no-report --json summary.json");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  return nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
+}
+
 }  // namespace
 
 TEST_CASE("tools/excavator-sim runs issue 16's swing fitted to the actuators end to end: the run's duration stretched with the path and said in the setup line, the task finished") {
@@ -146,4 +162,33 @@ TEST_CASE("tools/excavator-sim: a forced trip of the tracking-error fault is on 
   // The report's status row carries the whole reason.
   const std::string report = read_text_file(r.dir / "out" / "report" / "report.md");
   CHECK(report.find("| status | FAILED: " + failure + " |") != std::string::npos);
+}
+
+TEST_CASE("tools/excavator-sim: in issue 16's saturated swing with no soil the adaptive law's arm and bucket errors are within 1.5x of PID's; tens of times PID's only where the firmware takes itself to be in soil") {
+  // The tip stays above the ground (docs/control.md, "Saturation and the soil term"): no contact is
+  // estimated, so the law has no soil term and no update (its estimates end where they began): it
+  // is the PD computed torque, PID's law without the integral. On the paper's force actuators and
+  // through the valves.
+  const std::string paper = std::string(EXC_SOURCE_DIR) + "/scenes/paper_free_motion.yaml";
+  for (const std::string& scene : {paper, kFreeMotion}) {
+    const nlohmann::json j = saturated_swing(scene, "saturated_" + fs::path(scene).stem().string());
+    for (const char* c : {"pid", "adaptive"}) CHECK(j[c]["max_error"]["swing"].get<double>() > 1.5);  // saturated
+    for (const std::string joint : {"arm", "bucket"}) {
+      const double ratio = j["adaptive"]["rms_error"][joint].get<double>() / j["pid"]["rms_error"][joint].get<double>();
+      MESSAGE(fs::path(scene).filename().string() << ", no soil: adaptive / PID on the " << joint << " " << ratio);
+      CHECK(ratio < 1.5);
+    }
+    CHECK(j["adaptive"]["theta_hat"] == nlohmann::json({{"M_x", 100.0}, {"B_x", 2000.0}, {"K_x", 30000.0},
+                                                        {"M_z", 100.0}, {"B_z", 2000.0}, {"K_z", 30000.0}}));
+  }
+  // Through the valves with the firmware's terrain 4 m up: every tip position is "in soil" to the
+  // firmware, none to the plant (no soil). The soil term pulls the tip toward an anchor with
+  // estimates the update cannot take below their bounds (theta_min): arm and bucket tens of times PID's.
+  const nlohmann::json buried =
+      saturated_swing(kFreeMotion, "buried_swing", {{"terrain: {height: 0.0}", "terrain: {height: 4.0}"}});
+  for (const std::string joint : {"arm", "bucket"}) {
+    const double ratio = buried["adaptive"]["rms_error"][joint].get<double>() / buried["pid"]["rms_error"][joint].get<double>();
+    MESSAGE("no soil, the firmware's terrain above the tip: adaptive / PID on the " << joint << " " << ratio);
+    CHECK(ratio > 10);
+  }
 }
