@@ -1,5 +1,7 @@
 #include "sim_plant/plant_node.hpp"
 
+#include <algorithm>
+
 #include "app/can_stats_message.hpp"
 #include "app/timing_message.hpp"
 #include "hal/clock.hpp"
@@ -171,9 +173,20 @@ void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
     actuator.pilot_a[j] *= 1 - fault_.magnitude;  // the spool's travel scales with its pilot difference
     actuator.pilot_b[j] *= 1 - fault_.magnitude;
   } else if (fault_.kind == InjectedFault::Kind::actuator_jam) {
-    // A stuck actuator keeps what it applied when it stuck, whatever is commanded.
-    if (!fault_started_) jammed_effort_ = plant_.state().effort[j];
-    actuator.value[j] = jammed_effort_;
+    // A stuck actuator keeps what it applied when it stuck, whatever is commanded: a force actuator
+    // its effort, a valve its spool (its target held where the spool was, as an opening or pilots).
+    if (!fault_started_) {
+      jammed_effort_ = plant_.state().effort[j];
+      jammed_spool_ = plant_.state().spool[j];
+    }
+    if (actuator.mode == plant::ActuatorCommand::effort) {
+      actuator.value[j] = jammed_effort_;
+    } else {
+      const double full_stroke = plant_.scene().machine.hydraulics.pilot_full_stroke;
+      actuator.value[j] = jammed_spool_;
+      actuator.pilot_a[j] = std::max(jammed_spool_, 0.0) * full_stroke;
+      actuator.pilot_b[j] = std::max(-jammed_spool_, 0.0) * full_stroke;
+    }
   }
   if (fault_.kind == InjectedFault::Kind::actuator_loss || fault_.kind == InjectedFault::Kind::actuator_jam)
     fault_started_ = true;
