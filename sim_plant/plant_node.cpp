@@ -22,6 +22,8 @@ bool PlantNode::poll() {
   return true;
 }
 
+void PlantNode::coast() { step(last_cycle_ + 1, false); }
+
 bool PlantNode::wait(std::int64_t timeout_ns) {
   std::uint64_t cycle = 0;
   if (!port_.wait_sync(cycle, timeout_ns)) return false;
@@ -49,7 +51,8 @@ void PlantNode::hold_for_silence() {
   port_.send_fault(true, 1);
 }
 
-void PlantNode::step(std::uint64_t cycle) {
+void PlantNode::step(std::uint64_t cycle, bool answer) {
+  last_cycle_ = cycle;
   if (port_.read(command_)) {
     have_command_ = true;
     last_command_cycle_ = cycle;
@@ -112,8 +115,8 @@ void PlantNode::step(std::uint64_t cycle) {
   apply_sensor_fault();
   sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
   sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
-  if (!failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
-  if (cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
+  if (answer && !failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
+  if (answer && cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
   if (telemetry_ != nullptr) {
     publish_state();
     if (cycle % 100 == 0) publish_counters();

@@ -103,6 +103,21 @@ TEST_CASE("plant/node: a jammed actuator on the hydraulic machine is a stuck spo
   CHECK(bench.plant.state().spool[1] < -0.1);
 }
 
+TEST_CASE("plant/node: a cycle whose SYNC was lost coasts: the machine moves on one step with the command it holds and the node sends nothing") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  NodeBench bench(t.scene());
+  hal::SensorState seen;
+  for (std::uint64_t k = 0; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);
+  const double time = bench.plant.state().time, boom = bench.plant.state().q_a[1];
+  bench.node.coast();
+  CHECK(bench.plant.state().time == doctest::Approx(time + bench.plant.scene().cycle));
+  CHECK(bench.plant.state().q_a[1] > boom);  // still extending
+  hal::CanFrame frame;
+  CHECK_FALSE(bench.fw_bus->receive(frame));
+  CHECK(bench.node.steps() == 301);
+}
+
 TEST_CASE("plant/node: SENS_MACHINE carries every chamber and both pump pressures of the hydraulic plant's sensors, PressureValid 1") {
   plant::test::SceneText t;
   t.actuators = "fidelity: hydraulic";
