@@ -148,6 +148,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   std::vector<std::array<double, 4>> cycle_sum_sq(cycles_acc.size(), std::array<double, 4>{});
   const bool hydraulic = scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
   result.hydraulic = hydraulic;
+  if (options.fault.kind == FaultSchedule::Kind::pump_loss && !hydraulic)
+    throw std::invalid_argument("fault pump_loss: " + scene.name + " has no pumps (actuators " +
+                                plant::to_string(scene.actuators.fidelity) + "; it needs hydraulic)");
   if (hydraulic) result.min_pressure = result.peak_pressure = plant.state().hydraulics.min_pressure;
   const double cpu_start = thread_cpu_seconds();
   {
@@ -166,6 +169,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         plant_end.set(fault_on && fault.kind == FaultSchedule::Kind::bus_burst);
         plant_node.set_fault(fault_on ? plant_fault_of(fault) : app::InjectedFault{});
         if (fault.kind == FaultSchedule::Kind::rock) plant.set_soil_stiffness_scale(fault_on ? fault.magnitude : 1.0);
+        if (fault.kind == FaultSchedule::Kind::pump_loss) plant.set_pump_flow_scale(fault_on ? 1 - fault.magnitude : 1.0);
       }
       node.begin_cycle();
       if (!plant_node.poll()) plant_node.coast();  // a SYNC lost in a burst: the machine moves on

@@ -17,11 +17,7 @@
 #include "sim_runs.hpp"
 
 namespace fs = std::filesystem;
-
-using exc::test::edited_scene;
-using exc::test::read_text_file;
-using exc::test::Run;
-using exc::test::run_sim;
+using namespace exc::test;  // Run, run_sim, edited_scene, read_text_file
 
 namespace {
 

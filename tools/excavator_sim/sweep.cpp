@@ -14,6 +14,7 @@
 
 #include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
+#include "fault_campaign.hpp"
 #include "harness/lockstep_run.hpp"
 
 namespace exc::sim {
@@ -48,9 +49,15 @@ SweepSpec load_sweep_spec(const std::string& path) {
   SectionReader s = top.section("sweep", "the sweep's mapping", Need::required);
   SweepSpec spec;
   spec.file = path;
+  // One scene, or several: case i runs scene i mod their number.
   std::string scene;
-  s.text("scene", scene, "the scene file, relative to the spec", Need::required);
-  spec.scene_path = doc.resolve(scene);
+  std::vector<std::string> scenes;
+  s.text("scene", scene, "the scene file, relative to the spec", s.given("scenes") ? Need::optional : Need::required);
+  s.texts("scenes", scenes, 1, "scene files relative to the spec, case i on scene i mod their number");
+  if (!scene.empty() && !scenes.empty()) s.fail("scenes", "give scene or scenes, not both");
+  if (scenes.empty()) scenes.push_back(scene);
+  for (const std::string& f : scenes) spec.scene_paths.push_back(doc.resolve(f));
+  spec.scene_path = spec.scene_paths.front();
   s.choices("controllers", spec.controllers, control::kControllerKinds, 1, "the controllers each case runs");
   s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws, case i from seed + i");
   s.whole("seed", spec.seed, 0, 4e9, "", "the draws' seed");
@@ -77,34 +84,24 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
   c.soil_stiffness = draw(rng, spec.soil_stiffness, 1);
   c.position_noise = draw(rng, spec.position_noise, 0);
   c.delay_cycles = static_cast<int>(std::floor(draw(rng, spec.delay_cycles, 0) + (spec.delay_cycles.given ? 0.5 : 0)));
-  if (!spec.faults.empty()) {
-    // The fault's kind, then when, how long, where and how large (ranges in docs/sweeps.md).
-    const auto pick = std::uniform_int_distribution<std::size_t>(0, spec.faults.size() - 1)(rng);
-    c.fault = spec.faults[pick];
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    c.fault_start = 1.0 + 5.0 * u(rng);
-    c.fault_duration = 0.05 + 0.95 * u(rng);
-    c.fault_joint = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
-    const double x = u(rng);
-    const FaultSchedule::Kind kind = *kFaultKinds.named(c.fault);
-    c.fault_magnitude = kind == FaultSchedule::Kind::bus_burst     ? 0.2 + 0.7 * x
-                        : kind == FaultSchedule::Kind::sensor_jump  ? 0.02 + 0.3 * x
-                        : kind == FaultSchedule::Kind::actuator_loss ? 0.3 + 0.7 * x
-                        : kind == FaultSchedule::Kind::rock         ? 5 + 45 * x
-                                                                    : 0;
-  }
+  if (!spec.faults.empty()) draw_fault(rng, spec.faults, c);
+  c.scene = id % static_cast<int>(spec.scene_paths.size());
   return c;
 }
 
 int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path& out, bool progress) {
-  const SceneBundle nominal = load_scene_bundle(spec.scene_path);
+  std::vector<SceneBundle> nominal;
+  for (const std::string& path : spec.scene_paths) {
+    nominal.push_back(load_scene_bundle(path));
+    check_faults_fit(spec.faults, nominal.back());
+  }
   if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
   std::ofstream file(out);
   if (!file) throw std::runtime_error("cannot write " + out.string());
   int done = 0;
   for (int id = shard; id < spec.cases; id += shards) {
     const SweepCase c = sweep_case(spec, id);
-    SceneBundle b = nominal;
+    SceneBundle b = nominal[static_cast<std::size_t>(c.scene)];
     for (BodyInertia& body : b.firmware.machine.bodies) {
       body.mass *= 1 + c.model_mass;
       body.inertia *= 1 + c.model_mass;
@@ -117,6 +114,7 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
                            {"soil_stiffness", c.soil_stiffness},
                            {"position_noise", c.position_noise},
                            {"delay_cycles", c.delay_cycles}};
+    if (nominal.size() > 1) line["scene"] = b.name;
     if (c.fault != "none")
       line["fault"] = {{"kind", c.fault}, {"start", c.fault_start}, {"duration", c.fault_duration},
                        {"joint", c.fault_joint}, {"magnitude", c.fault_magnitude}};
@@ -124,21 +122,11 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
       LockstepOptions o;
       o.controller = *control::kControllerKinds.named(name);
       o.duration = spec.duration;
-      if (c.fault != "none") {
-        o.fault.kind = *kFaultKinds.named(c.fault);
-        o.fault.start = c.fault_start;
-        o.fault.duration = c.fault_duration;
-        o.fault.joint = c.fault_joint;
-        o.fault.magnitude = c.fault_magnitude;
-        o.fault.seed = spec.seed * 1000003ull + static_cast<std::uint64_t>(id);
-      }
+      o.fault = fault_schedule(c, spec.seed);
       const RunRecord r = run_lockstep(b.scene, b.firmware, o);
       nlohmann::json run = {{"ok", r.ok}, {"rms_error", per_joint(r.rms_error)}, {"max_error", per_joint(r.max_error)}};
       if (!r.ok) run["failure"] = r.failure;
-      // The outcome the campaign counts: tracked, safe state (and when), or neither.
-      const bool plant_failed = r.failure.rfind("plant stopped", 0) == 0;
-      run["outcome"] = r.ok ? "tracked" : r.first_safe_stop_time >= 0 && !plant_failed ? "safe_state" : "neither";
-      if (r.first_safe_stop_time >= 0) run["safe_state_time"] = r.first_safe_stop_time;
+      run.update(run_outcome(r, b.firmware));  // the outcome the campaign counts, and its times
       line[name] = run;
     }
     file << line.dump() << "\n";
@@ -194,19 +182,7 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
       const nlohmann::json& r = j[c];
       csv << ',' << (r["ok"].get<bool>() ? 1 : 0) << ',' << r["rms_error"]["boom"].get<double>() << ','
           << r["rms_error"]["arm"].get<double>() << ',' << r["rms_error"]["bucket"].get<double>();
-      if (j.contains("fault")) {
-        const std::string kind = j["fault"]["kind"].get<std::string>();
-        nlohmann::json& k = campaign[c][kind];
-        if (k.is_null()) k = {{"runs", 0}, {"tracked", 0}, {"safe_state", 0}, {"neither", 0}, {"worst_time_to_safe_state", nullptr}};
-        k["runs"] = k["runs"].get<int>() + 1;
-        const std::string outcome = r.value("outcome", r["ok"].get<bool>() ? "tracked" : "neither");
-        k[outcome] = k[outcome].get<int>() + 1;
-        if (outcome == "safe_state" && r.contains("safe_state_time")) {
-          const double dt = r["safe_state_time"].get<double>() - j["fault"]["start"].get<double>();
-          if (k["worst_time_to_safe_state"].is_null() || dt > k["worst_time_to_safe_state"].get<double>())
-            k["worst_time_to_safe_state"] = dt;
-        }
-      }
+      if (j.contains("fault")) count_campaign_run(campaign, j, c);
       if (!r["ok"].get<bool>()) {
         // The region of a failure: the perturbation that was largest relative to its range.
         const double stiff = j["soil_stiffness"].get<double>(), mass = std::abs(j["model_mass"].get<double>());

@@ -1,9 +1,10 @@
 #pragma once
-// Sweeps: many closed-loop runs of one scene, numbered deterministically, run in shards that any
-// engine can schedule (GNU parallel, Slurm job arrays, a plain loop) and merged afterwards.
+// Sweeps: many closed-loop runs of a scene (or of several), numbered deterministically, run in shards
+// that any engine can schedule (GNU parallel, Slurm job arrays, a plain loop) and merged afterwards.
 //
 //   sweep:
-//     scene: scenes/dig.yaml          # relative to the spec file
+//     scene: scenes/dig.yaml          # relative to the spec file (or scenes: [a, b]: case i on
+//                                     # scene i mod their number)
 //     controllers: [pid, adaptive]
 //     cases: 1000                     # seeded random draws, case i from seed + i
 //     seed: 1
@@ -13,9 +14,10 @@
 //       soil_stiffness: [0.5, 3]      # the plant's soil K x value
 //       position_noise: [0, 1e-4]     # m (rad on the swing), 1 sigma
 //       delay_cycles: [0, 2]          # whole cycles, drawn as integers
-//     faults: [bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock]
-//                                     # the fault campaign: one fault per case, its kind drawn from
-//                                     # the list, its start, length, joint and size drawn too
+//     faults: [bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss]
+//                                     # the fault campaign (fault_campaign.hpp): one fault per case,
+//                                     # its kind drawn from the list, its start, length, joint and
+//                                     # size drawn too
 //
 // Case i's perturbation depends on (seed, i) only, so a shard computes exactly the cases a single
 // process would, and any set of shard files merges into the same table.
@@ -34,7 +36,8 @@ struct SweepRange {
 
 struct SweepSpec {
   std::string file;
-  std::string scene_path;
+  std::string scene_path;                // the first of scene_paths
+  std::vector<std::string> scene_paths;  // `scene`, or `scenes`: case i runs scene i mod their number
   std::vector<std::string> controllers{"pid", "adaptive"};
   int cases = 1;
   unsigned seed = 1;
@@ -53,6 +56,7 @@ struct SweepCase {
   std::string fault = "none";
   double fault_start = 0, fault_duration = 0, fault_magnitude = 0;
   int fault_joint = 0;
+  int scene = 0;  // index into the spec's scene_paths
 };
 SweepCase sweep_case(const SweepSpec& spec, int id);
 
