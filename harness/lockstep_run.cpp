@@ -87,6 +87,7 @@ SceneBundle load_scene_bundle(const std::string& path) {
   b.scene = plant::read_scene(scene);
   b.firmware = app::read_firmware_settings(scene);
   b.name = b.scene.name;
+  b.scene.duration = b.firmware.duration;  // longer when task.efforts.fit_timing stretched the path
   b.effective = YAML::Clone(b.scene.effective);
   settings::merge_effective(b.effective, b.firmware.effective);
   return b;
@@ -147,6 +148,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   std::vector<std::array<double, 4>> cycle_sum_sq(cycles_acc.size(), std::array<double, 4>{});
   const bool hydraulic = scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
   result.hydraulic = hydraulic;
+  if (options.fault.kind == FaultSchedule::Kind::pump_loss && !hydraulic)
+    throw std::invalid_argument("fault pump_loss: " + scene.name + " has no pumps (actuators " +
+                                plant::to_string(scene.actuators.fidelity) + "; it needs hydraulic)");
   if (hydraulic) result.min_pressure = result.peak_pressure = plant.state().hydraulics.min_pressure;
   const double cpu_start = thread_cpu_seconds();
   {
@@ -165,9 +169,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         plant_end.set(fault_on && fault.kind == FaultSchedule::Kind::bus_burst);
         plant_node.set_fault(fault_on ? plant_fault_of(fault) : app::InjectedFault{});
         if (fault.kind == FaultSchedule::Kind::rock) plant.set_soil_stiffness_scale(fault_on ? fault.magnitude : 1.0);
+        if (fault.kind == FaultSchedule::Kind::pump_loss) plant.set_pump_flow_scale(fault_on ? 1 - fault.magnitude : 1.0);
       }
       node.begin_cycle();
-      plant_node.poll();
+      if (!plant_node.poll()) plant_node.coast();  // a SYNC lost in a burst: the machine moves on
       node.end_cycle();
       const plant::PlantState& s = plant.state();
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
@@ -192,7 +197,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         rec.peak_soil_force = std::max(rec.peak_soil_force, s.soil_force.norm());
         for (int i = 0; i < 6; ++i) rec.theta_hat[i] = node.last_output().theta_hat[i];
       }
-      if (result.first_safe_stop_time < 0 && node.safe_stops() > 0) result.first_safe_stop_time = s.time;
+      if (result.first_safe_stop_time < 0 && node.safe_stops() > 0) {
+        // The firmware's clock (the schedule's): the plant's lags it by every SYNC a burst dropped.
+        result.first_safe_stop_time = node.time();
+        result.first_fault_detected_time = node.fault_detected_time();
+      }
       if (options.observer) options.observer(k, plant, node);
       if (plant_node.failed()) break;
       if (options.stop_at_safe_state && node.safe_stops() > 0) break;

@@ -87,6 +87,7 @@ struct RunRecord {
   std::size_t telemetry_ring_high_water = 0;
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
+  double first_fault_detected_time = -1;  // s its fault was detected (FirmwareNode::fault_detected_time)
   // The hydraulic machine (zeros for force-commanded fidelities), from the plant's true circuit and
   // the firmware's valve stage.
   bool hydraulic = false;
@@ -102,23 +103,25 @@ struct RunRecord {
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
 struct FaultSchedule {
-  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock };
+  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss };
   Kind kind = Kind::none;
   double start = 0, duration = 0;  // s
   int joint = 1;                   // sensor and actuator faults: 0 swing .. 3 bucket
   // bus_burst: fraction of frames damaged (split evenly into dropped, corrupted, delayed);
-  // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x.
+  // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x;
+  // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only).
   double magnitude = 0;
   std::uint64_t seed = 1;
 };
 // The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 6> kFaultKinds{{{
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 7> kFaultKinds{{{
     {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
     {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
     {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
     {FaultSchedule::Kind::actuator_loss, "actuator_loss", "an actuator loses a fraction of its effort"},
     {FaultSchedule::Kind::actuator_jam, "actuator_jam", "an actuator jams"},
     {FaultSchedule::Kind::rock, "rock", "the soil 5-50x stiffer"},
+    {FaultSchedule::Kind::pump_loss, "pump_loss", "the hydraulic machine's pumps lose a fraction of their flow"},
 }}};
 inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);

@@ -115,7 +115,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // relief), summed per pump; the flow-sharing factor follows (flow_sharing.hpp). It is taken from
   // the pressures at the start of the substep.
   const int pumps = hp_.pumps_merged ? 1 : kNumPumps;
-  const double pump_limit = hp_.pump_flow / pumps;
+  const double pump_limit = hp_.pump_flow * pump_flow_scale_ / pumps;
   double demand[kNumPumps] = {0, 0};
   for (int i = 0; i < kNumActive; ++i) {
     const double a = r.opening[i];

@@ -86,6 +86,8 @@ class HydraulicCircuit {
   void stick_spool(int function, double spool);
   void release_spool() { stuck_ = -1; }
   int stuck_function() const { return stuck_; }  // -1: none
+  // Fault injection (the fault campaign): the pumps deliver `scale` of pump_flow from now on.
+  void set_pump_flow_scale(double scale) { pump_flow_scale_ = scale; }
 
   // Advance spools, pumps and chambers over dt; q_a is the position at the end, qd_a the velocity
   // over the substep (the piston sweeps A qd_a dt).
@@ -122,6 +124,7 @@ class HydraulicCircuit {
   HydraulicGeometry g_;  // areas and fully open orifice gains (model/hydraulic_geometry.hpp)
   Vec4 relief_setting_ = Vec4::Zero();
   double k_relief_ = 0, k_makeup_ = 0;
+  double pump_flow_scale_ = 1;
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();
   Vec4 v_a_ = Vec4::Zero(), v_b_ = Vec4::Zero();  // chamber volumes at the end of the last substep
   HydraulicReport report_;

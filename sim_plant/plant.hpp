@@ -58,6 +58,8 @@ class Plant {
   // `spool` (-1..1) whatever is commanded, from the next step until release_spool() or reset().
   void stick_spool(int function, double spool) { actuators_.stick_spool(function, spool); }
   void release_spool() { actuators_.release_spool(); }
+  // The hydraulic machine's pumps deliver `scale` of their flow from now on (1: the machine's).
+  void set_pump_flow_scale(double scale) { actuators_.set_pump_flow_scale(scale); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.

@@ -1,5 +1,7 @@
 #include "sim_plant/plant_node.hpp"
 
+#include <algorithm>
+
 #include "app/can_stats_message.hpp"
 #include "app/timing_message.hpp"
 #include "hal/clock.hpp"
@@ -19,6 +21,8 @@ bool PlantNode::poll() {
   step(cycle);
   return true;
 }
+
+void PlantNode::coast() { step(last_cycle_ + 1, false); }
 
 bool PlantNode::wait(std::int64_t timeout_ns) {
   std::uint64_t cycle = 0;
@@ -47,7 +51,8 @@ void PlantNode::hold_for_silence() {
   port_.send_fault(true, 1);
 }
 
-void PlantNode::step(std::uint64_t cycle) {
+void PlantNode::step(std::uint64_t cycle, bool answer) {
+  last_cycle_ = cycle;
   if (port_.read(command_)) {
     have_command_ = true;
     last_command_cycle_ = cycle;
@@ -110,8 +115,8 @@ void PlantNode::step(std::uint64_t cycle) {
   apply_sensor_fault();
   sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
   sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
-  if (!failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
-  if (cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
+  if (answer && !failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
+  if (answer && cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
   if (telemetry_ != nullptr) {
     publish_state();
     if (cycle % 100 == 0) publish_counters();
@@ -175,9 +180,20 @@ void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
     actuator.pilot_a[j] *= 1 - fault_.magnitude;  // the spool's travel scales with its pilot difference
     actuator.pilot_b[j] *= 1 - fault_.magnitude;
   } else if (fault_.kind == InjectedFault::Kind::actuator_jam) {
-    // A stuck actuator keeps what it applied when it stuck, whatever is commanded.
-    if (!fault_started_) jammed_effort_ = plant_.state().effort[j];
-    actuator.value[j] = jammed_effort_;
+    // A stuck actuator keeps what it applied when it stuck, whatever is commanded: a force actuator
+    // its effort, a valve its spool (its target held where the spool was, as an opening or pilots).
+    if (!fault_started_) {
+      jammed_effort_ = plant_.state().effort[j];
+      jammed_spool_ = plant_.state().spool[j];
+    }
+    if (actuator.mode == plant::ActuatorCommand::effort) {
+      actuator.value[j] = jammed_effort_;
+    } else {
+      const double full_stroke = plant_.scene().machine.hydraulics.pilot_full_stroke;
+      actuator.value[j] = jammed_spool_;
+      actuator.pilot_a[j] = std::max(jammed_spool_, 0.0) * full_stroke;
+      actuator.pilot_b[j] = std::max(-jammed_spool_, 0.0) * full_stroke;
+    }
   }
   if (fault_.kind == InjectedFault::Kind::actuator_loss || fault_.kind == InjectedFault::Kind::actuator_jam)
     fault_started_ = true;

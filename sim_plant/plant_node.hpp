@@ -43,6 +43,10 @@ class PlantNode {
   bool poll();
   // Same, waiting up to timeout_ns for a SYNC (SocketCAN); false on timeout.
   bool wait(std::int64_t timeout_ns);
+  // A cycle whose SYNC never reached the plant (lost on the bus): the machine goes on with the
+  // command it holds, one step, and sends nothing (no SYNC, no answer). Lockstep harnesses call it so
+  // that the machine's time keeps the firmware's when frames are lost.
+  void coast();
 
   bool failed() const { return !plant_.status().ok(); }
   // The firmware fell silent (no SYNC): latch the hold until a fresh command set arrives, and say
@@ -58,7 +62,7 @@ class PlantNode {
   void publish_counters();
 
  private:
-  void step(std::uint64_t cycle);
+  void step(std::uint64_t cycle, bool answer = true);
   void apply_actuator_fault(plant::ActuatorCommand& actuator);
   void apply_sensor_fault();
   // Efforts that brake the machine to rest where it is: g_a(q) - M_a * rate * qd_a.
@@ -73,6 +77,7 @@ class PlantNode {
   hal::CommandState command_;
   hal::SensorState sensors_;
   std::uint64_t last_command_cycle_ = 0;
+  std::uint64_t last_cycle_ = 0;  // of the last step
   bool have_command_ = false;
   bool holding_ = true;
   bool silence_hold_ = false;
@@ -82,6 +87,7 @@ class PlantNode {
   bool fault_started_ = false;
   hal::SensorState frozen_;       // sensor_freeze: what the stuck sensor keeps reporting
   double jammed_effort_ = 0;      // actuator_jam: the effort the stuck actuator keeps applying
+  double jammed_spool_ = 0;       // actuator_jam on valve commands: where the stuck spool stays
   control::PerfCounter step_timing_{"plant_step", 1000.0};
 };
 

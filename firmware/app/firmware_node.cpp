@@ -137,6 +137,8 @@ void FirmwareNode::end_cycle() {
       ++safe_stops_;
       safe_stop_cycle_ = cycle_;
       fault_code_ = fault_ ? pending_fault_ : FirmwareFault::sensor_timeout;
+      // A sensor timeout is detected from the first cycle of the gap that ended in it.
+      fault_detected_time_ = fault_ ? pending_time_ : last_valid_time_ + period_;
       if (fault_code_ == FirmwareFault::sensor_timeout)
         std::snprintf(fault_text_, sizeof fault_text_, "sensor timeout: no valid sensor set for %.0f ms at t = %.3f s",
                       (t - last_valid_time_) * 1e3, t);
@@ -260,16 +262,14 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   input.actuator_limited = valve_interface() ? valves_.last().limited : lag_compensator_.clamped();
   out_ = controller_->update(input);
   if (!fault_ && (out_.status != ModelStatus::ok || !finite(out_.tau))) {
-    fault_ = true;
-    pending_fault_ = FirmwareFault::model;
+    raise(FirmwareFault::model);
     std::snprintf(pending_text_, sizeof pending_text_, "model: the closed-chain model refused the state at t = %.3f s", t);
   }
   // Far from where it was told to go: stop (the state machine takes the safe state next cycle).
   for (int j = 0; j < 4 && !fault_; ++j) {
     const double limit = config_.controller.tracking_error_limit[j];
     if (std::abs(out_.e[j]) > limit) {
-      fault_ = true;
-      pending_fault_ = FirmwareFault::tracking_error;
+      raise(FirmwareFault::tracking_error);
       std::snprintf(pending_text_, sizeof pending_text_, "tracking error: %s %.4f %s > limit %.4f at t = %.3f s",
                     kActiveNames[static_cast<std::size_t>(j)], std::abs(out_.e[j]), j == 0 ? "rad" : "m", limit, t);
     }
@@ -293,6 +293,12 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   control_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
 }
 
+void FirmwareNode::raise(FirmwareFault fault) {
+  fault_ = true;
+  pending_fault_ = fault;
+  pending_time_ = time();
+}
+
 void FirmwareNode::command_valves(const Vec4& q) {
   const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
   valves_.set_holding(machine_.mode() == control::Mode::hold, out_.e);
@@ -303,8 +309,7 @@ void FirmwareNode::command_valves(const Vec4& q) {
     // The force loop closes on the measured chamber pressures: without them it would drive the
     // valves blind. Fault (the safe state centres the valves next cycle) rather than guess.
     if (!sensors_.pressure_valid && !fault_) {
-      fault_ = true;
-      pending_fault_ = FirmwareFault::no_pressures;
+      raise(FirmwareFault::no_pressures);
       std::snprintf(pending_text_, sizeof pending_text_,
                     "no pressures: the valve stage's force loop needs the chamber pressures (t = %.3f s)", time());
     }

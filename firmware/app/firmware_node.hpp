@@ -127,6 +127,10 @@ class FirmwareNode {
   // 0.1013 rad > limit 0.1 rad at t = 1.234 s").
   FirmwareFault last_fault() const { return fault_code_; }
   const char* last_fault_text() const { return fault_text_; }
+  // When the fault of the last safe stop was detected (s; -1 before any): the cycle its condition was
+  // first met (the safe state follows the next cycle), or for a sensor timeout the first cycle
+  // without a valid sensor set (the watchdog's timeout later).
+  double fault_detected_time() const { return fault_detected_time_; }
   // Publishes the timing and CAN counters now (also done every 100 cycles).
   void publish_counters();
 
@@ -139,6 +143,8 @@ class FirmwareNode {
   // The pump-limited warning's debounce, raise and clear (FirmwareFault::pump_limited).
   void update_pump_warning(bool limited, double demanded_flow);
   void publish_fault(FirmwareFault code, std::int8_t severity, bool active, const char* text);
+  // A fault condition met this cycle: the state machine takes the safe state next cycle.
+  void raise(FirmwareFault fault);
 
   const Model& model_;
   const control::Task& task_;
@@ -178,6 +184,8 @@ class FirmwareNode {
   FirmwareFault pending_fault_ = FirmwareFault::none;  // raised by this cycle's computation
   FirmwareFault fault_code_ = FirmwareFault::none;     // of the last safe stop
   char pending_text_[96] = "";
+  double pending_time_ = 0;           // s, the cycle the pending fault was raised
+  double fault_detected_time_ = -1;   // s, of the last safe stop's fault
   char fault_text_[96] = "";
   bool finished_ = false;
   double finish_time_ = 0;

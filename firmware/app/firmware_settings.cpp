@@ -1,7 +1,9 @@
 #include "app/firmware_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
 
+#include "app/firmware_node.hpp"
 #include "control/effort_feasibility.hpp"
 #include "model/model.hpp"
 #include "model/scene_common.hpp"
@@ -10,7 +12,8 @@ namespace exc::app {
 namespace {
 
 // The task against the actuators' limits before the run: refused with the place, the joint and the
-// effort, or (task.efforts.fit_timing) slowed down until it fits, 2 % beyond the exact fit.
+// effort, or (task.efforts.fit_timing) slowed down until it fits, 2 % beyond the exact fit, and the
+// run's duration with it.
 void check_task_efforts(FirmwareSettings& s) {
   control::Task& task = s.task;
   if (!task.efforts.check) return;
@@ -29,6 +32,12 @@ void check_task_efforts(FirmwareSettings& s) {
     throw SettingsError(s.file, 0, 0, field, r.message(marks, field) +
                                              (std::isinf(r.time_scale) ? "" : "; or set task.efforts.fit_timing: true"));
   task.timing_scale = r.time_scale * 1.02;
+  // A run that covered the path (its duration at least the path's) covers the stretched path, and
+  // the time it had after it, at least until the task has finished (tracking begins after the node's
+  // track delay); a run asked to cover only part of the path keeps its duration.
+  const double path_time = task.end_time() - task.start_time();
+  const double after = std::max(s.duration - path_time, FirmwareNodeConfig{}.track_delay + s.controller.period);
+  if (s.duration >= path_time) s.duration = path_time * task.timing_scale + after;
   task.trajectory = control::scale_timing(task.trajectory, task.timing_scale);
   const double t0 = task.waypoint_times.front();
   for (double& t : task.waypoint_times) t = t0 + (t - t0) * task.timing_scale;
@@ -47,7 +56,7 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene) {
   s.machine_file = common.machine_file;
   s.machine = std::move(common.machine);
   s.terrain_height = common.terrain_height;  // a profile's shape is the plant's; the estimator anchors to the flat height
-  s.duration = common.duration;
+  s.duration = s.scene_duration = common.duration;
   settings::SectionReader controller = top.section("controller", "the control law's settings");
   control::read_controller_config(controller, s.controller);
   settings::SectionReader task = top.section("task", "what the machine does");

@@ -24,7 +24,10 @@ struct FirmwareSettings {
   control::ControllerConfig controller;
   control::Task task;
   double terrain_height = 0;  // m, world z of the flat ground the soil estimator anchors to
-  double duration = 10;       // s, how long the run lasts
+  // s, how long the run lasts: the scene's `duration`, unless task.efforts.fit_timing stretched a
+  // path the scene's duration covered (then longer by the time the path grew)
+  double duration = 10;
+  double scene_duration = 10;  // s, the scene's `duration` as written
   // The firmware's sections as read, every default filled in (the effective configuration).
   YAML::Node effective;
 };

@@ -217,6 +217,11 @@ void SectionReader::text(const char* key, std::string& value, const char* what, 
   out_[key] = value;
 }
 
+void SectionReader::texts(const char* key, std::vector<std::string>& values, std::size_t min, const char* what) {
+  if (given(key)) values = read_names(key, min, "a list of at least " + std::to_string(min) + " strings (" + what + ")");
+  record_names(key, values);
+}
+
 void SectionReader::read_list(const char* key, double* values, int n, const double* lo, const double* hi,
                               int stride, const char* unit, const char* what, Need need) {
   declare(key);

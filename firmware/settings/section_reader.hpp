@@ -70,6 +70,8 @@ class SectionReader {
   }
   void flag(const char* key, bool& value, const char* what);
   void text(const char* key, std::string& value, const char* what, Need need = Need::optional);
+  // A list of at least `min` strings (file names, ...); the default is values'.
+  void texts(const char* key, std::vector<std::string>& values, std::size_t min, const char* what);
   // A fixed-size list of numbers (Eigen vector, std::array: anything with size() and data()).
   template <typename V>
   void numbers(const char* key, V& values, Bounds bounds, const char* unit, const char* what,

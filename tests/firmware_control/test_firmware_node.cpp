@@ -168,7 +168,7 @@ TEST_CASE("firmware/node: a stop request from outside brings a tracking machine 
   CHECK((loop.plant.q() - q_at_stop).cwiseAbs().maxCoeff() < 1e-3);
 }
 
-TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fault and sends it on the bus") {
+TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fault the watchdog's time after the first missing set and sends it on the bus") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   Loop loop(model, sim::kFreeMotionTask, cfg);
@@ -183,6 +183,10 @@ TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fau
   CHECK(loop.node.mode() == Mode::safe_stop);
   // The watchdog's timeout is 20 ms: the safe state comes on the first cycle past it.
   CHECK(cycles_to_stop == static_cast<int>(std::lround(cfg.controller.watchdog_timeout / 1e-3)) + 1);
+  // Detected on the gap's first cycle: the safe state follows the watchdog's time later.
+  const double silent_from = loop.node.time() - (cycles_to_stop - 1) * 1e-3;
+  CHECK(loop.node.fault_detected_time() == doctest::Approx(silent_from));
+  CHECK(loop.node.time() - loop.node.fault_detected_time() == doctest::Approx(cfg.controller.watchdog_timeout));
   // The plant's end reads the fault frame with its code (on its next SYNC).
   loop.cycle();
   CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::sensor_timeout));
@@ -285,12 +289,14 @@ TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated
   // Stopped before the error passed the limit by more than one cycle of the path's motion.
   CHECK(error_before <= limit + desired_step + 1e-9);
   CHECK(loop.node.time() < 2.5 + cfg.track_delay);  // long before the path's end
+  // Detected on the last tracking cycle, the safe state on the next.
+  CHECK(loop.node.time() - loop.node.fault_detected_time() == doctest::Approx(1e-3));
   // The plant hears it: FW_EMERGENCY carries the code.
   loop.cycle();
   CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::tracking_error));
 }
 
-TEST_CASE("firmware/node: the shipped tasks never trip the tracking-error fault with any controller") {
+TEST_CASE("firmware/node: the reference dig and free-motion tasks on the force-actuated model never trip the tracking-error fault with any effort law") {
   const Model model = build_model(reference_machine());
   for (const char* task : {sim::kDigTask, sim::kFreeMotionTask}) {
     for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {

@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "app/firmware_node.hpp"
 #include "app/firmware_settings.hpp"
 #include "control/effort_feasibility.hpp"
 #include "scenes.hpp"
@@ -101,11 +102,11 @@ TEST_CASE("firmware/settings name the file when it is missing or not YAML") {
 namespace {
 
 // Issue 16's scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
-std::string fast_swing_scene(const std::string& efforts) {
+std::string fast_swing_scene(const std::string& efforts, const std::string& duration = "3") {
   std::string task = exc::control::sim::kFastSwingTask;
   const std::string type = "  type: joint_waypoints\n";
   task.insert(task.find(type) + type.size(), efforts);
-  return "name: fast_swing\nduration: 3\n" + task;
+  return "name: fast_swing\nduration: " + duration + "\n" + task;
 }
 
 }  // namespace
@@ -128,7 +129,7 @@ TEST_CASE("firmware/settings refuse a task the actuators cannot drive, naming th
   }
 }
 
-TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much, check: false forces it as written") {
+TEST_CASE("firmware/settings fit a task's timing when asked, say by how much and stretch the run's duration with it, check: false forces it as written") {
   const app::FirmwareSettings fit =
       read(fast_swing_scene("  efforts: {fit_timing: true}\n"));
   MESSAGE("timing scaled by " << fit.task.timing_scale);
@@ -138,11 +139,20 @@ TEST_CASE("firmware/settings fit a task's timing when asked, and say by how much
   CHECK(fit.task.waypoint_times.back() == doctest::Approx(2.5 * fit.task.timing_scale));
   const Model model = build_model(fit.machine);
   CHECK(control::check_effort_feasibility(model, fit.task.trajectory).ok);
+  // The 3 s run covered the 2.5 s path: it covers the stretched path and the 0.5 s after it.
+  CHECK(fit.scene_duration == 3);
+  CHECK(fit.duration == doctest::Approx(2.5 * fit.task.timing_scale + 0.5));
+  // Covered to its last cycle, it still runs until the task has finished (tracking from 50 ms on).
+  const app::FirmwareSettings exact = read(fast_swing_scene("  efforts: {fit_timing: true}\n", "2.5"));
+  CHECK(exact.duration == doctest::Approx(2.5 * exact.task.timing_scale + app::FirmwareNodeConfig{}.track_delay + 1e-3));
+  // A run asked for part of the path keeps its duration.
+  CHECK(read(fast_swing_scene("  efforts: {fit_timing: true}\n", "2")).duration == 2);
 
   const app::FirmwareSettings forced =
       read(fast_swing_scene("  efforts: {check: false}\n"));
   CHECK(forced.task.timing_scale == 1.0);
   CHECK(forced.task.end_time() == doctest::Approx(2.5));
+  CHECK(forced.duration == 3);
   const std::string maybe = fast_swing_scene("  efforts: {check: maybe}\n");
   check_error(maybe, "task.efforts.check", "maybe", "is 'maybe'; allowed values: true, false");
 }

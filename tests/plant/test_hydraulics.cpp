@@ -346,6 +346,36 @@ TEST_CASE("plant/hydraulics: in the plant, boom and arm together both slow by pu
   CHECK(mean[2] == doctest::Approx(s * m.arm.max_speed).epsilon(0.03));
 }
 
+TEST_CASE("plant/hydraulics: pumps that lose flow (the fault campaign's pump_loss) deliver their share: the boom alone slows to it, and speeds up again when the flow is back") {
+  // The boom alone, its valve fully open, asks 434 L/min of the pumps' 439: unsaturated. With 30 %
+  // of the flow left (Plant::set_pump_flow_scale) the pumps deliver 132 L/min, all of it to the boom,
+  // whose mean speed is then that flow over its bore area.
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  t.q_a = "[0.5, 1.9, 3.0, 1.8]";
+  Plant plant(t.scene());
+  const Machine& m = plant.scene().machine;
+  const double pump = m.hydraulics.pump_flow;
+  const double bore = m.boom.max_force / m.relief_pressure;
+  plant.set_pump_flow_scale(0.3);
+  Vec4 q0 = Vec4::Zero();
+  for (int k = 1; k <= 1400; ++k) {
+    REQUIRE(plant.step(valve(Vec4(0, 1, 0, 0))).ok());
+    if (k == 400) q0 = plant.state().q_a;
+    if (k > 400) {
+      CHECK(plant.state().hydraulics.flow_scale[0] < 1);
+      CHECK(plant.state().hydraulics.meter_in_flow.sum() == doctest::Approx(0.3 * pump).epsilon(1e-9));
+    }
+  }
+  const double slow = plant.state().q_a[1] - q0[1];  // m over 1 s
+  MESSAGE("boom at 30 % of the pumps' flow: " << slow << " m/s (flow / bore area " << 0.3 * pump / bore << ")");
+  CHECK(slow == doctest::Approx(0.3 * pump / bore).epsilon(0.03));
+  plant.set_pump_flow_scale(1);
+  for (int k = 1; k <= 400; ++k) REQUIRE(plant.step(valve(Vec4(0, 1, 0, 0))).ok());
+  CHECK(plant.state().hydraulics.flow_scale[0] == 1);
+  CHECK(plant.state().hydraulics.meter_in_flow[1] > 0.9 * pump);
+}
+
 TEST_CASE("plant/hydraulics: a fast boom-down (overrunning load) refills the rod side from tank; no pressure below vapour") {
   // Lowering, the boom's weight drives it faster than the pump fills the rod side (the meter-out
   // from the loaded bore side sets the speed): without the make-up valves the rod side would fall

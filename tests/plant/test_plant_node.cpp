@@ -78,6 +78,46 @@ TEST_CASE("plant/node: CMD_PILOT drives the hydraulic plant as pilot commands, s
   CHECK(bench.port.rx_stats().rejected() == 0);
 }
 
+TEST_CASE("plant/node: a jammed actuator on the hydraulic machine is a stuck spool: it stays where it was whatever the pilots or the safe state's centred valves ask, and follows them again once freed") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  NodeBench bench(t.scene());
+  hal::SensorState seen;
+  std::uint64_t k = 0;
+  for (; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);
+  const double open = bench.plant.state().spool[1];
+  REQUIRE(open > 0.1);
+  app::InjectedFault jam;
+  jam.kind = app::InjectedFault::Kind::actuator_jam;
+  jam.joint = hal::kBoom;
+  bench.node.set_fault(jam);
+  hal::CommandState centred;
+  centred.mode = hal::CommandMode::valve;  // the firmware's safe state
+  for (; k < 600; ++k) {
+    bench.cycle(k, k < 450 ? boom_pilots(0, 4e6) : centred, seen);
+    REQUIRE(bench.plant.state().spool[1] == doctest::Approx(open).epsilon(1e-9));
+  }
+  bench.node.set_fault(app::InjectedFault{});
+  for (; k < 900; ++k) bench.cycle(k, boom_pilots(0, 4e6), seen);
+  MESSAGE("spool stuck at " << open << ", freed: " << bench.plant.state().spool[1]);
+  CHECK(bench.plant.state().spool[1] < -0.1);
+}
+
+TEST_CASE("plant/node: a cycle whose SYNC was lost coasts: the machine moves on one step with the command it holds and the node sends nothing") {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  NodeBench bench(t.scene());
+  hal::SensorState seen;
+  for (std::uint64_t k = 0; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);
+  const double time = bench.plant.state().time, boom = bench.plant.state().q_a[1];
+  bench.node.coast();
+  CHECK(bench.plant.state().time == doctest::Approx(time + bench.plant.scene().cycle));
+  CHECK(bench.plant.state().q_a[1] > boom);  // still extending
+  hal::CanFrame frame;
+  CHECK_FALSE(bench.fw_bus->receive(frame));
+  CHECK(bench.node.steps() == 301);
+}
+
 TEST_CASE("plant/node: SENS_MACHINE carries every chamber and both pump pressures of the hydraulic plant's sensors, PressureValid 1") {
   plant::test::SceneText t;
   t.actuators = "fidelity: hydraulic";

@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "harness/lockstep_run.hpp"
 #include "sim_runs.hpp"
 
 namespace fs = std::filesystem;
@@ -38,16 +39,17 @@ namespace {
 
 const char* const kJoints[4] = {"swing", "boom", "arm", "bucket"};
 
-// A shipped sweep spec with fewer cases, the shipped dig scene by absolute path and `extra` lines
+// A shipped sweep spec with fewer cases, the shipped scenes by absolute path and `extra` lines
 // appended to the sweep's mapping, written to `to`.
 void write_sweep_spec(const std::string& shipped, int cases, const std::string& extra, const fs::path& to) {
   std::string spec = read_text_file(std::string(EXC_SOURCE_DIR) + "/sweeps/" + shipped);
-  for (const auto& [from, with] : {std::pair<std::string, std::string>{"cases: 1000", "cases: " + std::to_string(cases)},
-                                  std::pair<std::string, std::string>{"../scenes/dig.yaml", kDig}}) {
-    const auto at = spec.find(from);
-    REQUIRE(at != std::string::npos);
-    spec.replace(at, from.size(), with);
-  }
+  const auto count = spec.find("cases: ");
+  REQUIRE(count != std::string::npos);
+  spec.replace(count, spec.find('\n', count) - count, "cases: " + std::to_string(cases));
+  const std::string scenes = "../scenes/", absolute = std::string(EXC_SOURCE_DIR) + "/scenes/";
+  REQUIRE(spec.find(scenes) != std::string::npos);
+  for (auto at = spec.find(scenes); at != std::string::npos; at = spec.find(scenes, at + absolute.size()))
+    spec.replace(at, scenes.size(), absolute);
   std::ofstream(to) << spec << extra;
 }
 
@@ -586,27 +588,47 @@ TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the ca
   CHECK(bad.err.find("bulk_modulus") != std::string::npos);
 }
 
-TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a random fault ends tracking within its limits or in the safe state, none otherwise, every fault kind drawn") {
+TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a random fault on the dig and the free motion ends tracking within its limits or in the safe state within the watchdog time of the fault's detection, none otherwise, every fault kind drawn") {
   const Run setup = run_sim("--help");
   const fs::path dir = setup.dir;
-  write_sweep_spec("fault_campaign.yaml", 24, "", dir / "spec.yaml");
+  write_sweep_spec("fault_campaign.yaml", 12, "", dir / "spec.yaml");  // 12 cases on each scene
   const std::string in_dir = "cd '" + dir.string() + "' && ";
   REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --out all.jsonl > /dev/null 2>&1").c_str()) == 0);
   REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep-merge spec.yaml all.jsonl --out merged > /dev/null 2>&1").c_str()) == 0);
   const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "merged" / "sweep.json"));
+  const double watchdog = exc::sim::load_scene_bundle(kDig).firmware.controller.watchdog_timeout;
   int runs = 0, kinds = 0;
   for (const char* c : {"pid", "adaptive"}) {
     REQUIRE(j["campaign"].contains(c));
+    std::map<std::string, int> per_scene;
     for (const auto& [kind, k] : j["campaign"][c].items()) {
-      INFO(c << " " << kind);
+      INFO(c << " " << kind << ": " << k.dump());
       CHECK(k["neither"].get<int>() == 0);
       CHECK(k["tracked"].get<int>() + k["safe_state"].get<int>() == k["runs"].get<int>());
+      if (!k["worst_time_from_detection"].is_null()) CHECK(k["worst_time_from_detection"].get<double>() <= watchdog + 1e-9);
+      for (const auto& [scene, n] : k["scenes"].items()) per_scene[scene] += n["runs"].get<int>();
       runs += k["runs"].get<int>();
       ++kinds;
     }
+    CHECK(per_scene == std::map<std::string, int>{{"dig", 12}, {"free_motion", 12}});  // cases 0-11 on the dig, 12-23 on the free motion
   }
   CHECK(runs == 2 * 24);
-  CHECK(kinds == 2 * 6);
+  CHECK(kinds == 2 * 7);
+}
+
+TEST_CASE("tools/excavator-sim sweep refuses a spec naming both scene and scenes, and pump_loss on a scene without pumps before any run") {
+  const Run setup = run_sim("--help");
+  const std::string in_dir = "cd '" + setup.dir.string() + "' && ";
+  std::ofstream(setup.dir / "both.yaml") << "sweep:\n  scene: " << kDig << "\n  scenes: [" << kDig << "]\n";
+  std::ofstream(setup.dir / "pumps.yaml") << "sweep:\n  scene: " << kPaperDig << "\n  faults: [rock, pump_loss]\n";
+  for (const auto& [spec, reason] : {std::pair<std::string, std::string>{"both.yaml", "scene: FILE or scenes: [FILE, ...] (one of them)"},
+                                     {"pumps.yaml", "pump_loss needs the hydraulic machine; " + kPaperDig}}) {
+    const int status = std::system((in_dir + EXC_SIM_TOOL + " sweep " + spec + " --quiet --out x.jsonl > out.txt 2> err.txt").c_str());
+    const std::string err = read_text_file(setup.dir / "err.txt");
+    INFO(spec << ": " << err);
+    CHECK(WEXITSTATUS(status) == 2);
+    CHECK(err.find(reason) != std::string::npos);
+  }
 }
 
 TEST_CASE("tools/excavator-sim: the 10 s paper dig run for 40 s ends its task at 10.05 s and holds, no worse than the 10 s run") {

@@ -37,8 +37,14 @@ std::string describe_setup(const SceneBundle& bundle) {
     else
       o << "off";
   }
-  if (bundle.firmware.task.timing_scale != 1)
-    o << "; task timing scaled by " << bundle.firmware.task.timing_scale << " to fit the actuators' limits";
+  const app::FirmwareSettings& fw = bundle.firmware;
+  if (fw.task.timing_scale != 1) {
+    o << "; task timing scaled by " << fw.task.timing_scale << " to fit the actuators' limits";
+    if (fw.duration != fw.scene_duration)
+      o << ", the run's duration with it (" << fw.scene_duration << " s -> " << fw.duration << " s)";
+    else
+      o << " (the run's " << fw.duration << " s cover part of the path, as the scene asks)";
+  }
   o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
     << " at " << sc.integrator.step * 1e3 << " ms";
   return o.str();

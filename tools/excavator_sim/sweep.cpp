@@ -9,6 +9,7 @@
 
 #include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
+#include "fault_campaign.hpp"
 #include "sweep_tables.hpp"
 
 namespace exc::sim {
@@ -143,6 +144,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
   SectionReader s = top.section("sweep", "the sweep's mapping", Need::required);
   SweepSpec spec;
   spec.file = path;
+  // One scene, or several: case i runs scene i mod their number.
   std::string scene;
   if (s.given("scene")) {
     s.text("scene", scene, "the scene file, relative to the spec");
@@ -255,22 +257,7 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
   c.soil_stiffness = draw(rng, spec.soil_stiffness, 1);
   c.position_noise = draw(rng, spec.position_noise, 0);
   c.delay_cycles = static_cast<int>(std::floor(draw(rng, spec.delay_cycles, 0) + (spec.delay_cycles.given ? 0.5 : 0)));
-  if (!spec.faults.empty()) {
-    // The fault's kind, then when, how long, where and how large (ranges in docs/sweeps.md).
-    const auto pick = std::uniform_int_distribution<std::size_t>(0, spec.faults.size() - 1)(rng);
-    c.fault = spec.faults[pick];
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    c.fault_start = 1.0 + 5.0 * u(rng);
-    c.fault_duration = 0.05 + 0.95 * u(rng);
-    c.fault_joint = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
-    const double x = u(rng);
-    const FaultSchedule::Kind kind = *kFaultKinds.named(c.fault);
-    c.fault_magnitude = kind == FaultSchedule::Kind::bus_burst     ? 0.2 + 0.7 * x
-                        : kind == FaultSchedule::Kind::sensor_jump  ? 0.02 + 0.3 * x
-                        : kind == FaultSchedule::Kind::actuator_loss ? 0.3 + 0.7 * x
-                        : kind == FaultSchedule::Kind::rock         ? 5 + 45 * x
-                                                                    : 0;
-  }
+  if (!spec.faults.empty()) draw_fault(rng, spec.faults, c);
   return c;
 }
 

@@ -17,7 +17,7 @@
 //       - {name: nominal}
 //       - {name: delay2, delay_cycles: 2, description: "sensor frames 2 cycles late"}
 //     search: {integrator.step: [1e-2, 1e-3]}   # per case: the first value whose run passes
-//     faults: [bus_burst, ...]        # the fault campaign: one fault per case
+//     faults: [bus_burst, ...]        # the fault campaign (fault_campaign.hpp): one fault per case
 //     record: [failures, robustness, stability]   # the merge's outputs besides the table (default: failures)
 //
 // Case id = ((scene * variants + variant) * grid points + point) * cases + draw; a case's draws depend
@@ -112,7 +112,7 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c);
 // The same run, its whole record (the robustness table keeps every figure).
 RunRecord run_sweep_case(const SceneBundle& nominal, const SweepSpec& spec, const SweepCase& c,
                          const std::string& controller);
-nlohmann::json record_json(const RunRecord& r);
+nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firmware);
 
 // Runs the cases id = shard, shard + shards, ... and writes one JSON line per case to `out` (flushed
 // as each finishes). Returns the number of cases run.

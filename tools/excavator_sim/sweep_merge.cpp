@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "run_report.hpp"
+#include "fault_campaign.hpp"
 #include "sweep.hpp"
 #include "sweep_tables.hpp"
 
@@ -43,22 +44,6 @@ std::string failure_kind(const std::string& f) {
   const auto last = f.find("the last for ");
   if (last != std::string::npos) return "firmware safe state: " + head(f.substr(last + 13));
   return head(f);
-}
-
-// The fault campaign: per controller and fault kind, the runs' outcomes and the worst time from the
-// fault's start to the safe state.
-void add_campaign_outcome(json& campaign, const std::string& c, const json& j, const json& r) {
-  const std::string kind = j["fault"]["kind"].get<std::string>();
-  json& k = campaign[c][kind];
-  if (k.is_null()) k = {{"runs", 0}, {"tracked", 0}, {"safe_state", 0}, {"neither", 0}, {"worst_time_to_safe_state", nullptr}};
-  k["runs"] = k["runs"].get<int>() + 1;
-  const std::string outcome = r.value("outcome", r["ok"].get<bool>() ? "tracked" : "neither");
-  k[outcome] = k[outcome].get<int>() + 1;
-  if (outcome == "safe_state" && r.contains("safe_state_time")) {
-    const double dt = r["safe_state_time"].get<double>() - j["fault"]["start"].get<double>();
-    if (k["worst_time_to_safe_state"].is_null() || dt > k["worst_time_to_safe_state"].get<double>())
-      k["worst_time_to_safe_state"] = dt;
-  }
 }
 
 // The Monte-Carlo draws' regions: the perturbation that was largest relative to its range.
@@ -186,7 +171,7 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
         csv << ',' << (v.is_string() ? v.get<std::string>() : cell(v));
       }
       csv << ',' << quoted(r.value("failure", ""));
-      if (j.contains("fault")) add_campaign_outcome(campaign, name, j, r);
+      if (j.contains("fault")) count_campaign_run(campaign, j, name);
       for (const SweepSetting& s : c.set) {
         json& v = by_value[name][s.first][s.second.text()];
         if (v.is_null()) v = {{"runs", 0}, {"failed", 0}};

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "control/controller_kinds.hpp"
+#include "fault_campaign.hpp"
 #include "sweep.hpp"
 
 namespace exc::sim {
@@ -77,14 +78,7 @@ RunRecord run_one(const SceneBundle& nominal, const SweepSpec& spec, const Sweep
   o.controller = *control::kControllerKinds.named(controller);
   o.duration = spec.duration;
   o.stop_at_safe_state = spec.stop_at_safe_state;
-  if (c.fault != "none") {
-    o.fault.kind = *kFaultKinds.named(c.fault);
-    o.fault.start = c.fault_start;
-    o.fault.duration = c.fault_duration;
-    o.fault.joint = c.fault_joint;
-    o.fault.magnitude = c.fault_magnitude;
-    o.fault.seed = spec.seed * 1000003ull + static_cast<std::uint64_t>(c.id);
-  }
+  o.fault = fault_schedule(c, spec.seed);
   return run_lockstep(b.scene, b.firmware, o);
 }
 
@@ -95,13 +89,10 @@ RunRecord run_sweep_case(const SceneBundle& nominal, const SweepSpec& spec, cons
   return run_one(nominal, spec, c, controller, nullptr);
 }
 
-nlohmann::json record_json(const RunRecord& r) {
+nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firmware) {
   nlohmann::json run = {{"ok", r.ok}, {"rms_error", per_joint(r.rms_error)}, {"max_error", per_joint(r.max_error)}};
   if (!r.ok) run["failure"] = r.failure;
-  // The outcome the campaign counts: tracked, safe state (and when), or neither.
-  const bool plant_failed = r.failure.rfind("plant stopped", 0) == 0;
-  run["outcome"] = r.ok ? "tracked" : r.first_safe_stop_time >= 0 && !plant_failed ? "safe_state" : "neither";
-  if (r.first_safe_stop_time >= 0) run["safe_state_time"] = r.first_safe_stop_time;
+  run.update(run_outcome(r, firmware));  // the outcome the campaign counts, and its times
   run["simulated_seconds"] = r.simulated_seconds;
   if (r.hydraulic) run["pressure"] = {{"min", r.min_pressure}, {"max", r.peak_pressure}};
   return run;
@@ -125,7 +116,7 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c) {
                      {"joint", c.fault_joint}, {"magnitude", c.fault_magnitude}};
   for (const std::string& name : spec.controllers) {
     if (spec.search.knob.empty()) {
-      line[name] = record_json(run_one(nominal, spec, c, name, nullptr));
+      line[name] = record_json(run_one(nominal, spec, c, name, nullptr), nominal.firmware);
       continue;
     }
     // The search: the first value (in the spec's order) whose run passes; the failure of the one before.
@@ -135,7 +126,7 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c) {
       const RunRecord r = run_one(nominal, spec, c, name, &s);
       if (r.ok) {
         const std::string before = run.value("failure", "");
-        run = record_json(r);
+        run = record_json(r, nominal.firmware);
         run["search_value"] = v.to_json();
         if (!before.empty()) run["failure_before"] = before;
         break;
@@ -152,6 +143,8 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
   if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
   std::ofstream file(out);
   if (!file) throw std::runtime_error("cannot write " + out.string());
+  // A fault the scenes cannot take (pump_loss without the hydraulic machine) before any run.
+  for (const std::string& scene : spec.scenes) check_faults_fit(spec.faults, cached_scene(scene));
   int done = 0;
   const int total = spec.total_cases();
   for (int id = shard; id < total; id += shards) {

@@ -1,0 +1,111 @@
+#include "fault_campaign.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace exc::sim {
+namespace {
+
+using Kind = FaultSchedule::Kind;
+
+// The size of a fault of this kind from a uniform draw x in [0, 1) (docs/sweeps.md).
+double fault_magnitude(Kind kind, double x) {
+  switch (kind) {
+    case Kind::bus_burst: return 0.2 + 0.7 * x;      // fraction of frames damaged
+    case Kind::sensor_jump: return 0.02 + 0.3 * x;   // m
+    case Kind::actuator_loss: return 0.3 + 0.7 * x;  // fraction of the effort lost
+    case Kind::rock: return 5 + 45 * x;              // soil stiffness x
+    case Kind::pump_loss: return 0.3 + 0.7 * x;      // fraction of the pumps' flow lost
+    default: return 0;
+  }
+}
+
+// Keeps the larger of a table's time and t (null: none yet).
+void keep_worst(nlohmann::json& worst, double t) {
+  if (worst.is_null() || t > worst.get<double>()) worst = t;
+}
+
+nlohmann::json& row(nlohmann::json& table, const std::string& key) {
+  nlohmann::json& k = table[key];
+  if (k.is_null()) k = {{"runs", 0}, {"tracked", 0}, {"safe_state", 0}, {"neither", 0}};
+  return k;
+}
+
+}  // namespace
+
+void draw_fault(std::mt19937_64& rng, const std::vector<std::string>& kinds, SweepCase& c) {
+  const auto pick = std::uniform_int_distribution<std::size_t>(0, kinds.size() - 1)(rng);
+  c.fault = kinds[pick];
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  c.fault_start = 1.0 + 5.0 * u(rng);
+  c.fault_duration = 0.05 + 0.95 * u(rng);
+  c.fault_joint = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
+  c.fault_magnitude = fault_magnitude(*kFaultKinds.named(c.fault), u(rng));
+}
+
+void check_faults_fit(const std::vector<std::string>& kinds, const SceneBundle& scene) {
+  const bool pumps = scene.scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
+  if (!pumps && std::find(kinds.begin(), kinds.end(), "pump_loss") != kinds.end())
+    throw std::invalid_argument("sweep.faults: pump_loss needs the hydraulic machine; " + scene.scene.file +
+                                " has actuators " + plant::to_string(scene.scene.actuators.fidelity));
+}
+
+FaultSchedule fault_schedule(const SweepCase& c, std::uint64_t seed) {
+  FaultSchedule f;
+  if (c.fault == "none") return f;
+  f.kind = *kFaultKinds.named(c.fault);
+  f.start = c.fault_start;
+  f.duration = c.fault_duration;
+  f.joint = c.fault_joint;
+  f.magnitude = c.fault_magnitude;
+  f.seed = seed * 1000003ull + static_cast<std::uint64_t>(c.id);
+  return f;
+}
+
+nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firmware) {
+  nlohmann::json o;
+  const double watchdog = firmware.controller.watchdog_timeout;
+  if (r.first_safe_stop_time >= 0) {
+    o["safe_state_time"] = r.first_safe_stop_time;
+    o["fault_detected_time"] = r.first_fault_detected_time;
+  }
+  std::string why;
+  if (r.failure.rfind("plant stopped", 0) == 0) {
+    why = r.failure;
+  } else if (r.first_safe_stop_time >= 0) {
+    const double late = r.first_safe_stop_time - r.first_fault_detected_time - watchdog;
+    if (late > 1e-9) why = "the safe state " + std::to_string(late * 1e3) + " ms later than the watchdog time after detection";
+  } else if (r.tracking_samples == 0) {
+    why = r.failure;
+  } else {
+    const auto& limit = firmware.controller.tracking_error_limit;
+    for (int j = 0; j < 4 && why.empty(); ++j)
+      if (r.max_error[j] > limit[j])
+        why = "joint " + std::to_string(j) + "'s true error " + std::to_string(r.max_error[j]) + " beyond its limit " +
+              std::to_string(limit[j]) + " without a safe stop";
+  }
+  o["outcome"] = !why.empty() ? "neither" : r.first_safe_stop_time >= 0 ? "safe_state" : "tracked";
+  if (!why.empty()) o["why"] = why;
+  return o;
+}
+
+void count_campaign_run(nlohmann::json& table, const nlohmann::json& line, const std::string& controller) {
+  const nlohmann::json& r = line[controller];
+  const nlohmann::json& fault = line["fault"];
+  const std::string outcome = r.value("outcome", r["ok"].get<bool>() ? "tracked" : "neither");
+  nlohmann::json& k = row(table[controller], fault["kind"].get<std::string>());
+  for (nlohmann::json* counts : {&k, line.contains("scene") ? &row(k["scenes"], line["scene"].get<std::string>()) : nullptr}) {
+    if (counts == nullptr) continue;
+    (*counts)["runs"] = (*counts)["runs"].get<int>() + 1;
+    (*counts)[outcome] = (*counts)[outcome].get<int>() + 1;
+  }
+  if (outcome == "neither") k["neither_cases"].push_back(line["case"]);
+  if (!k.contains("worst_time_to_safe_state")) k["worst_time_to_safe_state"] = k["worst_time_from_detection"] = nullptr;
+  if (outcome == "safe_state" && r.contains("safe_state_time")) {
+    const double stop = r["safe_state_time"].get<double>();
+    keep_worst(k["worst_time_to_safe_state"], stop - fault["start"].get<double>());
+    if (r.contains("fault_detected_time")) keep_worst(k["worst_time_from_detection"], stop - r["fault_detected_time"].get<double>());
+  }
+}
+
+}  // namespace exc::sim

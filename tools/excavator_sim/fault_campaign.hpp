@@ -1,0 +1,38 @@
+#pragma once
+// The fault campaign (issue 16, docs/sweeps.md): a sweep whose cases each carry one random fault.
+// Kept apart from the sweep's reading, sharding and merging (sweep.cpp): the fault a case draws, the
+// schedule the harness injects, a run's outcome, and the merge's count of outcomes per controller
+// and fault kind.
+#include <cstdint>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "sweep.hpp"
+
+namespace exc::sim {
+
+// Draws case c's fault from the case's generator: its kind from `kinds`, its start, length, joint
+// and size (ranges in docs/sweeps.md).
+void draw_fault(std::mt19937_64& rng, const std::vector<std::string>& kinds, SweepCase& c);
+// Refuses a fault the scene cannot take (pump_loss without the hydraulic machine), before any run.
+void check_faults_fit(const std::vector<std::string>& kinds, const SceneBundle& scene);
+// The schedule the harness injects for case c (none for a case without a fault).
+FaultSchedule fault_schedule(const SweepCase& c, std::uint64_t seed);
+
+// A run's outcome as the campaign counts it, with the times it was judged by:
+//   tracked     no safe stop, and the true error within controller.tracking_error_limit throughout
+//   safe_state  the firmware took the safe state within controller.watchdog_timeout of detecting the
+//               fault (FirmwareNode::fault_detected_time)
+//   neither     anything else (the plant stopped, never tracked, beyond the limits without a stop, a
+//               late safe state), with the reason in "why"
+nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firmware);
+
+// Counts the run of `controller` in a merged case line (one with a "fault") into `table`, the
+// campaign's rows by controller and fault kind: runs, outcomes, the worst times to the safe state
+// from the fault's start and from its detection, the cases that ended neither way, and per scene.
+void count_campaign_run(nlohmann::json& table, const nlohmann::json& line, const std::string& controller);
+
+}  // namespace exc::sim
