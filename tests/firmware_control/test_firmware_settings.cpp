@@ -50,7 +50,7 @@ TEST_CASE("firmware/settings read the shipped dig scene's firmware sections as w
   CHECK(s.controller.command_interface == control::CommandInterface::valve);  // a hydraulic machine
   CHECK(s.controller.actuator_lag == 0.0);
   CHECK(s.controller.adaptation_rate[2] == doctest::Approx(3e11));  // a tenth of the force-actuated rate
-  CHECK(s.duration == doctest::Approx(10.0));
+  CHECK(s.duration == doctest::Approx(10.1));  // the path ends at 10.05 s
   CHECK(s.terrain_height == doctest::Approx(0.0));
   CHECK(s.machine_file.empty());  // no 'machine:' key: the built-in reference machine
   CHECK(s.machine.bodies.size() == reference_machine().bodies.size());

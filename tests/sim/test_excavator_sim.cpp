@@ -160,14 +160,14 @@ TEST_CASE("tools/excavator-sim run on the paper's force-actuated dig writes the 
             "actuators limited (effort lag 20 ms), firmware commands efforts, lag compensation 20 ms -> 5 ms") == 0);
   CHECK(r.out.find("scene paper_dig: actuators limited") != std::string::npos);
   CHECK(j["heap_allocations_in_loop"].get<long long>() == 0);
-  CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.0).epsilon(1e-3));
+  CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.1).epsilon(1e-3));
   CHECK(j["control_step_us"]["median"].get<double>() > 0);
 
-  // The log holds every message of every cycle: 10 s at 1 kHz = 10,000 per controller on each
-  // per-cycle channel, counted by its sequence numbers 0 .. 9,999 and stamped 1 ms apart (counted,
+  // The log holds every message of every cycle: 10.1 s at 1 kHz = 10,100 per controller on each
+  // per-cycle channel, counted by its sequence numbers 0 .. 10,099 and stamped 1 ms apart (counted,
   // not weighed).
   const std::map<std::string, LogChannel> log = read_log_channels(r.dir / "out" / "run.lcm");
-  check_every_cycle_logged(log, {"pid", "adaptive"}, 10000);
+  check_every_cycle_logged(log, {"pid", "adaptive"}, 10100);
   for (const char* c : {"pid", "adaptive"}) {
     // The report's CSVs (excavator-log export, as the report writes them) have one row per cycle.
     {
@@ -177,7 +177,7 @@ TEST_CASE("tools/excavator-sim run on the paper's force-actuated dig writes the 
       REQUIRE(std::system(cmd.c_str()) == 0);
       for (const char* base : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
         INFO(base);
-        CHECK(exc::test::csv_data_rows(csv / (std::string(base) + "__" + c + ".csv")) == 10000);
+        CHECK(exc::test::csv_data_rows(csv / (std::string(base) + "__" + c + ".csv")) == 10100);
       }
     }
     // The telemetry path's own counters: nothing dropped (blocking publisher), every message published.
@@ -255,7 +255,7 @@ TEST_CASE("tools/excavator-sim: on the paper dig's lagging force actuators the f
 }
 
 TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits 2") {
-  const fs::path bad = edited_dig("duration: 10.0", "duration: -3", "bad_scene");
+  const fs::path bad = edited_dig("duration: 10.1", "duration: -3", "bad_scene");
   for (const char* sub : {"run", "robustness"}) {
     const Run r = run_sim(std::string(sub) + " " + bad.string() + " --quiet");
     INFO(sub << ": " << r.err);
@@ -382,12 +382,12 @@ TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback reco
   REQUIRE(r.status == 0);
   REQUIRE(fs::exists(log_path));
   const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
-  CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.0).epsilon(1e-3));
+  CHECK(j["simulated_seconds"].get<double>() == doctest::Approx(10.1).epsilon(1e-3));
   std::vector<std::string> controllers;
   for (const auto& [key, value] : j.items())
     if (value.is_object() && value.contains("telemetry")) controllers.push_back(key);
   CHECK(controllers == std::vector<std::string>{"adaptive", "flow", "pid"});  // the JSON's keys, sorted
-  check_every_cycle_logged(read_log_channels(log_path), controllers, 10000);
+  check_every_cycle_logged(read_log_channels(log_path), controllers, 10100);
   for (const std::string& c : controllers) {
     INFO(c);
     CHECK(j[c]["telemetry"]["dropped"].get<long long>() == 0);

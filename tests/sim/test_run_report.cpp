@@ -29,7 +29,7 @@ bool have_matplotlib() { return std::system("/usr/bin/python3 -c 'import matplot
 
 // The dig pass at twice the speed (5 s), twice, with a 2 s return move between: two short cycles.
 fs::path repeated_dig() {
-  return edited_dig({{"duration: 10.0", "duration: 12.5"},
+  return edited_dig({{"duration: 10.1", "duration: 12.5"},
                      {"  swing: 0.0                   # rad, held", "  swing: 0.0\n  repeat: 2\n  return_time: 2.0"},
                      {"{t: 2.0,", "{t: 1.0,"},
                      {"{t: 3.5,", "{t: 1.75,"},
