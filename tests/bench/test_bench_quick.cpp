@@ -167,7 +167,8 @@ TEST_CASE("tools/excavator-bench --quick writes its json and csvs and recommends
   }
   CHECK(j["plant_step_us"].get<double>() > 0);
   CHECK(j["control_step_us"].get<double>() > 0);
-  CHECK(j["constraint_error"].get<double>() >= 0);
+  // Independent coordinates close the loops in closed form: the constraint error is round-off.
+  CHECK(j["constraint_error"].get<double>() < 1e-9);
   REQUIRE(j.contains("pareto"));
   REQUIRE(j["pareto"].is_array());
   CHECK(j["pareto"].size() >= 2);  // at least one point per scene
