@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include "harness/lockstep_run.hpp"
+#include "matplotlib_probe.hpp"
 #include "sim_runs.hpp"
 
 namespace fs = std::filesystem;
@@ -189,9 +190,8 @@ TEST_CASE("tools/excavator-sim run on the paper's force-actuated dig writes the 
 }
 
 TEST_CASE("tools/excavator-sim robustness: adaptive completes every variant and stays at least 2x better than PID on arm and bucket wherever PID completes, and PID stops only by the tracking-error fault") {
-  const bool have_matplotlib = std::system("/usr/bin/python3 -c 'import matplotlib' 2>/dev/null") == 0;
-  const Run r = run_sim("robustness " + kDig + " --quiet --json robust.json --out rob" +
-                        (have_matplotlib ? "" : " --no-plots"));
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
+  const Run r = run_sim("robustness " + kDig + " --quiet --json robust.json --out rob");
   INFO(r.err);
   REQUIRE(r.status == 0);
   const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "robust.json"));
@@ -224,13 +224,9 @@ TEST_CASE("tools/excavator-sim robustness: adaptive completes every variant and 
   const double nominal_bucket = rows[0]["adaptive"]["rms_error"]["bucket"].get<double>();
   for (std::size_t i = 1; i < rows.size(); ++i) CHECK(rows[i]["adaptive"]["rms_error"]["bucket"].get<double>() != nominal_bucket);
   CHECK(r.out.find("PID/adapt.") != std::string::npos);
-  // The same table next to its chart (1200 x 700 PNG; skipped only without matplotlib).
+  // The same table next to its chart (1200 x 700 PNG).
   CHECK(read_text_file(r.dir / "rob" / "robustness.json") == read_text_file(r.dir / "robust.json"));
-  if (have_matplotlib) {
-    CHECK(fs::file_size(r.dir / "rob" / "robustness.png") > 20000);
-  } else {
-    MESSAGE("matplotlib missing: robustness.png not checked");
-  }
+  CHECK(fs::file_size(r.dir / "rob" / "robustness.png") > 20000);
 }
 
 TEST_CASE("tools/excavator-sim: on the paper dig's lagging force actuators the firmware's lag compensation keeps the adaptive law's lead") {
@@ -568,9 +564,8 @@ TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the ca
   CHECK(j["missing"].empty());
   CHECK(j["failures_by_value"]["adaptive"]["machine.hydraulics.valve_time_constant"]["0.2"]["runs"].get<int>() == 2);
   CHECK(j["failures_by_value"]["adaptive"]["gain_scale"]["8"]["runs"].get<int>() == 1);
-  if (std::system("/usr/bin/python3 -c 'import matplotlib' 2>/dev/null") == 0) {
-    CHECK(fs::file_size(dir / "merged" / "stability.png") > 20000);
-  }
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
+  CHECK(fs::file_size(dir / "merged" / "stability.png") > 20000);
   // Variants with random draws: each variant gets `cases` draws, case = variant * cases + draw.
   std::ofstream(dir / "variants.yaml") << "sweep:\n  scenes: [" << kDig << "]\n  controllers: [pid]\n  duration: 0.2\n"
       "  cases: 2\n  perturbations: {model_mass: [-0.1, 0.1]}\n"

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "matplotlib_probe.hpp"
 #include "png_size.hpp"
 #include "sim_runs.hpp"
 
@@ -25,7 +26,6 @@ using exc::test::run_sim;
 
 namespace {
 
-bool have_matplotlib() { return std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0; }
 
 // The dig pass at twice the speed (5 s), twice, with a 2 s return move between: two short cycles.
 fs::path repeated_dig() {
@@ -70,10 +70,7 @@ std::map<std::string, double> run_python(const fs::path& dir, const std::string&
 }  // namespace
 
 TEST_CASE("tools/excavator-sim report of a repeated dig: each controller's per-cycle table (time, RMS and worst error of all four joints, soil force, estimates) and chart, what they show in words, and the task's end time") {
-  if (!have_matplotlib()) {
-    MESSAGE("SKIPPED: matplotlib is missing (Debian package python3-matplotlib)");
-    return;
-  }
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
   const fs::path scene = repeated_dig();
   const Run r = run_sim("run " + scene.string() + " --controller pid,adaptive --quiet --out out");
   INFO(r.err);
@@ -143,10 +140,7 @@ TEST_CASE("tools/excavator-sim report of a repeated dig: each controller's per-c
 }
 
 TEST_CASE("tools/plot-run: before tracking starts the desired trajectory is a gap (NaN), not zero, in every row and in a bucketed view's envelope") {
-  if (!have_matplotlib()) {
-    MESSAGE("SKIPPED: matplotlib is missing (Debian package python3-matplotlib)");
-    return;
-  }
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
   const Run r = run_sim("run " + exc::test::kDig + " --duration 3 --quiet --no-report --out out");
   REQUIRE(r.status == 0);
   const std::string log = (r.dir / "out" / "run.lcm").string();

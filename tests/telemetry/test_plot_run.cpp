@@ -18,6 +18,7 @@
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/machine_state_t.hpp"
 #include "exlcm/timing_t.hpp"
+#include "matplotlib_probe.hpp"
 #include "png_size.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
@@ -67,10 +68,7 @@ void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale) {
 }  // namespace
 
 TEST_CASE("tools/plot-run draws every figure and the report from a small recorded log") {
-  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) {
-    MESSAGE("SKIPPED: matplotlib is missing (Debian package python3-matplotlib)");
-    return;
-  }
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
   const fs::path dir = fs::temp_directory_path() / ("exc-plot-run-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
