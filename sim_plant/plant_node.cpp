@@ -165,7 +165,8 @@ void PlantNode::publish_counters() {
 }
 
 void PlantNode::set_fault(const InjectedFault& fault) {
-  if (fault_.kind == InjectedFault::Kind::valve_stuck) plant_.release_spool();
+  if (fault_.kind == InjectedFault::Kind::valve_stuck || fault_.kind == InjectedFault::Kind::actuator_jam)
+    plant_.release_spool();  // a spool held by the fault that ends (none on a force-actuated plant)
   fault_ = fault;
   fault_started_ = false;
   // A stuck spool is the circuit's own state: no command moves it (hydraulic plants; the others have
@@ -181,18 +182,13 @@ void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
     actuator.pilot_b[j] *= 1 - fault_.magnitude;
   } else if (fault_.kind == InjectedFault::Kind::actuator_jam) {
     // A stuck actuator keeps what it applied when it stuck, whatever is commanded: a force actuator
-    // its effort, a valve its spool (its target held where the spool was, as an opening or pilots).
-    if (!fault_started_) {
-      jammed_effort_ = plant_.state().effort[j];
-      jammed_spool_ = plant_.state().spool[j];
-    }
+    // its effort; on the hydraulic machine its spool, through the circuit's own stuck-spool state (the
+    // valve_stuck fault's), so the safe state's centred valves do not move it either.
     if (actuator.mode == plant::ActuatorCommand::effort) {
+      if (!fault_started_) jammed_effort_ = plant_.state().effort[j];
       actuator.value[j] = jammed_effort_;
-    } else {
-      const double full_stroke = plant_.scene().machine.hydraulics.pilot_full_stroke;
-      actuator.value[j] = jammed_spool_;
-      actuator.pilot_a[j] = std::max(jammed_spool_, 0.0) * full_stroke;
-      actuator.pilot_b[j] = std::max(-jammed_spool_, 0.0) * full_stroke;
+    } else if (!fault_started_) {
+      plant_.stick_spool(j, plant_.state().spool[j]);
     }
   }
   if (fault_.kind == InjectedFault::Kind::actuator_loss || fault_.kind == InjectedFault::Kind::actuator_jam)

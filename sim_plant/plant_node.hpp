@@ -87,7 +87,6 @@ class PlantNode {
   bool fault_started_ = false;
   hal::SensorState frozen_;       // sensor_freeze: what the stuck sensor keeps reporting
   double jammed_effort_ = 0;      // actuator_jam: the effort the stuck actuator keeps applying
-  double jammed_spool_ = 0;       // actuator_jam on valve commands: where the stuck spool stays
   control::PerfCounter step_timing_{"plant_step", 1000.0};
 };
 
