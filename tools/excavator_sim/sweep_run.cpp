@@ -144,7 +144,8 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
   std::ofstream file(out);
   if (!file) throw std::runtime_error("cannot write " + out.string());
   // A fault the scenes cannot take (pump_loss without the hydraulic machine) before any run.
-  for (const std::string& scene : spec.scenes) check_faults_fit(spec.faults, cached_scene(scene));
+  if (!spec.faults.empty())
+    for (const std::string& scene : spec.scenes) check_faults_fit(spec.faults, cached_scene(scene));
   int done = 0;
   const int total = spec.total_cases();
   for (int id = shard; id < total; id += shards) {
