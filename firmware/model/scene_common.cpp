@@ -37,7 +37,7 @@ SceneCommon read_scene_common(settings::SectionReader& top, const settings::Docu
     terrain.number("height", c.terrain_height, {-20, 20}, "m", "flat ground at world z");
   }
   terrain.finish();
-  top.number("duration", c.duration, {1e-3, 28800}, "s", "how long the run lasts (up to a working shift)", Need::required);
+  top.number("duration", c.duration, kRunDurationBounds, "s", "how long the run lasts (up to a working shift)", Need::required);
   return c;
 }
 

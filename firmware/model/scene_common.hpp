@@ -18,6 +18,9 @@ inline const std::vector<std::string> kFirmwareSceneSections = {"controller", "t
 inline const std::vector<std::string> kPlantSceneSections = {"soil",       "initial_state", "actuators",
                                                              "integrator", "sensors",       "checks"};
 
+// A run's duration (s): the scene's `duration` and the programs' --duration overrides.
+inline constexpr settings::Bounds kRunDurationBounds{1e-3, 28800};
+
 struct SceneCommon {
   std::string name, description;
   std::string machine_file;  // absolute path of the machine file, empty for the built-in reference machine

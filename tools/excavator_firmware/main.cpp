@@ -5,6 +5,9 @@
 // deadlines of the controller's period instead, and a run that misses them says so.
 #include <CLI/CLI.hpp>
 
+#include "model/scene_common.hpp"
+#include "option_checks.hpp"
+
 #include <atomic>
 #include <csignal>
 #include <cstdio>
@@ -62,21 +65,22 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
   app.add_option("--controller", controller, exc::control::kControllerKinds.names() + " (default: the scene's controller.type, else adaptive)")
       ->check(CLI::IsMember(exc::control::kControllerKinds.name_list()));
-  app.add_option("--duration", duration, "seconds to run (default: the scene's duration)")->check(CLI::PositiveNumber);
+  app.add_option("--duration", duration, "seconds to run (default: the scene's duration)")
+      ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   app.add_option("--json", json_path, "write the run's summary (ok, tracking figures, timing, deadlines) here");
   app.add_option("--lcm", lcm_url, "publish telemetry to this LCM URL (default: none)");
   app.add_option("--sensor-timeout-ms", sensor_timeout_ms,
                  "how long a cycle waits for the plant's sensor set: lockstep default 250 ms; real time default "
                  "and upper bound: the cycle's deadline less 10 % of the period")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in({0.01, 600000}, "ms"));
   app.add_option("--startup-timeout", startup_s,
                  "how long the first cycle waits for the plant's first answer (s), in both modes")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in({0.001, 86400}, "s"));
   app.add_flag("--realtime", realtime, "run on absolute deadlines of controller.period instead of lockstep");
   app.add_option("--max-overrun-fraction", max_overrun_fraction,
                  "real time: the run fails when its late wake-ups and skipped periods together exceed this "
                  "fraction of its cycles (default 0.01)")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(exc::cli::number_in({0, 1}, ""));
   app.add_flag("--print-config", print_config,
                "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
   CLI11_PARSE(app, argc, argv);

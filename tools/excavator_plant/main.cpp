@@ -3,6 +3,9 @@
 // was stopped) it holds the machine, says so on the bus (PLANT_EMERGENCY) and on stdout, and waits.
 #include <CLI/CLI.hpp>
 
+#include "model/scene_common.hpp"
+#include "option_checks.hpp"
+
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -29,12 +32,12 @@ int main(int argc, char** argv) {
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--scene", scene_path, "scene file")->required();
   app.add_option("--duration", duration, "exit after this many simulated seconds (default: the scene's)")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   app.add_option("--lcm", lcm_url, "publish the machine state (EXC_STATE) to this LCM URL");
   app.add_option("--silence-ms", silence_ms, "hold after this long without SYNC (wall clock)")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in({0.01, 600000}, "ms"));
   app.add_option("--startup-timeout", startup_s, "give up if no SYNC arrives within this many seconds")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in({0.001, 86400}, "s"));
   app.add_flag("--realtime", realtime,
                "the firmware runs --realtime: a full telemetry ring drops and counts messages instead of "
                "delaying the answer to SYNC past the firmware's deadline (default: wait, lose nothing)");

@@ -3,6 +3,9 @@
 // writes the summary (stdout and JSON), the CSVs, the plots and a report page.
 #include <CLI/CLI.hpp>
 
+#include "model/scene_common.hpp"
+#include "option_checks.hpp"
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -53,7 +56,7 @@ int main(int argc, char** argv) {
                   "LCM provider for telemetry (default: file://<out>/run.lcm?mode=w; "
                   "live: udpm://239.255.76.67:7667?ttl=0)");
   run->add_option("--duration", duration, "simulated seconds (default: the scene's duration)")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   run->add_flag("--no-report", no_report, "skip the CSV export, plots and report page");
   run->add_flag("--quiet", quiet, "no progress output");
 
@@ -73,7 +76,7 @@ int main(int argc, char** argv) {
       ->delimiter(',');
   robust->add_option("--json", robust_json, "write the table as JSON to this file");
   robust->add_option("--duration", robust_duration, "simulated seconds per run (default: the scene's duration)")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   robust->add_flag("--quiet", robust_quiet, "no progress output");
   robust->add_option("--out", robust_out,
                      "output directory for robustness.json and robustness.png (default: out/<scene name>-robustness)");
@@ -93,7 +96,7 @@ int main(int argc, char** argv) {
   paper->add_option("--out", paper_out,
                     "output directory (default: out/paper): report.md, free_motion/, dig/, hydraulic_dig/");
   paper->add_option("--duration", paper_duration, "simulated seconds of each scene (default: each scene's)")
-      ->check(CLI::PositiveNumber);
+      ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   paper->add_flag("--quiet", paper_quiet, "no progress output");
   auto* sweep = app.add_subcommand(
       "sweep", "run a sweep's cases (all, or one shard of them for GNU parallel or a Slurm job array) into a JSON-lines "

@@ -9,6 +9,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "option_checks.hpp"
+
 #include "control/task.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
@@ -110,7 +112,8 @@ int main(int argc, char** argv) {
   std::string scene_path = std::string(EXC_SOURCE_DIR_BENCH) + "/scenes/dig.yaml";
   int repeats = 3;
   app.add_option("--scene", scene_path, "the dig scene (default: scenes/dig.yaml)");
-  app.add_option("--repeats", repeats, "runs of the dig scene for the real-time factors (best is reported)");
+  app.add_option("--repeats", repeats, "runs of the dig scene for the real-time factors (best is reported)")
+      ->check(exc::cli::count_in(1, 1000));
   CLI11_PARSE(app, argc, argv);
 
   Scene base;

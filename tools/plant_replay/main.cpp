@@ -10,6 +10,9 @@
 
 #include <CLI/CLI.hpp>
 
+#include "model/scene_common.hpp"
+#include "option_checks.hpp"
+
 #include "sim_plant/plant.hpp"
 
 namespace {
@@ -72,7 +75,8 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_path, "scene file (YAML, docs/scene-schema.md)")->required();
   app.add_option("--efforts", efforts_path, "CSV of efforts t,swing,boom,arm,bucket")->required();
   app.add_option("--out", out_path, "output CSV (default: standard output)");
-  app.add_option("--duration", duration, "simulated seconds (default: the scene's duration)");
+  app.add_option("--duration", duration, "simulated seconds (default: the scene's duration)")
+      ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   CLI11_PARSE(app, argc, argv);
 
   std::vector<Row> rows;

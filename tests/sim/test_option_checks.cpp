@@ -1,0 +1,101 @@
+// The programs' numeric options: NaN, infinities, values out of range and text that is no number are
+// refused with the option's name and its allowed range, as the settings files word it; the bounds
+// themselves are accepted. Before these checks "--duration nan" ran the scene's own duration (a
+// silent default) and "--repeats 0" crashed the two benches.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "model/scene_common.hpp"
+#include "option_checks.hpp"
+#include "text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The message CLI11 gives for `args` on an app with one option checked by `check`; empty when accepted.
+std::string parse_error(const CLI::Validator& check, const std::string& value) {
+  CLI::App app{"t"};
+  std::string held;
+  app.add_option("--x", held)->check(check);
+  std::vector<std::string> args = {value, "--x"};  // CLI11 takes them in reverse
+  try {
+    app.parse(args);
+  } catch (const CLI::ParseError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+struct Exit {
+  int status = -1;
+  std::string err;
+};
+
+Exit run(const std::string& command) {
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("option_checks_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const std::string cmd = "cd '" + dir.string() + "' && " + command + " > out.txt 2> err.txt";
+  const int raw = std::system(cmd.c_str());
+  Exit e;
+  e.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  e.err = exc::test::read_text_file(dir / "err.txt");
+  return e;
+}
+
+}  // namespace
+
+TEST_CASE("tools/option checks refuse nan, inf, out-of-range and non-numbers, naming the range, and accept the bounds") {
+  const CLI::Validator duration = exc::cli::number_in(exc::kRunDurationBounds, "s");
+  for (const char* bad : {"nan", "NaN", "-nan", "inf", "-inf", "0", "-1", "28800.5", "1e9"}) {
+    INFO(bad);
+    CHECK(parse_error(duration, bad).find("--x: is " + std::string(bad) + " s; allowed range [0.001, 28800] s") !=
+          std::string::npos);
+  }
+  for (const char* text : {"abc", "", "1s", "0x"}) {
+    INFO(text);
+    CHECK(parse_error(duration, text).find("is not a number") != std::string::npos);
+  }
+  for (const char* good : {"0.001", "28800", "10.1", "1e3"}) {
+    INFO(good);
+    CHECK(parse_error(duration, good).empty());
+  }
+  const CLI::Validator repeats = exc::cli::count_in(1, 1000);
+  CHECK(parse_error(repeats, "0").find("is 0; allowed range [1, 1000]") != std::string::npos);
+  CHECK(parse_error(repeats, "1001").find("is 1001; allowed range [1, 1000]") != std::string::npos);
+  CHECK(parse_error(repeats, "2.5").find("'2.5' is not a whole number") != std::string::npos);
+  CHECK(parse_error(repeats, "99999999999999999999").find("is not a whole number") != std::string::npos);
+  CHECK(parse_error(repeats, "1").empty());
+  CHECK(parse_error(repeats, "1000").empty());
+}
+
+TEST_CASE("tools/every program refuses a NaN or zero count on its numeric options before it runs, exit non-zero") {
+  const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+  struct Case {
+    std::string command, message;
+  };
+  const std::vector<Case> cases = {
+      {std::string(EXC_SIM_TOOL) + " run " + dig + " --duration nan", "--duration: is nan s; allowed range [0.001, 28800] s"},
+      {std::string(EXC_SIM_TOOL) + " paper --duration -inf", "--duration: is -inf s; allowed range [0.001, 28800] s"},
+      {std::string(EXC_FIRMWARE_TOOL) + " --can vcan0 --scene " + dig + " --startup-timeout nan",
+       "--startup-timeout: is nan s; allowed range [0.001, 86400] s"},
+      {std::string(EXC_PLANT_TOOL) + " --can vcan0 --scene " + dig + " --silence-ms nan",
+       "--silence-ms: is nan ms; allowed range [0.01, 600000] ms"},
+      {std::string(EXC_PLANT_REPLAY_TOOL) + " --scene " + dig + " --efforts x.csv --duration nan",
+       "--duration: is nan s; allowed range [0.001, 28800] s"},
+      {std::string(EXC_LOOP_BENCH_TOOL) + " --repeats 0", "--repeats: is 0; allowed range [1, 1000]"},
+      {std::string(EXC_PLANT_BENCH_TOOL) + " --repeats 0", "--repeats: is 0; allowed range [1, 1000]"},
+  };
+  for (const Case& c : cases) {
+    INFO(c.command);
+    const Exit e = run(c.command);
+    CHECK(e.status > 0);
+    CHECK(e.status < 128);  // refused, not killed by a signal
+    CHECK(e.err.find(c.message) != std::string::npos);
+  }
+}
