@@ -1,0 +1,98 @@
+// excavator-loop-bench --split end to end: the program profiles itself under valgrind's callgrind and
+// prints one cycle's instructions by stage. The table must be consistent with its own nesting: no
+// stage above the stage that calls it, the parts of a node within the node, and the two nodes with
+// the SYNC stage accounting for most of the loop (the rest is the lockstep's own glue). A parse that
+// matched the wrong function, or a double count, breaks one of these.
+#include <doctest/doctest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+struct Row {
+  int depth = 0;
+  std::string stage;
+  double count = -1;  // instructions per cycle; -1 when inlined
+};
+}  // namespace
+
+TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the nodes account for the loop") {
+  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "bench" / ("loop_split_" + std::to_string(getpid()));
+  fs::create_directories(dir);
+  const std::string cmd = std::string(EXC_LOOP_BENCH_EXE) +
+                          " --split --split-duration 0.5 --duration 0.2 --repeats 1 --no-pin > '" +
+                          (dir / "out.txt").string() + "' 2> '" + (dir / "err.txt").string() + "'";
+  const int raw = std::system(cmd.c_str());
+  const std::string out = exc::test::read_text_file(dir / "out.txt");
+  INFO(out);
+  INFO(exc::test::read_text_file(dir / "err.txt"));
+  REQUIRE(WIFEXITED(raw));
+  REQUIRE(WEXITSTATUS(raw) == 0);  // valgrind is an install step (tools/install-deps test)
+  const std::size_t at = out.find("# Instructions per cycle by stage");
+  REQUIRE(at != std::string::npos);
+
+  std::vector<Row> rows;
+  std::istringstream lines(out.substr(at));
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.rfind("| ", 0) != 0 || line.rfind("| stage", 0) == 0) continue;
+    const std::size_t a = 2, b = line.find(" | ", a);
+    REQUIRE(b != std::string::npos);
+    std::string stage = line.substr(a, b - a);
+    Row r;
+    while (stage.rfind("  ", 0) == 0) {
+      stage.erase(0, 2);
+      ++r.depth;
+    }
+    r.stage = stage;
+    const std::string cell = line.substr(b + 3, line.find(" | ", b + 3) - (b + 3));
+    if (cell != "(inlined)") {
+      REQUIRE(cell.back() == 'k');
+      r.count = std::stod(cell.substr(0, cell.size() - 1)) * 1e3;
+    }
+    rows.push_back(r);
+  }
+  REQUIRE(rows.size() == 20);  // the stages the README's table names
+  REQUIRE(rows[0].stage.rfind("the loop", 0) == 0);
+  const double loop = rows[0].count;
+  REQUIRE(loop > 1e3);
+
+  // Nesting: each row's caller is the nearest row above it one level up; a stage costs no more than
+  // its caller (0.1k of rounding), and the parts of a caller add up to no more than it.
+  double node_sum = 0;
+  int nodes = 0;
+  for (std::size_t i = 1; i < rows.size(); ++i) {
+    if (rows[i].stage.rfind("across the nodes", 0) == 0 || rows[i].stage.rfind("telemetry thread", 0) == 0) {
+      if (rows[i].count >= 0 && rows[i].stage.rfind("across", 0) == 0) CHECK(rows[i].count <= loop);
+      continue;  // cross-cutting figures, not parts of one caller
+    }
+    if (rows[i].depth == 1 && rows[i].count >= 0) {
+      node_sum += rows[i].count;
+      ++nodes;
+    }
+    std::size_t parent = i;
+    while (parent > 0 && rows[--parent].depth != rows[i].depth - 1) {}
+    if (rows[i].count < 0 || rows[parent].count < 0) continue;
+    INFO(rows[i].stage << " under " << rows[parent].stage);
+    CHECK(rows[i].count <= rows[parent].count + 100);
+    double parts = 0;
+    for (std::size_t j = parent + 1; j < rows.size() && rows[j].depth > rows[parent].depth; ++j)
+      if (rows[j].depth == rows[parent].depth + 1 && rows[j].count > 0) parts += rows[j].count;
+    CHECK(parts <= rows[parent].count + 300);
+  }
+  if (nodes == 3) {  // all three calls of the loop kept as functions by the compiler
+    CHECK(node_sum <= loop + 300);
+    CHECK(node_sum >= 0.85 * loop);
+  }
+  fs::remove_all(dir);
+}
