@@ -14,6 +14,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -346,5 +347,64 @@ TEST_CASE("telemetry/export writes a long channel's bucketed view (min, max, fir
       CHECK(cell(detail, 5000, "utime") == 9999000);
     }
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("tools/excavator-log info gives each channel's rate per second of the run, not of the wall clock") {
+  // A simulated run logs far faster than real time: 101 messages 1 ms apart in the run, all written
+  // within 2 ms of wall time, must read 1000 Hz (the wall clock would say 50 kHz).
+  const fs::path dir = fs::temp_directory_path() / ("exc-info-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log_path = dir / "run.lcm";
+  {
+    lcm::LogFile log(log_path.string(), "w");
+    REQUIRE(log.good());
+    std::vector<std::uint8_t> buffer;
+    for (int k = 0; k <= 100; ++k) {
+      exlcm::timing_t msg{};
+      msg.utime = 50000 + 1000 * k;  // us since the run started
+      msg.seq = k;
+      buffer.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+      REQUIRE(msg.encode(buffer.data(), 0, static_cast<int>(buffer.size())) >= 0);
+      lcm::LogEvent event{};
+      event.timestamp = 1700000000000000 + 20 * k;
+      event.channel = "EXC_TIMING/pid";
+      event.datalen = static_cast<std::int32_t>(buffer.size());
+      event.data = buffer.data();
+      REQUIRE(log.writeEvent(&event) == 0);
+    }
+    std::uint8_t junk[12] = {1, 2, 3};
+    lcm::LogEvent event{};
+    event.timestamp = 1700000000003000;
+    event.channel = "OTHER";
+    event.datalen = sizeof junk;
+    event.data = junk;
+    REQUIRE(log.writeEvent(&event) == 0);
+  }
+  const std::string cmd = std::string(EXC_EXCAVATOR_LOG) + " info '" + log_path.string() + "' > '" +
+                          (dir / "out.txt").string() + "'";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  std::ifstream in(dir / "out.txt");
+  const std::string out((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(out);
+  CHECK(out.find("102 events, run time 0.050 to 0.150 s (the messages' utime), logged in 0.003 s of wall time") !=
+        std::string::npos);
+  std::istringstream lines(out);
+  std::string line, timing, other;
+  while (std::getline(lines, line)) {
+    if (line.rfind("EXC_TIMING/pid", 0) == 0) timing = line;
+    if (line.rfind("OTHER", 0) == 0) other = line;
+  }
+  std::istringstream t(timing);
+  std::string channel, type, messages, rate;
+  t >> channel >> type >> messages >> rate;
+  CHECK(type == "timing_t");
+  CHECK(messages == "101");
+  CHECK(rate == "1000.0");
+  std::istringstream o(other);
+  o >> channel >> type >> messages >> rate;
+  CHECK(type == "unknown");
+  CHECK(rate == "-");  // no time of its own to count by
   fs::remove_all(dir);
 }

@@ -5,6 +5,7 @@
 //   excavator-log report run.lcm --out DIR [--summary JSON]  CSV, then plot-run's figures and report
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -15,14 +16,27 @@
 namespace {
 
 void print_summary(const std::string& log_path, const exc::log::LogSummary& summary) {
-  std::printf("%s: %llu events over %.3f s\n", log_path.c_str(),
-              static_cast<unsigned long long>(summary.events), summary.duration_s());
-  std::printf("%-32s %-20s %10s %10s %10s\n", "channel", "type", "messages", "rate_hz",
-              "undecodable");
+  // Rates are per second of the run (the messages' own utime): a simulated run is logged far faster
+  // than real time, so the log's wall-clock stamps would give a 1 kHz channel 100 kHz or more.
+  bool any_decoded = false;
+  std::int64_t run_first = 0, run_last = 0;
   for (const auto& [name, channel] : summary.channels) {
-    const double span = (channel.last_log_utime - channel.first_log_utime) * 1e-6;
-    const double rate = span > 0 ? (channel.messages - 1) / span : 0.0;
-    std::printf("%-32s %-20s %10llu %10.1f %10llu\n", name.c_str(), channel.type_name.c_str(),
+    if (channel.messages == channel.undecodable || channel.type_name == "unknown") continue;
+    run_first = any_decoded ? std::min(run_first, channel.min_utime) : channel.min_utime;
+    run_last = any_decoded ? std::max(run_last, channel.max_utime) : channel.max_utime;
+    any_decoded = true;
+  }
+  std::printf("%s: %llu events", log_path.c_str(), static_cast<unsigned long long>(summary.events));
+  if (any_decoded) std::printf(", run time %.3f to %.3f s (the messages' utime)", run_first * 1e-6, run_last * 1e-6);
+  std::printf(", logged in %.3f s of wall time\n", summary.duration_s());
+  std::printf("%-32s %-20s %10s %10s %10s\n", "channel", "type", "messages", "rate_hz", "undecodable");
+  for (const auto& [name, channel] : summary.channels) {
+    const std::uint64_t decoded = channel.messages - channel.undecodable;
+    const double span = (channel.max_utime - channel.min_utime) * 1e-6;
+    char rate[32] = "-";  // no decoded message with a time, or all at one instant
+    if (channel.type_name != "unknown" && decoded > 1 && span > 0)
+      std::snprintf(rate, sizeof rate, "%.1f", static_cast<double>(decoded - 1) / span);
+    std::printf("%-32s %-20s %10llu %10s %10llu\n", name.c_str(), channel.type_name.c_str(),
                 static_cast<unsigned long long>(channel.messages), rate,
                 static_cast<unsigned long long>(channel.undecodable));
   }
