@@ -5,13 +5,10 @@
 # failed shard alone and the merged table equals the single process's byte for byte.
 #   parallel_sweep.sh EXC_SIM SPEC_TEMPLATE SCENE WORK
 set -euo pipefail
-sim=$1 template=$2 scene=$3 work=$4
 here=$(cd "$(dirname "$0")" && pwd)
+. "$here/sweep_test.sh"
+sweep_test_setup "$@"
 script=$here/../../tools/sweep/parallel-sweep
-rm -rf "$work"; mkdir -p "$work"
-sed -e 's/cases: 1000/cases: 8/' -e "s|../scenes/dig.yaml|$scene|" "$template" > "$work/spec.yaml"
-echo "  duration: 0.3" >> "$work/spec.yaml"
-fail() { echo "FAIL: $*" >&2; exit 1; }
 "$sim" sweep "$work/spec.yaml" --quiet --out "$work/one.jsonl"
 "$sim" sweep-merge "$work/spec.yaml" "$work/one.jsonl" --out "$work/single"
 # A program that dies on shard 1 of 4 before writing anything (as a lost host or a killed task does).

@@ -3,11 +3,9 @@
 # as a 4-task job array (tools/sweep/slurm-sweep.sbatch) must merge to the same table, case for case.
 #   slurm_sweep.sh EXC_SIM SPEC_TEMPLATE SCENE WORK
 set -euo pipefail
-sim=$1 template=$2 scene=$3 work=$4
 here=$(cd "$(dirname "$0")" && pwd)
-rm -rf "$work"; mkdir -p "$work"
-sed -e 's/cases: 1000/cases: 8/' -e "s|../scenes/dig.yaml|$scene|" "$template" > "$work/spec.yaml"
-echo "  duration: 0.3" >> "$work/spec.yaml"
+. "$here/sweep_test.sh"
+sweep_test_setup "$@"
 cluster=$work/cluster
 trap '"$here/slurm_cluster.sh" stop "$cluster"' EXIT
 "$here/slurm_cluster.sh" start "$cluster"

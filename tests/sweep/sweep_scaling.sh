@@ -4,13 +4,10 @@
 # exit 0; a bad count is refused with exit 2. No time is asserted (the figures are the README's job).
 #   sweep_scaling.sh EXC_SIM SPEC_TEMPLATE SCENE WORK
 set -euo pipefail
-sim=$1 template=$2 scene=$3 work=$4
 here=$(cd "$(dirname "$0")" && pwd)
+. "$here/sweep_test.sh"
+sweep_test_setup "$@"
 script=$here/../../tools/sweep/sweep-scaling
-rm -rf "$work"; mkdir -p "$work"
-sed -e 's/cases: 1000/cases: 8/' -e "s|../scenes/dig.yaml|$scene|" "$template" > "$work/spec.yaml"
-echo "  duration: 0.3" >> "$work/spec.yaml"
-fail() { echo "FAIL: $*" >&2; exit 1; }
 EXC_SIM=$sim "$script" "$work/spec.yaml" 4 "$work/out" 1 2 | tee "$work/lines.txt"
 [ "$(grep -c '^sweep-scaling: [12] worker(s): [0-9.]* s wall, speed-up [0-9.]*x (same table)$' "$work/lines.txt")" -eq 2 ] ||
   fail "want two lines, one per worker count, each with its time, speed-up and 'same table'"
