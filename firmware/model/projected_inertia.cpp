@@ -51,18 +51,28 @@ void projected_mass_matrix(const Model& model, const Workspace& ws, const Mat12x
         Jf[i](row, k - 1) += sign * Psi(i, k);
       }
     }
-    // J^T G J: the in-plane block of G for the cylinder columns; the swing column in full.
-    Eigen::Matrix3d GJf;
-    GJf.noalias() = model.inertia_in_plane[i].lazyProduct(Jf[i]);
-    M_a.bottomRightCorner<3, 3>().noalias() += Jf[i].transpose().lazyProduct(GJf);
+    // J^T G J: the in-plane block of G for the cylinder columns; the swing column in full. The
+    // in-plane block of a spatial inertia about the origin is [[a, b, c], [b, m, 0], [c, 0, m]]
+    // (spatial_inertia), and J^T G J is symmetric: its upper triangle only.
+    const Mat3& G = model.inertia_in_plane[i];
+    const double a = G(0, 0), b = G(0, 1), cz = G(0, 2), m = G(1, 1);
+    const Mat3& J = Jf[i];
+    Mat3 GJ;
+    for (int k = 0; k < 3; ++k) {
+      GJ(0, k) = a * J(0, k) + b * J(1, k) + cz * J(2, k);
+      GJ(1, k) = b * J(0, k) + m * J(1, k);
+      GJ(2, k) = cz * J(0, k) + m * J(2, k);
+    }
+    for (int k = 0; k < 3; ++k)
+      for (int l = k; l < 3; ++l) M_a(1 + k, 1 + l) += J.col(k).dot(GJ.col(l));
     const BodyInertia& body = model.machine.bodies[i];
     const Wrench GJ0 = inertia_apply(body.mass, body.com, body.inertia, J0[i]);
     M_a(0, 0) += J0[i].dot(GJ0);
     const Vec3 GJ0_in(GJ0[1], GJ0[3], GJ0[5]);
-    M_a.block<1, 3>(0, 1).noalias() += GJ0_in.transpose().lazyProduct(Jf[i]);
+    M_a.block<1, 3>(0, 1).noalias() += GJ0_in.transpose().lazyProduct(J);
   }
-  M_a.block<3, 1>(1, 0) = M_a.block<1, 3>(0, 1).transpose();
-  M_a.bottomRightCorner<3, 3>() = (0.5 * (M_a.bottomRightCorner<3, 3>() + M_a.bottomRightCorner<3, 3>().transpose())).eval();
+  for (int k = 0; k < 4; ++k)
+    for (int l = k + 1; l < 4; ++l) M_a(l, k) = M_a(k, l);
 }
 
 }  // namespace exc
