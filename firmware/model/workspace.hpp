@@ -22,6 +22,8 @@ struct Workspace {
   std::array<Twist, kNumJoints> V, Vd;
   // f_parent of the front links is a pin rotation about -y by q_i (cosine, sine in joint_cos,
   // joint_sin) and f_parent's offset: set by tree_kinematics_from_front, cleared by tree_kinematics.
+  // tree_kinematics_from_front writes only those entries of f_parent: the others are the constant
+  // 0 and 1 of a front joint, from construction (the home translations) or tree_kinematics.
   bool pin_valid = false;
   std::array<Wrench, kNumJoints> F;
   Vec12 tau_r = Vec12::Zero();
