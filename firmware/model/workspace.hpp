@@ -42,9 +42,10 @@ struct Workspace {
   Mat2x4 J_t = Mat2x4::Zero();     // d rho / d q_a
   Vec3 tip_world = Vec3::Zero();
 
-  // Planar front kinematics in the swing plane (front_kinematics.hpp): absolute link angles,
-  // angular rates, origins and their derivatives, per tree joint (entry 0, the swing, stays zero).
-  std::array<double, kNumJoints> phi{}, cos_phi{}, sin_phi{}, omega{}, alpha{};
+  // Planar front kinematics in the swing plane (front_kinematics.hpp): cosine and sine of the
+  // absolute link angles phi, angular rates, origins and their derivatives, per tree joint (entry 0,
+  // the swing, stays zero).
+  std::array<double, kNumJoints> cos_phi{}, sin_phi{}, omega{}, alpha{};
   // cos q_i and sin q_i of each front pin (1 and 0 for a slide), from the loop closure's vectors or
   // from front_positions.
   std::array<double, kNumJoints> joint_cos{}, joint_sin{};
