@@ -53,9 +53,16 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   Vec8 gamma_p;
   times_block_diagonal(ws.Hp_inv, H_a, dqp_dqa);  // H_p^-1 H_a; Psi takes its negative
   ws.Psi.setZero();
-  for (int k = 0; k < kNumActive; ++k) ws.Psi(kActiveJoints[k], k) = 1.0;
-  for (int k = 0; k < kNumPassive; ++k) ws.Psi.row(kPassiveJoints[k]) = -dqp_dqa.row(k);
-  ws.qd.noalias() = ws.Psi.lazyProduct(qd_a);
+  for (int k = 0; k < kNumActive; ++k) {
+    ws.Psi(kActiveJoints[k], k) = 1.0;
+    ws.qd[kActiveJoints[k]] = qd_a[k];
+  }
+  Vec8 qd_p;  // Psi's passive rows times qd_a, without its unit and zero rows
+  qd_p.noalias() = dqp_dqa.lazyProduct(qd_a);
+  for (int k = 0; k < kNumPassive; ++k) {
+    ws.Psi.row(kPassiveJoints[k]) = -dqp_dqa.row(k);
+    ws.qd[kPassiveJoints[k]] = -qd_p[k];
+  }
 
   // Acceleration bias: with qdd = 0 the cut pins accelerate apart by Hd qd; gamma = (0; -H_p^-1 Hd qd).
   front_rates(model, ws.qd, Vec12::Zero(), ws);
@@ -63,8 +70,9 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   times_block_diagonal(ws.Hp_inv, ws.Hd_qd, gamma_p);
   ws.gamma.setZero();
   for (int k = 0; k < kNumPassive; ++k) ws.gamma[kPassiveJoints[k]] = -gamma_p[k];
-  // A NaN or Inf anywhere makes the sum of magnitudes non-finite: one test instead of 60.
-  if (!std::isfinite(ws.Psi.cwiseAbs().sum() + ws.gamma.cwiseAbs().sum())) {
+  // A NaN or Inf anywhere makes the sum of magnitudes non-finite: one test instead of 40 (Psi's
+  // and gamma's other entries are 0 and 1).
+  if (!std::isfinite(dqp_dqa.cwiseAbs().sum() + gamma_p.cwiseAbs().sum())) {
     ws.report = ModelReport{ModelStatus::singular, -1, 0};
     return ws.report;
   }
@@ -73,10 +81,14 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
   Vec2 tip;
   front_tip(model, ws, tip, ws.J_tip_tree, ws.tip_acc_tree);
   ws.rho = tip + Vec2(0.0, model.machine.swing_height);
-  ws.J_t.noalias() = ws.J_tip_tree.lazyProduct(ws.Psi);
-  ws.rhod.noalias() = ws.J_t.lazyProduct(qd_a);
+  // J_tip_tree is zero off the bucket's path to the swing: J_t and the bias from its columns only.
+  ws.J_t.setZero();
   ws.rhodd_bias = ws.tip_acc_tree;
-  ws.rhodd_bias.noalias() += ws.J_tip_tree.lazyProduct(ws.gamma);
+  for (int j = kBucket; j > 0; j = model.parent[j]) {
+    ws.J_t.noalias() += ws.J_tip_tree.col(j) * ws.Psi.row(j);
+    ws.rhodd_bias += ws.J_tip_tree.col(j) * ws.gamma[j];
+  }
+  ws.rhod.noalias() = ws.J_t.lazyProduct(qd_a);
 
   // Tree poses and twists for Newton-Euler (also fills ws.tip_world), from the planar pass above.
   tree_kinematics_from_front(model, ws, ws.qd);

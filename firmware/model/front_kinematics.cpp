@@ -30,7 +30,6 @@ void front_positions(const Model& model, const Vec12& q, Workspace& ws) {
 
 void front_positions_from_joint_trig(const Model& model, const Vec12& q, Workspace& ws) {
   ws.pin_valid = false;  // f_parent no longer matches joint_cos, joint_sin
-  ws.phi[0] = 0;
   ws.cos_phi[0] = 1;
   ws.sin_phi[0] = 0;
   ws.origin[0].setZero();
@@ -38,14 +37,12 @@ void front_positions_from_joint_trig(const Model& model, const Vec12& q, Workspa
     const int p = model.parent[i];
     const Vec2 offset = planar(model.home[i].topRightCorner<3, 1>());
     if (model.prismatic[i]) {
-      ws.phi[i] = ws.phi[p];
       ws.cos_phi[i] = ws.cos_phi[p];
       ws.sin_phi[i] = ws.sin_phi[p];
       ws.origin[i] = ws.origin[p] + rotate_by(ws, p, offset + Vec2(q[i], 0.0));
     } else {
       // phi_i = phi_p + q_i by the angle-sum formulas: no trig per link.
       const double c = ws.joint_cos[i], s = ws.joint_sin[i];
-      ws.phi[i] = ws.phi[p] + q[i];
       ws.cos_phi[i] = ws.cos_phi[p] * c - ws.sin_phi[p] * s;
       ws.sin_phi[i] = ws.sin_phi[p] * c + ws.cos_phi[p] * s;
       ws.origin[i] = ws.origin[p] + rotate_by(ws, p, offset);

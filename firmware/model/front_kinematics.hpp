@@ -8,7 +8,7 @@
 namespace exc {
 
 // Angles and origins of every link from q (positions only); fills ws.joint_cos,
-// ws.joint_sin, ws.phi, ws.cos_phi, ws.sin_phi, ws.origin.
+// ws.joint_sin, ws.cos_phi, ws.sin_phi, ws.origin.
 void front_positions(const Model& model, const Vec12& q, Workspace& ws);
 
 // The same with ws.joint_cos, ws.joint_sin already set for q (the closed-form loop closure has

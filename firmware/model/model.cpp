@@ -91,7 +91,6 @@ Workspace::Workspace(const Model& model) {
     Vd[i].setZero();
     F[i].setZero();
   }
-  phi.fill(0.0);
   cos_phi.fill(1.0);
   sin_phi.fill(0.0);
   omega.fill(0.0);

@@ -46,11 +46,11 @@ inline void set_pose(SE3& T, const Vec3& x, const Vec3& y, const Vec3& z, const 
 }
 
 
-// Out-of-plane offset of each front origin (pin rotations and slides keep it).
-std::array<double, kNumJoints> front_y_offsets(const Model& model) {
-  std::array<double, kNumJoints> y{};
-  for (int i = 1; i < kNumJoints; ++i)
-    y[i] = (model.parent[i] > 0 ? y[model.parent[i]] : 0.0) + model.home[i](1, 3);
+// Out-of-plane offset of a front origin (pin rotations and slides keep it): the sum of the homes'
+// y on its path to the swing.
+double front_y_offset(const Model& model, int i) {
+  double y = 0.0;
+  for (; i > 0; i = model.parent[i]) y += model.home[i](1, 3);
   return y;
 }
 
@@ -91,40 +91,45 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
   ws.V[0] = model.screw[0] * qd[0];
   for (int i = 1; i < kNumJoints; ++i) {
     const int p = model.parent[i];
-    const Vec3 home = model.home[i].topRightCorner<3, 1>();
-    // Relative motion: a pin rotation about -y by q_i (cos, sin from the front pass) or a slide.
-    SE3& f = ws.f_parent[i];
+    // Relative motion: a pin rotation about -y by q_i (cos, sin from the front pass) or a slide (cos
+    // 1, sin 0). Only the rotation's cos, sin and the offset are written: f_parent's other entries
+    // are those of every front joint (0 and 1, set from the home translations by the Workspace and
+    // by tree_kinematics).
     const double c = ws.joint_cos[i], s = ws.joint_sin[i];
-    const Vec3 offset = home + Vec3(model.prismatic[i] ? ws.q[i] : 0.0, 0, 0);
-    if (model.prismatic[i])
-      set_pose(f, Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ(), offset);
-    else
-      set_pose(f, Vec3(c, 0, s), Vec3::UnitY(), Vec3(-s, 0, c), offset);
-    ws.V[i] = Ad_inv_apply_pin(c, s, offset, ws.V[p]);
+    double* f = ws.f_parent[i].data();  // column-major
+    f[0] = c, f[2] = s, f[8] = -s, f[10] = c;
+    f[12] = model.home[i](0, 3) + (model.prismatic[i] ? ws.q[i] : 0.0);
+    f[13] = model.home[i](1, 3);
+    f[14] = model.home[i](2, 3);
+    ws.V[i] = Ad_inv_apply_pin(c, s, ws.f_parent[i].topRightCorner<3, 1>(), ws.V[p]);
     ws.V[i][model.prismatic[i] ? 3 : 1] += model.prismatic[i] ? qd[i] : -qd[i];  // + S_i qd_i
   }
   ws.pin_valid = true;
   ws.front_world_poses_valid = false;
   SE3 X_bucket;
-  set_front_world_pose(ws, kBucket, front_y_offsets(model)[kBucket], X_bucket);
+  set_front_world_pose(ws, kBucket, front_y_offset(model, kBucket), X_bucket);
   ws.tip_world = X_bucket.topLeftCorner<3, 3>() * model.tip_in_bucket + X_bucket.topRightCorner<3, 1>();
 }
 
 void tree_world_poses(const Model& model, Workspace& ws) {
   if (ws.front_world_poses_valid) return;
-  const std::array<double, kNumJoints> y = front_y_offsets(model);
-  for (int i = 1; i < kNumJoints; ++i) set_front_world_pose(ws, i, y[i], ws.X_Wi[i]);
+  std::array<double, kNumJoints> y{};  // front_y_offset of each link, parents first
+  for (int i = 1; i < kNumJoints; ++i) {
+    y[i] = (model.parent[i] > 0 ? y[model.parent[i]] : 0.0) + model.home[i](1, 3);
+    set_front_world_pose(ws, i, y[i], ws.X_Wi[i]);
+  }
   ws.front_world_poses_valid = true;
 }
 
 void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, const Vec2& f_soil,
                            Vec12& tau) {
   // Forward: accelerations, with gravity as the base acceleration Vd_0 (model.md s.3).
+  const bool pin = ws.pin_valid;  // read once: the passes below branch on it per link
   for (int i = 0; i < kNumJoints; ++i) {
     const int p = model.parent[i];
     const Twist& V = ws.V[i];
     Twist& Vd = ws.Vd[i];
-    if (ws.pin_valid && i > 0) {
+    if (pin && i > 0) {
       // The front's screws are known (build_model checked them): a pin S = (-e_y, 0) or a slide
       // S = (0, e_x), so S qdd and ad_V (S qd) are a few products.
       Vd = Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.Vd[p]);
@@ -155,7 +160,7 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
   // (paper eq. 2). f_soil is in the swing plane of the swing frame.
   if (f_soil.x() != 0.0 || f_soil.y() != 0.0) {
     Vec3 f_b;  // in the bucket frame
-    if (ws.pin_valid) {
+    if (pin) {
       // The bucket is turned from the swing frame about -y by its absolute angle in the plane.
       const double c = ws.cos_phi[kBucket], s = ws.sin_phi[kBucket];
       f_b << c * f_soil.x() + s * f_soil.y(), 0.0, c * f_soil.y() - s * f_soil.x();
@@ -167,12 +172,17 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
     ws.F[kBucket].head<3>() += model.tip_in_bucket.cross(f_b);
     ws.F[kBucket].tail<3>() += f_b;
   }
-  // Backward: children have higher indices than their parents (Table 1 order).
+  // Backward: children have higher indices than their parents (Table 1 order). eq. 1: tau_i =
+  // S_i^T F_i; for the front's known screws (pin) one entry of F_i.
   for (int i = kNumJoints - 1; i >= 0; --i) {
     const int p = model.parent[i];
-    // eq. 1: tau_i = S_i^T F_i; for the front's known screws one entry of F_i.
-    tau[i] = ws.pin_valid && p >= 0 ? (model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1]) : model.screw[i].dot(ws.F[i]);
-    if (p >= 0) ws.F[p] += to_parent(ws, i, ws.F[i]);
+    if (pin && p >= 0) {
+      tau[i] = model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1];
+      ws.F[p] += Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.F[i]);
+    } else {
+      tau[i] = model.screw[i].dot(ws.F[i]);
+      if (p >= 0) ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
+    }
   }
   ws.tau_r = tau;
 }

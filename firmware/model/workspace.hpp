@@ -22,6 +22,8 @@ struct Workspace {
   std::array<Twist, kNumJoints> V, Vd;
   // f_parent of the front links is a pin rotation about -y by q_i (cosine, sine in joint_cos,
   // joint_sin) and f_parent's offset: set by tree_kinematics_from_front, cleared by tree_kinematics.
+  // tree_kinematics_from_front writes only those entries of f_parent: the others are the constant
+  // 0 and 1 of a front joint, from construction (the home translations) or tree_kinematics.
   bool pin_valid = false;
   std::array<Wrench, kNumJoints> F;
   Vec12 tau_r = Vec12::Zero();
@@ -40,9 +42,10 @@ struct Workspace {
   Mat2x4 J_t = Mat2x4::Zero();     // d rho / d q_a
   Vec3 tip_world = Vec3::Zero();
 
-  // Planar front kinematics in the swing plane (front_kinematics.hpp): absolute link angles,
-  // angular rates, origins and their derivatives, per tree joint (entry 0, the swing, stays zero).
-  std::array<double, kNumJoints> phi{}, cos_phi{}, sin_phi{}, omega{}, alpha{};
+  // Planar front kinematics in the swing plane (front_kinematics.hpp): cosine and sine of the
+  // absolute link angles phi, angular rates, origins and their derivatives, per tree joint (entry 0,
+  // the swing, stays zero).
+  std::array<double, kNumJoints> cos_phi{}, sin_phi{}, omega{}, alpha{};
   // cos q_i and sin q_i of each front pin (1 and 0 for a slide), from the loop closure's vectors or
   // from front_positions.
   std::array<double, kNumJoints> joint_cos{}, joint_sin{};
