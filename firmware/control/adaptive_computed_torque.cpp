@@ -79,7 +79,9 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
     Vec4 BtPx = P_.bottomRows<4>() * z;                     // B^T P x (or z)
     for (int j = 0; j < 4; ++j)
       if ((off_dynamics >> j) & 1u) BtPx[j] = 0;            // its error is the limit's, not the soil's
-    const Vec6 theta_dot = -config_.adaptation_rate.cwiseProduct(Phi.transpose() * BtPx);
+    Vec6 theta_dot = -config_.adaptation_rate.cwiseProduct(Phi.transpose() * BtPx);
+    if (config_.adaptation_leakage_time > 0)  // sigma-modification: the drift over passes bounded
+      theta_dot -= (theta_hat_ - config_.theta_initial) / config_.adaptation_leakage_time;
     theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
   }
   return out;

@@ -31,6 +31,10 @@ void check_cross_fields(const SectionReader& r, const ControllerConfig& c) {
       r.fail("ki", j, format_number(c.gains.ki[j]) + " makes the PID loop unstable: must be below kv*kp = " +
                           format_number(c.gains.kv[j] * c.gains.kp[j]));
   }
+  // The leak is integrated by explicit Euler at the control period: below 10 periods it overshoots.
+  if (c.adaptation_leakage_time > 0 && c.adaptation_leakage_time < 10 * c.period)
+    r.fail("adaptation_leakage_time", format_number(c.adaptation_leakage_time) + " s must be 0 (no leakage) or at least 10 "
+                                      "control periods = " + format_number(10 * c.period) + " s");
   // A target slower than the lag would lag more, not less; a lead gain above 20 amplifies the
   // measurement noise that reaches the command twentyfold.
   if (c.actuator_lag > 0 && !(c.actuator_lag_target <= c.actuator_lag && c.actuator_lag <= 20 * c.actuator_lag_target))
@@ -66,6 +70,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.numbers("theta_min", c.theta_min, kTheta, "", "lower bounds of the soil parameters (projection)");
   r.numbers("theta_max", c.theta_max, kTheta, "", "upper bounds of the soil parameters");
   r.numbers("theta_initial", c.theta_initial, kTheta, "", "initial soil estimate");
+  r.number("adaptation_leakage_time", c.adaptation_leakage_time, {0, 1e6}, "s",
+           "leakage of the update toward theta_initial while it runs (beyond the paper; 0: none, eq. 27)");
   r.choice("regressor_acceleration", c.regressor_acceleration, kRegressorAccelerations,
            "the joint acceleration in the regressor's M_t term");
   SectionReader sl = r.section("slotine_li", "the Slotine-Li law's gains");

@@ -54,6 +54,10 @@ struct ControllerConfig {
   Vec6 theta_min = (Vec6() << 50, 1e3, 1e4, 50, 1e3, 1e4).finished();
   Vec6 theta_max = (Vec6() << 500, 3e4, 1e6, 500, 3e4, 1e6).finished();
   Vec6 theta_initial = (Vec6() << 100, 2e3, 3e4, 100, 2e3, 3e4).finished();
+  // Beyond the paper: leakage (sigma-modification) in the update, Theta_hat_dot += -(Theta_hat -
+  // theta_initial) / adaptation_leakage_time while the update runs. Over many passes the published
+  // update drifts (the force loop's lag reads as soil); the leak bounds it. 0: eq. 27 as published.
+  double adaptation_leakage_time = 0;  // s
   RegressorAcceleration regressor_acceleration = RegressorAcceleration::filtered;
   // Beyond the paper: integral action in the adaptive law (K_i and integral_limit as the PID's), with
   // Q of the integral states (z = [int e; e; ed] order: these first, then lyapunov_q).

@@ -254,3 +254,49 @@ TEST_CASE("firmware/adaptive with integral action removes the steady error of a 
     CHECK(final_error[1][j] < 1e-3 * final_error[0][j]);  // and integral action removes it
   }
 }
+
+TEST_CASE("firmware/adaptive: the update's leakage pulls Theta_hat to theta_initial at its time constant, and only while it adapts") {
+  // In the soil with zero tracking error the published update is zero: what moves Theta_hat is the
+  // leak alone, Theta_hat - theta_initial shrinking by (1 - T / tau) per period (explicit Euler).
+  const Model model = build_model(reference_machine());
+  ControllerConfig cfg;
+  cfg.adaptation_leakage_time = 0.5;
+  EffortLimits unlimited;
+  AdaptiveComputedTorque ctrl(model, cfg, unlimited);
+  Vec4 q0;
+  REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 30 * 3.14159265358979 / 180}, q0) == IkStatus::ok);
+  Workspace ws(model);
+  update_closed_chain(model, ws, q0, Vec4::Zero());
+  const Vec6 start = (Vec6() << 300, 8e3, 2e5, 250, 6e3, 1.5e5).finished();
+  ctrl.set_theta_hat(start);
+  ControlInput in;
+  in.q = in.q_d = q0;  // e = ed = 0: B^T P x = 0
+  in.soil.anchor_given = true;
+  in.soil.rho_env = ws.rho + Vec2(0.05, 0.03);
+  const int n = 500;  // 0.5 s = one time constant
+  in.soil.in_soil = true;
+  for (int k = 0; k < n; ++k) {
+    in.t = k * cfg.period;
+    const ControlOutput out = ctrl.update(in);
+    REQUIRE(out.in_soil);
+  }
+  const double factor = std::pow(1.0 - cfg.period / cfg.adaptation_leakage_time, n);  // ~exp(-1)
+  for (int i = 0; i < 6; ++i) {
+    CAPTURE(i);
+    CHECK(ctrl.theta_hat()[i] - cfg.theta_initial[i] ==
+          doctest::Approx((start[i] - cfg.theta_initial[i]) * factor).epsilon(1e-9));
+  }
+  // Out of the soil the update does not run: the estimate is held, leak and all.
+  const Vec6 held = ctrl.theta_hat();
+  in.soil.in_soil = false;
+  for (int k = 0; k < 200; ++k) ctrl.update(in);
+  CHECK(ctrl.theta_hat() == held);
+
+  // Without leakage (the published law) the same half second leaves Theta_hat where it was.
+  ControllerConfig published;
+  AdaptiveComputedTorque plain(model, published, unlimited);
+  plain.set_theta_hat(start);
+  in.soil.in_soil = true;
+  for (int k = 0; k < n; ++k) plain.update(in);
+  CHECK(plain.theta_hat() == start);
+}

@@ -70,6 +70,17 @@ TEST_CASE("firmware/settings refuse a flow law on the effort interface, naming b
             .controller.kind == control::ControllerKind::flow);
 }
 
+TEST_CASE("firmware/settings refuse an adaptation leakage faster than 10 control periods, and accept 0 (none) and slower") {
+  check_error("name: x\nduration: 2\ncontroller: {adaptation_leakage_time: 0.005}\n" + std::string(kTask),
+              "controller.adaptation_leakage_time", "0.005",
+              "0.005 s must be 0 (no leakage) or at least 10 control periods = 0.01 s");
+  check_error("name: x\nduration: 2\ncontroller: {adaptation_leakage_time: -1}\n" + std::string(kTask),
+              "controller.adaptation_leakage_time", "-1", "is -1 s; allowed range [0, 1000000] s");
+  CHECK(read("name: x\nduration: 2\n" + std::string(kTask)).controller.adaptation_leakage_time == 0.0);
+  CHECK(read("name: x\nduration: 2\ncontroller: {adaptation_leakage_time: 0.01}\n" + std::string(kTask))
+            .controller.adaptation_leakage_time == 0.01);
+}
+
 TEST_CASE("firmware/settings accept the plant's sections without reading them and refuse unknown ones") {
   const std::string plant_sections =
       "name: x\nduration: 2\nsoil: {preset: loam}\nactuators: {fidelity: limited, lag: 0.02}\n"

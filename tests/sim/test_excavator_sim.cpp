@@ -487,6 +487,41 @@ TEST_CASE("tools/excavator-sim truck loading: five cycles of all four actuators,
   CHECK(r.out.find("per work cycle") != std::string::npos);
 }
 
+TEST_CASE("tools/excavator-sim truck loading over fifteen passes: with the scene's leakage the adaptive law's error stays flat, with the published update it drifts") {
+  // Fifteen passes (332 s) of the shipped scene, its telemetry to /dev/null (a million messages a run).
+  const auto passes = [](bool leakage) {
+    std::vector<std::pair<std::string, std::string>> edits = {{"repeat: 5", "repeat: 15"},
+                                                              {"duration: 112.0", "duration: 332.0"}};
+    if (!leakage) edits.push_back({"adaptation_leakage_time: 20", "adaptation_leakage_time: 0"});
+    const fs::path scene = edited_scene(std::string(EXC_SOURCE_DIR) + "/scenes/truck_loading.yaml", edits,
+                                        leakage ? "truck15_leak" : "truck15_published");
+    const Run r = run_sim("run " + scene.string() +
+                          " --controller adaptive --quiet --no-report --json s.json --lcm 'file:///dev/null?mode=w'");
+    fs::remove(scene);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "s.json"));
+    REQUIRE(j["adaptive"]["cycles"].size() == 15);
+    return j["adaptive"]["cycles"];
+  };
+  const auto bucket = [](const nlohmann::json& c, int k) { return c[k]["rms_error"]["bucket"].get<double>(); };
+  const auto theta = [](const nlohmann::json& c, int k, const char* p) { return c[k]["theta_hat"][p].get<double>(); };
+
+  const nlohmann::json leak = passes(true);
+  for (int k = 2; k < 15; ++k) {
+    CAPTURE(k);
+    CHECK(bucket(leak, k) < 1.25 * bucket(leak, 1));  // flat from the second pass on
+  }
+  CHECK(theta(leak, 14, "K_x") == doctest::Approx(7e4).epsilon(0.25));  // near the soil's (loam: 70 kN/m)
+  CHECK(theta(leak, 14, "B_z") < 0.5 * 3e4);                            // far from its bound
+
+  // The negative control: the published update (eq. 27) on the same passes drifts.
+  const nlohmann::json published = passes(false);
+  CHECK(bucket(published, 14) > 2 * bucket(published, 1));
+  CHECK(theta(published, 14, "K_z") > 2e5);
+  CHECK(theta(published, 14, "B_z") == doctest::Approx(3e4));  // at theta_max
+}
+
 TEST_CASE("tools/excavator-sim opens a scene file once per run, counted by strace") {
   // Both sides (plant and firmware) read their sections from one reading of the file.
   const Run r = run_sim("run " + kDig + " --duration 0.05 --quiet --no-report");
