@@ -26,6 +26,15 @@ void desired(double t, const Vec4& q0, Vec4& q, Vec4& qd, Vec4& qdd) {
   }
 }
 
+// The tests' digging pose: the tip 0.3 m below the ground at 7 m, bucket at 30 degrees; ws holds
+// the closed chain there (ws.rho the tip).
+Vec4 pose_in_soil(const Model& model, Workspace& ws) {
+  Vec4 q0;
+  REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 30 * 3.14159265358979 / 180}, q0) == IkStatus::ok);
+  update_closed_chain(model, ws, q0, Vec4::Zero());
+  return q0;
+}
+
 struct LyapunovRun {
   double v0 = 0, v_end = 0, worst_rise = 0;
   Vec6 theta_end = Vec6::Zero();
@@ -48,10 +57,8 @@ LyapunovRun run_lyapunov(const Vec2& anchor_error, bool integral_action = false,
   EffortLimits unlimited;
   AdaptiveComputedTorque ctrl(model, cfg, unlimited);
 
-  Vec4 q0;
-  REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 30 * 3.14159265358979 / 180}, q0) == IkStatus::ok);
   Workspace ws(model);
-  update_closed_chain(model, ws, q0, Vec4::Zero());
+  const Vec4 q0 = pose_in_soil(model, ws);
   sim::SoilTruth soil;
   soil.theta = (Vec6() << 300, 8e3, 2e5, 250, 6e3, 1.5e5).finished();
   soil.always_in_soil = true;
@@ -163,10 +170,8 @@ TEST_CASE("firmware/adaptive: the projection keeps every soil estimate inside it
 
 TEST_CASE("firmware/adaptive and Slotine-Li leave a joint the actuator-lag stage clamps out of the soil update, and freeze only when every joint is clamped") {
   const Model model = build_model(reference_machine());
-  Vec4 q0;
-  REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 30 * 3.14159265358979 / 180}, q0) == IkStatus::ok);
   Workspace ws(model);
-  update_closed_chain(model, ws, q0, Vec4::Zero());
+  const Vec4 q0 = pose_in_soil(model, ws);
   ControlInput in;
   in.q = q0;
   in.qd = Vec4(0, 0.02, -0.03, 0.04);
@@ -263,10 +268,8 @@ TEST_CASE("firmware/adaptive: the update's leakage pulls Theta_hat to theta_init
   cfg.adaptation_leakage_time = 0.5;
   EffortLimits unlimited;
   AdaptiveComputedTorque ctrl(model, cfg, unlimited);
-  Vec4 q0;
-  REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 30 * 3.14159265358979 / 180}, q0) == IkStatus::ok);
   Workspace ws(model);
-  update_closed_chain(model, ws, q0, Vec4::Zero());
+  const Vec4 q0 = pose_in_soil(model, ws);
   const Vec6 start = (Vec6() << 300, 8e3, 2e5, 250, 6e3, 1.5e5).finished();
   ctrl.set_theta_hat(start);
   ControlInput in;
