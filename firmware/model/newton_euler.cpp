@@ -46,11 +46,12 @@ inline void set_pose(SE3& T, const Vec3& x, const Vec3& y, const Vec3& z, const 
 }
 
 
-// Out-of-plane offset of a front origin (pin rotations and slides keep it): the sum of the homes'
-// y on its path to the swing.
-double front_y_offset(const Model& model, int i) {
-  double y = 0.0;
-  for (; i > 0; i = model.parent[i]) y += model.home[i](1, 3);
+// Out-of-plane offset of each front origin (pin rotations and slides keep it): the homes' y summed
+// along its path. From the Model's homes on every call (11 additions), not stored: a Model's homes
+// may be edited after build_model (a test shifts one out of the plane).
+std::array<double, kNumJoints> front_y_offsets(const Model& model) {
+  std::array<double, kNumJoints> y{};
+  for (int i = 1; i < kNumJoints; ++i) y[i] = (model.parent[i] > 0 ? y[model.parent[i]] : 0.0) + model.home[i](1, 3);
   return y;
 }
 
@@ -66,14 +67,15 @@ void set_front_world_pose(const Workspace& ws, int i, double y, SE3& X) {
 }
 
 // Ad_{f^-1} X into link i from its parent, and Ad*_{f^-1} F from link i to its parent: by the pin
-// transforms when they are current, else by the general f_parent.
-inline Twist to_child(const Workspace& ws, int i, const Twist& X) {
-  return ws.pin_valid ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), X)
-                      : Ad_inv_apply(ws.f_parent[i], X);
+// transforms when they are current (pin: ws.pin_valid, read once by the caller, since the passes
+// write into ws and the compiler would read it again per link), else by the general f_parent.
+EXC_HOT_INLINE Twist to_child(bool pin, const Workspace& ws, int i, const Twist& X) {
+  return pin ? Ad_inv_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), X)
+             : Ad_inv_apply(ws.f_parent[i], X);
 }
-inline Wrench to_parent(const Workspace& ws, int i, const Wrench& F) {
-  return ws.pin_valid ? Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), F)
-                      : Ad_inv_dual_apply(ws.f_parent[i], F);
+EXC_HOT_INLINE Wrench to_parent(bool pin, const Workspace& ws, int i, const Wrench& F) {
+  return pin ? Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), F)
+             : Ad_inv_dual_apply(ws.f_parent[i], F);
 }
 
 }  // namespace
@@ -107,17 +109,14 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
   ws.pin_valid = true;
   ws.front_world_poses_valid = false;
   SE3 X_bucket;
-  set_front_world_pose(ws, kBucket, front_y_offset(model, kBucket), X_bucket);
+  set_front_world_pose(ws, kBucket, front_y_offsets(model)[kBucket], X_bucket);
   ws.tip_world = X_bucket.topLeftCorner<3, 3>() * model.tip_in_bucket + X_bucket.topRightCorner<3, 1>();
 }
 
 void tree_world_poses(const Model& model, Workspace& ws) {
   if (ws.front_world_poses_valid) return;
-  std::array<double, kNumJoints> y{};  // front_y_offset of each link, parents first
-  for (int i = 1; i < kNumJoints; ++i) {
-    y[i] = (model.parent[i] > 0 ? y[model.parent[i]] : 0.0) + model.home[i](1, 3);
-    set_front_world_pose(ws, i, y[i], ws.X_Wi[i]);
-  }
+  const std::array<double, kNumJoints> y = front_y_offsets(model);
+  for (int i = 1; i < kNumJoints; ++i) set_front_world_pose(ws, i, y[i], ws.X_Wi[i]);
   ws.front_world_poses_valid = true;
 }
 
@@ -176,13 +175,8 @@ void tree_inverse_dynamics(const Model& model, Workspace& ws, const Vec12& qdd, 
   // S_i^T F_i; for the front's known screws (pin) one entry of F_i.
   for (int i = kNumJoints - 1; i >= 0; --i) {
     const int p = model.parent[i];
-    if (pin && p >= 0) {
-      tau[i] = model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1];
-      ws.F[p] += Ad_inv_dual_apply_pin(ws.joint_cos[i], ws.joint_sin[i], ws.f_parent[i].topRightCorner<3, 1>(), ws.F[i]);
-    } else {
-      tau[i] = model.screw[i].dot(ws.F[i]);
-      if (p >= 0) ws.F[p] += Ad_inv_dual_apply(ws.f_parent[i], ws.F[i]);
-    }
+    tau[i] = pin && p >= 0 ? (model.prismatic[i] ? ws.F[i][3] : -ws.F[i][1]) : model.screw[i].dot(ws.F[i]);
+    if (p >= 0) ws.F[p] += to_parent(pin, ws, i, ws.F[i]);
   }
   ws.tau_r = tau;
 }
@@ -194,11 +188,12 @@ void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Ma
   // time, with the same transform and inertia products.
   std::array<Twist, kNumJoints> acc;
   std::array<Wrench, kNumJoints> force;
+  const bool pin = ws.pin_valid;
   for (int col = 0; col < N; ++col) {
     for (int i = 0; i < kNumJoints; ++i) {
       const int p = model.parent[i];
       acc[i] = model.screw[i] * A(i, col);
-      if (p >= 0) acc[i] += to_child(ws, i, acc[p]);
+      if (p >= 0) acc[i] += to_child(pin, ws, i, acc[p]);
       const BodyInertia& b = model.machine.bodies[i];
       force[i] = inertia_apply(b.mass, b.com, b.inertia, acc[i]);
     }
@@ -206,7 +201,7 @@ void tree_inertia_times(const Model& model, const Workspace& ws, const Eigen::Ma
       out(i, col) = model.screw[i].dot(force[i]);
       const int p = model.parent[i];
       if (p < 0) continue;
-      force[p] += to_parent(ws, i, force[i]);
+      force[p] += to_parent(pin, ws, i, force[i]);
     }
   }
 }
