@@ -134,6 +134,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   }
   // Chambers: backward Euler each (or forward, chamber.hpp), the piston's sweep from this substep's
   // velocity.
+  const auto step = pressures_ == PressureMethod::backward_euler ? &step_chamber : &step_chamber_explicit;
   Vec4 mean_a, mean_b, meter_in;
   bool relief = false, cavitation = false;
   r.solver_iterations = 0;
@@ -158,7 +159,6 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     }
     const double va1 = volume_a(i, q_a), vb1 = volume_b(i, q_a);
     const double swept_a = g_.area_a[i] * qd_a[i] * dt, swept_b = -g_.area_b[i] * qd_a[i] * dt;
-    const auto step = pressures_ == PressureMethod::backward_euler ? &step_chamber : &step_chamber_explicit;
     const ChamberStep sa = step(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
     const ChamberStep sb = step(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);
     r.solver_iterations += sa.iterations + sb.iterations;

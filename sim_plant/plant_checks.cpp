@@ -101,22 +101,22 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
         if (p >= in.pressure_min && p <= in.pressure_max) continue;
         const char* chamber =
             side == 0 ? (i == 0 ? "port A" : "bore-side") : (i == 0 ? "port B" : "rod-side");
-        if (integ.pressure_method == PressureMethod::forward_euler) {
-          set_failure(status, PlantFailure::pressure_range, in.time, in.cycle,
-                      "the %s %s pressure is %.6g MPa, outside [%.4g, %.4g] MPa (vapour .. highest relief + "
-                      "checks.pressure_check_margin) with integrator.pressure_method forward_euler at step %.4g s: "
-                      "the explicit update overshoots at this step (past a valve that opens in between: a make-up "
-                      "valve, a relief); use pressure_method backward_euler or a smaller integrator.step (try %.4g s)",
-                      kActiveNames[i], chamber, p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6, integ.step,
-                      0.5 * integ.step);
-          return false;
-        }
+        // The likely cause: explicit pressures overshooting, else a load the reliefs cannot hold.
+        char cause[320];
+        if (integ.pressure_method == PressureMethod::forward_euler)
+          std::snprintf(cause, sizeof cause,
+                        " with integrator.pressure_method forward_euler at step %.4g s: the explicit update overshoots "
+                        "at this step (past a valve that opens in between: a make-up valve, a relief); use "
+                        "pressure_method backward_euler or a smaller integrator.step (try %.4g s)",
+                        integ.step, 0.5 * integ.step);
+        else
+          std::snprintf(cause, sizeof cause, "%s",
+                        ": a relief passes more than its override allows (a load the reliefs cannot hold) or the "
+                        "pressures were integrated wrongly; check the reliefs and hydraulics.bulk_modulus");
         set_failure(status, PlantFailure::pressure_range, in.time, in.cycle,
                     "the %s %s pressure is %.6g MPa, outside [%.4g, %.4g] MPa (vapour .. highest relief + "
-                    "checks.pressure_check_margin): a relief passes more than its override allows (a load the "
-                    "reliefs cannot hold) or the pressures were integrated wrongly; check the reliefs and "
-                    "hydraulics.bulk_modulus",
-                    kActiveNames[i], chamber, p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6);
+                    "checks.pressure_check_margin)%s",
+                    kActiveNames[i], chamber, p * 1e-6, in.pressure_min * 1e-6, in.pressure_max * 1e-6, cause);
         return false;
       }
     }
