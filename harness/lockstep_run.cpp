@@ -93,6 +93,12 @@ SceneBundle load_scene_bundle(const std::string& path) {
   return b;
 }
 
+std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
+  if (kind != FaultSchedule::Kind::pump_loss || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
+  return "pump_loss needs the hydraulic machine; " + scene.file + " has actuators " +
+         plant::to_string(scene.actuators.fidelity);
+}
+
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
   RunRecord result;
   result.controller = control::to_string(options.controller);
@@ -148,9 +154,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   std::vector<std::array<double, 4>> cycle_sum_sq(cycles_acc.size(), std::array<double, 4>{});
   const bool hydraulic = scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
   result.hydraulic = hydraulic;
-  if (options.fault.kind == FaultSchedule::Kind::pump_loss && !hydraulic)
-    throw std::invalid_argument("fault pump_loss: " + scene.name + " has no pumps (actuators " +
-                                plant::to_string(scene.actuators.fidelity) + "; it needs hydraulic)");
+  if (const std::string why = fault_misfit(options.fault.kind, scene); !why.empty())
+    throw std::invalid_argument("fault: " + why);
   if (hydraulic) result.min_pressure = result.peak_pressure = plant.state().hydraulics.min_pressure;
   const double cpu_start = thread_cpu_seconds();
   {

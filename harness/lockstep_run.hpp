@@ -127,6 +127,10 @@ inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);
 }
 
+// Why a fault of `kind` cannot run on `scene` ("" when it can): pump_loss needs the hydraulic
+// machine's pumps. run_lockstep refuses such a run, a sweep such a spec before any run.
+std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene);
+
 struct LockstepOptions {
   control::ControllerKind controller = control::ControllerKind::adaptive;
   double duration = 0;  // s; 0: the scene's

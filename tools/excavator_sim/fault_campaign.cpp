@@ -1,6 +1,5 @@
 #include "fault_campaign.hpp"
 
-#include <algorithm>
 #include <stdexcept>
 
 namespace exc::sim {
@@ -44,10 +43,9 @@ void draw_fault(std::mt19937_64& rng, const std::vector<std::string>& kinds, Swe
 }
 
 void check_faults_fit(const std::vector<std::string>& kinds, const SceneBundle& scene) {
-  const bool pumps = scene.scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
-  if (!pumps && std::find(kinds.begin(), kinds.end(), "pump_loss") != kinds.end())
-    throw std::invalid_argument("sweep.faults: pump_loss needs the hydraulic machine; " + scene.scene.file +
-                                " has actuators " + plant::to_string(scene.scene.actuators.fidelity));
+  for (const std::string& kind : kinds)
+    if (const std::string why = fault_misfit(*kFaultKinds.named(kind), scene.scene); !why.empty())
+      throw std::invalid_argument("sweep.faults: " + why);
 }
 
 FaultSchedule fault_schedule(const SweepCase& c, std::uint64_t seed) {
