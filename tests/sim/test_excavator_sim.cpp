@@ -12,6 +12,7 @@
 #include "exlcm/machine_state_t.hpp"
 #include <map>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 #include <sched.h>
@@ -22,6 +23,7 @@
 
 #include "harness/lockstep_run.hpp"
 #include "matplotlib_probe.hpp"
+#include "run_report.hpp"
 #include "sim_runs.hpp"
 
 namespace fs = std::filesystem;
@@ -520,6 +522,61 @@ TEST_CASE("tools/excavator-sim truck loading over fifteen passes: with the scene
   CHECK(bucket(published, 14) > 2 * bucket(published, 1));
   CHECK(theta(published, 14, "K_z") > 2e5);
   CHECK(theta(published, 14, "B_z") == doctest::Approx(3e4));  // at theta_max
+}
+
+TEST_CASE("tools/excavator-sim sweeps record a never-tracked run's errors as null, and the merged table leaves their cells empty, not 0") {
+  // The record: a run with no tracking samples has no error figure; one with samples has all four.
+  exc::sim::RunRecord never;
+  never.tracking_samples = 0;
+  CHECK(exc::sim::tracked_per_joint(never, never.rms_error).is_null());
+  exc::sim::RunRecord tracked;
+  tracked.tracking_samples = 10;
+  tracked.rms_error[3] = 2e-3;
+  const nlohmann::json figure = exc::sim::tracked_per_joint(tracked, tracked.rms_error);
+  CHECK(figure["bucket"].get<double>() == 2e-3);
+  CHECK(figure.size() == 4);
+
+  // The merge: case 1's PID run as a never-tracked run records it.
+  const Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  write_sweep_spec("dig_monte_carlo.yaml", 2, "  duration: 0.3\n", dir / "spec.yaml");
+  const std::string in_dir = "cd '" + dir.string() + "' && " + EXC_SIM_TOOL;
+  REQUIRE(std::system((in_dir + " sweep spec.yaml --quiet --out one.jsonl > /dev/null 2>&1").c_str()) == 0);
+  std::ifstream in(dir / "one.jsonl");
+  std::ofstream edited(dir / "edited.jsonl");
+  std::string line;
+  while (std::getline(in, line)) {
+    nlohmann::json j = nlohmann::json::parse(line);
+    if (j["case"] == 1) {
+      j["pid"]["ok"] = false;
+      j["pid"]["rms_error"] = j["pid"]["max_error"] = nullptr;
+      j["pid"]["failure"] = "never tracked";
+    }
+    edited << j.dump() << "\n";
+  }
+  edited.close();
+  REQUIRE(std::system((in_dir + " sweep-merge spec.yaml edited.jsonl --out merged --no-charts > /dev/null 2>&1").c_str()) == 0);
+  std::ifstream csv(dir / "merged" / "sweep.csv");
+  std::vector<std::vector<std::string>> rows;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) cells.push_back(cell);
+    rows.push_back(cells);
+  }
+  REQUIRE(rows.size() == 3);
+  const auto column = [&](const std::string& name) {
+    const auto at = std::find(rows[0].begin(), rows[0].end(), name);
+    REQUIRE(at != rows[0].end());
+    return static_cast<std::size_t>(at - rows[0].begin());
+  };
+  for (const char* joint : {"swing", "boom", "arm", "bucket"}) {
+    CAPTURE(joint);
+    CHECK(rows[2][column(std::string("pid_rms_") + joint)].empty());       // never tracked: no figure
+    CHECK_FALSE(rows[1][column(std::string("pid_rms_") + joint)].empty()); // tracked: its figure
+  }
+  CHECK(rows[2][column("pid_ok")] == "0");
 }
 
 TEST_CASE("tools/excavator-sim opens a scene file once per run, counted by strace") {

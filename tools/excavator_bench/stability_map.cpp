@@ -111,6 +111,7 @@ std::vector<StepStability> step_rows(const std::vector<json>& lines, const std::
 }
 
 double worst_rms(const json& run) {
+  if (!run.contains("rms_error") || !run["rms_error"].is_object()) return NAN;  // never tracked: no figure
   double w = 0;
   for (const auto& [joint, v] : run["rms_error"].items()) w = std::max(w, v.is_number() ? v.get<double>() : NAN);
   return w;

@@ -21,11 +21,6 @@ nlohmann::json per_joint(const double (&v)[4]) {
   return j;
 }
 
-// A tracking figure of a run: null when the run never tracked (a metric of no samples is not 0).
-nlohmann::json tracked(const RunResult& r, const double (&v)[4]) {
-  return r.tracking_samples > 0 ? per_joint(v) : nlohmann::json(nullptr);
-}
-
 // printf into a string of any length (a failure reason may be long).
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 std::string format(const char* fmt, ...) {
@@ -46,6 +41,10 @@ nlohmann::json timing_json(const Timing& t) {
 }
 
 }  // namespace
+
+nlohmann::json tracked_per_joint(const RunResult& r, const double (&v)[4]) {
+  return r.tracking_samples > 0 ? per_joint(v) : nlohmann::json(nullptr);
+}
 
 // Work cycles: one row per cycle and controller, when the task repeats.
 void print_cycles(const Summary& summary, std::ostream& out) {
@@ -119,9 +118,9 @@ nlohmann::json to_json(const Summary& summary) {
     nlohmann::json run;
     run["ok"] = r.ok;
     if (!r.ok) run["failure"] = r.failure;
-    run["rms_error"] = tracked(r, r.rms_error);
-    run["max_error"] = tracked(r, r.max_error);
-    run["tracking"] = {{"rms_error", tracked(r, r.measured_rms_error)}, {"max_error", tracked(r, r.measured_max_error)}};
+    run["rms_error"] = tracked_per_joint(r, r.rms_error);
+    run["max_error"] = tracked_per_joint(r, r.max_error);
+    run["tracking"] = {{"rms_error", tracked_per_joint(r, r.measured_rms_error)}, {"max_error", tracked_per_joint(r, r.measured_max_error)}};
     run["tracking_samples"] = r.tracking_samples;
     nlohmann::json theta_hat, theta_true;
     for (int i = 0; i < 6; ++i) {

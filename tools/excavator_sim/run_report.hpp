@@ -11,6 +11,9 @@
 namespace exc::sim {
 
 void print_summary(const Summary& summary, std::ostream& out);
+// A run's tracking figure per joint ({swing, boom, arm, bucket}), null when the run never tracked
+// (a metric of no samples is not 0): the summary's and the sweeps' records.
+nlohmann::json tracked_per_joint(const RunResult& r, const double (&v)[4]);
 nlohmann::json to_json(const Summary& summary);
 // Runs `excavator-log report` on out_dir/run.lcm; returns its exit status.
 int write_report(const std::filesystem::path& out_dir, const std::filesystem::path& summary_json, const std::string& title);

@@ -165,7 +165,7 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
       const json& r = j.at(name);
       const bool ok = r.at("ok").get<bool>();
       csv << ',' << (ok ? 1 : 0);
-      for (const char* joint : kJoints) csv << ',' << cell(r.contains("rms_error") ? r["rms_error"].value(joint, json()) : json());
+      for (const char* joint : kJoints) csv << ',' << cell(r.contains("rms_error") && r["rms_error"].is_object() ? r["rms_error"].value(joint, json()) : json());
       if (!spec.search.knob.empty()) {
         const json v = r.value("search_value", json());
         csv << ',' << (v.is_string() ? v.get<std::string>() : cell(v));

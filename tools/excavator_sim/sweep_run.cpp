@@ -8,16 +8,13 @@
 
 #include "control/controller_kinds.hpp"
 #include "fault_campaign.hpp"
+#include "run_report.hpp"
 #include "sweep.hpp"
 
 namespace exc::sim {
 namespace {
 
 namespace fs = std::filesystem;
-
-nlohmann::json per_joint(const double (&v)[4]) {
-  return {{"swing", v[0]}, {"boom", v[1]}, {"arm", v[2]}, {"bucket", v[3]}};
-}
 
 Vec4 joints_of(const SweepValue& v) {
   return v.type == SweepValue::Type::joints ? Vec4(v.joints[0], v.joints[1], v.joints[2], v.joints[3])
@@ -90,7 +87,9 @@ RunRecord run_sweep_case(const SceneBundle& nominal, const SweepSpec& spec, cons
 }
 
 nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firmware) {
-  nlohmann::json run = {{"ok", r.ok}, {"rms_error", per_joint(r.rms_error)}, {"max_error", per_joint(r.max_error)}};
+  nlohmann::json run = {{"ok", r.ok},
+                        {"rms_error", tracked_per_joint(r, r.rms_error)},
+                        {"max_error", tracked_per_joint(r, r.max_error)}};
   if (!r.ok) run["failure"] = r.failure;
   run.update(run_outcome(r, firmware));  // the outcome the campaign counts, and its times
   run["simulated_seconds"] = r.simulated_seconds;

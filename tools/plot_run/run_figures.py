@@ -123,11 +123,16 @@ def plot_robustness(plt, path, out_dir):
     for ax, joint in zip(axes[0], ("boom", "arm", "bucket")):
         for k, c in enumerate(controllers):
             xs = [i + (k - (len(controllers) - 1) / 2) * width for i in range(len(rows))]
-            bars = ax.bar(xs, [1e3 * r[c]["rms_error"][joint] for r in rows], width, label=c)
+            # A run that never tracked has no RMS (null): no bar, a mark at the foot of the panel.
+            bars = ax.bar(xs, [1e3 * r[c]["rms_error"][joint] if r[c].get("rms_error") else math.nan for r in rows],
+                          width, label=c)
             # A run the firmware stopped (its safe state) is hatched and marked: its RMS covers only
             # the time before the stop.
             for bar, r in zip(bars, rows):
-                if not r[c].get("ok", True):
+                if not r[c].get("rms_error"):
+                    ax.annotate("never tracked", (bar.get_x() + bar.get_width() / 2, 0.02),
+                                xycoords=("data", "axes fraction"), ha="center", va="bottom", fontsize=7, rotation=90)
+                elif not r[c].get("ok", True):
                     bar.set_hatch("//")
                     bar.set_edgecolor("black")
                     ax.annotate("stopped", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
