@@ -103,13 +103,18 @@ nlohmann::json SweepValue::to_json() const {
   return joints;
 }
 
+namespace {
+// The points of one grid: its axes crossed.
+int grid_size(const SweepGrid& g) {
+  int p = 1;
+  for (const SweepAxis& a : g) p *= static_cast<int>(a.values.size());
+  return p;
+}
+}  // namespace
+
 int SweepSpec::grid_points() const {
   int n = 0;
-  for (const SweepGrid& g : grids) {
-    int p = 1;
-    for (const SweepAxis& a : g) p *= static_cast<int>(a.values.size());
-    n += p;
-  }
+  for (const SweepGrid& g : grids) n += grid_size(g);
   return grids.empty() ? 1 : n;
 }
 
@@ -237,8 +242,7 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
   c.variant = spec.variants.empty() ? -1 : rest % variants;
   c.scene = rest / variants;
   for (std::size_t g = 0; g < spec.grids.size(); ++g) {
-    int size = 1;
-    for (const SweepAxis& a : spec.grids[g]) size *= static_cast<int>(a.values.size());
+    const int size = grid_size(spec.grids[g]);
     if (point >= size) {
       point -= size;
       continue;
