@@ -504,6 +504,7 @@ TEST_CASE("tools/excavator-sim truck loading over fifteen passes: with the scene
     REQUIRE(r.status == 0);
     const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "s.json"));
     REQUIRE(j["adaptive"]["cycles"].size() == 15);
+    CHECK(j["adaptive"]["heap_allocations_in_loop"].get<std::uint64_t>() == 0);  // the leak's branch included
     return j["adaptive"]["cycles"];
   };
   const auto bucket = [](const nlohmann::json& c, int k) { return c[k]["rms_error"]["bucket"].get<double>(); };
