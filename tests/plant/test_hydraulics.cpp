@@ -376,7 +376,7 @@ TEST_CASE("plant/hydraulics: pumps that lose flow (the fault campaign's pump_los
   CHECK(plant.state().hydraulics.meter_in_flow[1] > 0.9 * pump);
 }
 
-TEST_CASE("plant/hydraulics: a fast boom-down (overrunning load) refills the rod side from tank; no pressure below vapour") {
+TEST_CASE("plant/hydraulics: a fast boom-down (overrunning load) refills the rod side from tank with no pressure below vapour") {
   // Lowering, the boom's weight drives it faster than the pump fills the rod side (the meter-out
   // from the loaded bore side sets the speed): without the make-up valves the rod side would fall
   // below zero. Evidence that the load overran: the rod side swept more than the meter-in gave.

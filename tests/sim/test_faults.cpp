@@ -160,7 +160,7 @@ TEST_CASE("tools/excavator-sim: a forced trip of the tracking-error fault is on 
   CHECK(report.find("| status | FAILED: " + failure + " |") != std::string::npos);
 }
 
-TEST_CASE("tools/excavator-sim: in issue 16's saturated swing with no soil the adaptive law's arm and bucket errors are within 1.5x of PID's; tens of times PID's only where the firmware takes itself to be in soil") {
+TEST_CASE("tools/excavator-sim: in issue 16's saturated swing with no soil the adaptive law's arm and bucket errors are within 1.5x of PID's, tens of times PID's only where the firmware takes itself to be in soil") {
   // The tip stays above the ground (docs/control.md, "Saturation and the soil term"): no contact is
   // estimated, so the law has no soil term and no update (its estimates end where they began): it
   // is the PD computed torque, PID's law without the integral. On the paper's force actuators and

@@ -1,2 +1,47 @@
-#define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
+// The tests' main: doctest's own, plus one refusal. ctest runs each case by name
+// (--test-case=NAME); a name that no longer matches (a ';' in it splits the ctest entry, a renamed
+// case) would run nothing and pass. A run that passed no case through its filters fails instead.
+#define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
+
+#include <cstdio>
+
+namespace {
+
+unsigned g_cases_run = 0;
+bool g_run_ended = false;
+
+// Listens for the run's end only: how many cases passed the filters.
+struct FilterCount : doctest::IReporter {
+  explicit FilterCount(const doctest::ContextOptions&) {}
+  void report_query(const doctest::QueryData&) override {}
+  void test_run_start() override {}
+  void test_run_end(const doctest::TestRunStats& s) override {
+    g_cases_run = s.numTestCasesPassingFilters;
+    g_run_ended = true;
+  }
+  void test_case_start(const doctest::TestCaseData&) override {}
+  void test_case_reenter(const doctest::TestCaseData&) override {}
+  void test_case_end(const doctest::CurrentTestCaseStats&) override {}
+  void test_case_exception(const doctest::TestCaseException&) override {}
+  void subcase_start(const doctest::SubcaseSignature&) override {}
+  void subcase_end() override {}
+  void log_assert(const doctest::AssertData&) override {}
+  void log_message(const doctest::MessageData&) override {}
+  void test_case_skipped(const doctest::TestCaseData&) override {}
+};
+
+REGISTER_LISTENER("filter_count", 1, FilterCount);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  doctest::Context context(argc, argv);
+  const int result = context.run();
+  if (context.shouldExit() || !g_run_ended) return result;  // --help, --list-test-cases and the like
+  if (g_cases_run == 0) {
+    std::fprintf(stderr, "%s: no test case matches the filters given; nothing was tested\n", argc > 0 ? argv[0] : "test");
+    return result != 0 ? result : 1;
+  }
+  return result;
+}
