@@ -631,7 +631,7 @@ TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to t
   CHECK(a["merged"].get<int>() == 6);
 }
 
-TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the cases deterministically; variants and a second grid follow; the merge writes the table, the failures by value and the stability chart") {
+TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the cases deterministically, variants and a second grid follow, the merge writes the table, the failures by value and the stability chart") {
   const Run setup = run_sim("--help");
   const fs::path dir = setup.dir;
   // Two grids (2 x 2 on the valve stage against the plant's spool lag, then 2 gain scales), 0.3 s runs.
@@ -659,6 +659,15 @@ TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the ca
   CHECK(j["failures_by_value"]["adaptive"]["gain_scale"]["8"]["runs"].get<int>() == 1);
   REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
   CHECK(fs::file_size(dir / "merged" / "stability.png") > 20000);
+  // A chart that cannot be written (its file name taken by a directory): the table and summary are
+  // written all the same, the merge says which chart failed and exits 1.
+  fs::create_directories(dir / "unwritable" / "stability.png");
+  const int broken = std::system((in_dir + EXC_SIM_TOOL + " sweep-merge spec.yaml a.jsonl b.jsonl --out unwritable > broken.out 2> broken.err").c_str());
+  CHECK(WIFEXITED(broken));
+  CHECK(WEXITSTATUS(broken) == 1);
+  CHECK(read_text_file(dir / "broken.err").find("the charts failed") != std::string::npos);
+  CHECK(read_text_file(dir / "broken.out").find("(a chart failed)") != std::string::npos);
+  CHECK(read_text_file(dir / "unwritable" / "sweep.csv") == csv);
   // Variants with random draws: each variant gets `cases` draws, case = variant * cases + draw.
   std::ofstream(dir / "variants.yaml") << "sweep:\n  scenes: [" << kDig << "]\n  controllers: [pid]\n  duration: 0.2\n"
       "  cases: 2\n  perturbations: {model_mass: [-0.1, 0.1]}\n"

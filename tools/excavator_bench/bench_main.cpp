@@ -187,13 +187,21 @@ int run_bench(const Options& o) {
     for (const std::string& line : m.lines) std::printf("  %s\n", line.c_str());
   }
 
+  bool complete = true;
+  for (const std::string& name : maps.failed_merges) {
+    std::fprintf(stderr, "excavator-bench: the stability map %s lost cases or its chart (above)\n", name.c_str());
+    complete = false;
+  }
   if (o.plots) {
     const std::string cmd = std::string("/usr/bin/python3 '") + EXC_BENCH_PLOT_SCRIPT + "' '" + o.out + "'";
-    if (std::system(cmd.c_str()) != 0) std::printf("plots: the plotting script failed (CSV files are complete)\n");
+    if (std::system(cmd.c_str()) != 0) {
+      std::fprintf(stderr, "excavator-bench: the plotting script failed (%s); the CSV files are complete\n", cmd.c_str());
+      complete = false;
+    }
   }
   std::printf("json: %s (%.1f s wall)\n", json_path.c_str(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
-  return 0;
+  return complete ? 0 : 1;
 }
 
 int export_command(const std::string& machine_file, const std::string& out, std::vector<double> q_a) {

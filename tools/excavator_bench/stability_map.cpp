@@ -60,13 +60,15 @@ json run_open_loop_case(const SweepSpec& spec, const SweepCase& c) {
   return line;
 }
 
-// Runs a spec as one shard in this process and merges it into out/<name>/; returns its case lines.
-std::vector<json> run_spec(const SweepSpec& spec, const std::string& out, const sim::SweepRunner& runner) {
+// Runs a spec as one shard in this process and merges it into out/<name>/ (a merge that lost cases or
+// a chart is added to `failed`); returns its case lines.
+std::vector<json> run_spec(const SweepSpec& spec, const std::string& out, const sim::SweepRunner& runner,
+                           std::vector<std::string>& failed) {
   const std::string name = fs::path(spec.file).stem().string();
   const fs::path dir = fs::path(out) / name;
   progress("stability %s: %s\n", name, std::to_string(spec.total_cases()) + " cases");
   sim::run_sweep_shard(spec, 0, 1, dir / "shard-0.jsonl", false, runner);
-  sim::merge_sweep(spec, {dir / "shard-0.jsonl"}, dir);
+  if (!sim::merge_sweep(spec, {dir / "shard-0.jsonl"}, dir).ok()) failed.push_back(name);
   std::vector<json> lines;
   std::ifstream in(dir / "shard-0.jsonl");
   for (std::string line; std::getline(in, line);)
@@ -137,10 +139,10 @@ StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& s
   }
   for (const auto& [spec, knob, axis] : {std::make_tuple(&soil, "soil.stiffness", "soil_stiffness_N_per_m"),
                                          std::make_tuple(&speed, "profile.speed", "joint_speed_factor")}) {
-    const std::vector<StepStability> rows = step_rows(run_spec(*spec, out, run_open_loop_case), knob, axis);
+    const std::vector<StepStability> rows = step_rows(run_spec(*spec, out, run_open_loop_case, maps.failed_merges), knob, axis);
     maps.step.insert(maps.step.end(), rows.begin(), rows.end());
   }
-  for (const json& j : run_spec(control, out, sim::run_closed_loop_case)) {
+  for (const json& j : run_spec(control, out, sim::run_closed_loop_case, maps.failed_merges)) {
     const auto& [knob, value] = *j["set"].items().begin();
     for (const std::string& c : control.controllers) {
       if (c == "pid" && knob == "adaptation_scale") continue;  // PID adapts nothing
@@ -161,7 +163,7 @@ StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& s
     m.name = fs::path(name).stem().string();
     m.dir = (fs::path(out) / m.name).string();
     std::map<std::string, std::map<std::string, int>> failures;  // "controller knob=value" -> kind -> runs
-    for (const json& j : run_spec(spec, out, sim::run_closed_loop_case))
+    for (const json& j : run_spec(spec, out, sim::run_closed_loop_case, maps.failed_merges))
       for (const std::string& c : spec.controllers) {
         ++m.runs;
         if (j[c]["ok"].get<bool>()) continue;

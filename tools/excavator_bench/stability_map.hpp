@@ -36,6 +36,7 @@ struct StabilityMaps {
   std::vector<StepStability> step;
   std::vector<ControlStability> control;
   std::vector<HydraulicMap> hydraulic;  // empty with --quick
+  std::vector<std::string> failed_merges;  // specs whose merge lost cases or a chart (the bench fails)
 };
 
 // Runs sweeps/stability_*.yaml from `sweeps_dir` on the scenes of `scenes_dir` (quick: the CI cut,

@@ -137,9 +137,10 @@ int main(int argc, char** argv) {
       if (merge->parsed()) {
         const exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(merge_spec);
         std::vector<fs::path> files(merge_files.begin(), merge_files.end());
-        const bool complete = exc::sim::merge_sweep(spec, files, merge_out, !merge_no_charts);
-        std::cout << "sweep: " << (fs::path(merge_out) / "sweep.csv").string() << (complete ? "" : " (cases missing)") << "\n";
-        return complete ? 0 : 1;
+        const exc::sim::MergeOutcome merged = exc::sim::merge_sweep(spec, files, merge_out, !merge_no_charts);
+        std::cout << "sweep: " << (fs::path(merge_out) / "sweep.csv").string() << (merged.complete ? "" : " (cases missing)")
+                  << (merged.charts_ok ? "" : " (a chart failed)") << "\n";
+        return merged.ok() ? 0 : 1;
       }
       int shard = 0, shards = 1;
       if (std::sscanf(sweep_shard.c_str(), "%d/%d", &shard, &shards) != 2 || shards < 1 || shard < 0 || shard >= shards) {

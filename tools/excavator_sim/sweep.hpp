@@ -119,10 +119,17 @@ nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firm
 int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const std::filesystem::path& out, bool progress,
                     const SweepRunner& runner = run_closed_loop_case);
 
+// What a merge could not do: cases missing (named in the JSON and on stderr), a chart that failed
+// (named on stderr; the table and summary are written either way).
+struct MergeOutcome {
+  bool complete = true;
+  bool charts_ok = true;
+  bool ok() const { return complete && charts_ok; }
+};
+
 // Merges shard files (absent ones reported with their cases) into out_dir: sweep.csv, sweep.json
-// (missing cases, failures by region) and the charts the spec records. Returns false when cases are
-// missing (named in the JSON and on stderr).
-bool merge_sweep(const SweepSpec& spec, const std::vector<std::filesystem::path>& shard_files,
-                 const std::filesystem::path& out_dir, bool charts = true);
+// (missing cases, failures by region) and the charts the spec records.
+MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<std::filesystem::path>& shard_files,
+                         const std::filesystem::path& out_dir, bool charts = true);
 
 }  // namespace exc::sim

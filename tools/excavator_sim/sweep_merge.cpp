@@ -113,7 +113,9 @@ json robustness_rows(const SweepSpec& spec, const std::map<int, json>& cases) {
 
 }  // namespace
 
-bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files, const fs::path& out_dir, bool charts) {
+MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files, const fs::path& out_dir,
+                         bool charts) {
+  MergeOutcome outcome;
   std::map<int, json> cases;
   const json absent_files = read_shards(spec, shard_files, cases);
   fs::create_directories(out_dir);
@@ -204,20 +206,26 @@ bool merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& shard_files
   csv.close();
   if (charts && spec.records("robustness") && !spec.variants.empty()) {
     std::ofstream(out_dir / "robustness.json") << robustness_rows(spec, cases).dump(2) << "\n";
-    if (plot_robustness(out_dir / "robustness.json", out_dir) != 0) std::fprintf(stderr, "sweep merge: robustness.png failed\n");
+    if (plot_robustness(out_dir / "robustness.json", out_dir) != 0) {
+      std::fprintf(stderr, "sweep merge: the robustness chart failed (%s)\n", (out_dir / "robustness.png").c_str());
+      outcome.charts_ok = false;
+    }
   }
   const bool stability = spec.records("stability"), spread = spec.records("robustness") && spec.variants.empty();
   if (charts && (stability || spread) && !cases.empty()) {
     const std::string what = std::string(stability ? " --stability" : "") + (spread ? " --robustness" : "");
     const std::string cmd = "/usr/bin/python3 '" EXC_SWEEP_PLOT "'" + what + " '" + out_dir.string() + "'";
-    if (std::system(cmd.c_str()) != 0) std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", cmd.c_str());
+    if (std::system(cmd.c_str()) != 0) {
+      std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", cmd.c_str());
+      outcome.charts_ok = false;
+    }
   }
   if (!missing.empty()) {
     std::fprintf(stderr, "sweep merge: %zu of %d cases missing (first: %d); rerun their shards\n", missing.size(),
                  spec.total_cases(), missing.front());
-    return false;
+    outcome.complete = false;
   }
-  return true;
+  return outcome;
 }
 
 }  // namespace exc::sim
