@@ -379,4 +379,6 @@ std::string emit(const YAML::Node& effective) {
   return std::string(out.c_str()) + "\n";
 }
 
+bool finite_number(const YAML::Node& n, double& v) { return scalar_number(n, v) && std::isfinite(v); }
+
 }  // namespace exc::settings

@@ -39,6 +39,10 @@ struct Bounds {
 // form is more than 2 characters shorter: 0.001, 0.0003, 1000000, 34300000, 1e-06, 1e+09.
 std::string format_number(double v);
 
+// The node's number if it is a scalar that reads as a finite one, as every settings value is read
+// (a sweep's values too, so the same text means the same number in both).
+bool finite_number(const YAML::Node& n, double& v);
+
 class SectionReader {
  public:
   // The top level of a document.

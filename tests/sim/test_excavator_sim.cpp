@@ -683,6 +683,16 @@ TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the ca
   CHECK(bad.status == 2);
   CHECK(bad.err.find("bad.yaml") != std::string::npos);
   CHECK(bad.err.find("bulk_modulus") != std::string::npos);
+  // A value that is not a finite number (read as a settings file reads it) is refused at its element.
+  for (const char* value : {".nan", ".inf", "fast", "1e3x"}) {
+    std::ofstream(dir / "nan.yaml") << "sweep:\n  scene: " << kDig << "\n  grid:\n    gain_scale: [1, " << value << "]\n";
+    const Run nan = run_sim("sweep " + (dir / "nan.yaml").string() + " --quiet");
+    INFO(value << ": " << nan.err);
+    CHECK(nan.status == 2);
+    CHECK(nan.err.find("nan.yaml") != std::string::npos);
+    CHECK(nan.err.find("gain_scale[1]") != std::string::npos);
+    CHECK(nan.err.find("must be a number") != std::string::npos);
+  }
 }
 
 TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a random fault on the dig and the free motion ends tracking within its limits or in the safe state within the watchdog time of the fault's detection, none otherwise, every fault kind drawn") {

@@ -31,12 +31,6 @@ double draw(std::mt19937_64& rng, const SweepRange& r, double fallback) {
   return r.min + (r.max - r.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
 }
 
-bool parse_number(const std::string& s, double& x) {
-  char* end = nullptr;
-  x = std::strtod(s.c_str(), &end);
-  return !s.empty() && end == s.c_str() + s.size() && std::isfinite(x);
-}
-
 // One value of a knob from its node: a number, four numbers where the knob takes one per joint, or a
 // name where it takes names; range-checked. Errors at the key (index >= 0: at the list's element).
 SweepValue read_value(const SectionReader& r, const std::string& key, long index, const YAML::Node& n, const KnobInfo& k) {
@@ -55,7 +49,7 @@ SweepValue read_value(const SectionReader& r, const std::string& key, long index
     v.type = SweepValue::Type::joints;
     for (std::size_t j = 0; j < 4; ++j) {
       double x = 0;
-      if (!n[j].IsScalar() || !parse_number(n[j].Scalar(), x)) fail("must be four numbers " + range);
+      if (!settings::finite_number(n[j], x)) fail("must be four numbers " + range);
       v.joints[j] = checked(x);
     }
     return v;
@@ -67,7 +61,7 @@ SweepValue read_value(const SectionReader& r, const std::string& key, long index
     v.name = n.Scalar();
     return v;
   }
-  if (!parse_number(n.Scalar(), v.number)) fail("is '" + n.Scalar() + "'; must be a number " + range + " (" + k.what + ")");
+  if (!settings::finite_number(n, v.number)) fail("is '" + n.Scalar() + "'; must be a number " + range + " (" + k.what + ")");
   checked(v.number);
   return v;
 }
