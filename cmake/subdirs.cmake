@@ -34,7 +34,12 @@ function(exc_add_doctest target)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 600)
   endif()
-  set(_props TIMEOUT ${ARG_TIMEOUT} SKIP_REGULAR_EXPRESSION "SKIPPED:")
+  # A case that reports SKIPPED (a peer library absent) shows as skipped in a user's build; in the test
+  # build (CI) nothing may skip: without the property the case asserted nothing and the main fails it.
+  set(_props TIMEOUT ${ARG_TIMEOUT})
+  if(NOT EXC_TEST_BUILD)
+    list(APPEND _props SKIP_REGULAR_EXPRESSION "SKIPPED:")
+  endif()
   if(ARG_ENV)
     list(APPEND _props ENVIRONMENT "${ARG_ENV}")
   endif()
