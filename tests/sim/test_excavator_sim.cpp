@@ -832,3 +832,26 @@ TEST_CASE("tools/excavator-sim: the hydraulic dig run for 40 s holds its final p
     CHECK(moved[c] < 1e-4);
   }
 }
+
+TEST_CASE("tools/excavator-sim: an output file that cannot be written is an error naming it (run --json, sweep-merge's table), not a quiet success") {
+  // --json into a directory that does not exist: the run itself tracked, the summary is lost.
+  const Run json = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out --json no/such/dir/run.json");
+  INFO(json.err);
+  CHECK(json.status == 2);
+  CHECK(json.err.find("no/such/dir/run.json: cannot write") != std::string::npos);
+  // The control: the same run with a writable path writes it and exits 0.
+  const Run ok = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out --json run.json");
+  CHECK(ok.status == 0);
+  CHECK(fs::file_size(ok.dir / "run.json") > 100);
+  // sweep-merge whose table's name a directory takes.
+  const fs::path dir = ok.dir;
+  std::ofstream(dir / "spec.yaml") << "sweep:\n  scene: " << kDig << "\n  controllers: [pid]\n  duration: 0.1\n"
+                                      "  grid:\n    gain_scale: [1]\n";
+  const std::string in_dir = "cd '" + dir.string() + "' && ";
+  REQUIRE(std::system((in_dir + EXC_SIM_TOOL + " sweep spec.yaml --quiet --out s.jsonl > /dev/null 2>&1").c_str()) == 0);
+  fs::create_directories(dir / "merged" / "sweep.csv");
+  const int merged = std::system((in_dir + EXC_SIM_TOOL + " sweep-merge spec.yaml s.jsonl --out merged --no-charts > /dev/null 2> merge.err").c_str());
+  CHECK(WIFEXITED(merged));
+  CHECK(WEXITSTATUS(merged) == 2);
+  CHECK(read_text_file(dir / "merge.err").find("sweep.csv: cannot write") != std::string::npos);
+}

@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
+#include "output_file.hpp"
 #include "bench_runs.hpp"
 #include "fidelity_chart.hpp"
 #include "peer_comparison.hpp"
@@ -131,7 +132,7 @@ int run_bench(const Options& o) {
   j["quick"] = o.quick;
   j["wall_seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   const std::string json_path = o.json_file.empty() ? o.out + "/bench.json" : o.json_file;
-  std::ofstream(json_path) << j.dump(2) << '\n';
+  output::write_file(json_path, j.dump(2) + "\n");
 
   // Summary table.
   std::printf("\n== excavator-bench %s (CSV, PNG and JSON in %s) ==\n", o.quick ? "--quick" : "", o.out.c_str());

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "bench_common.hpp"
+#include "output_file.hpp"
 
 namespace exc::bench {
 
@@ -87,7 +88,7 @@ std::vector<FidelityRow> fidelity_chart(const std::vector<BenchScene>& scenes, d
 }
 
 void write_fidelity_csv(const std::string& path, const std::vector<FidelityRow>& rows) {
-  std::ofstream f(path);
+  std::ofstream f = output::open_file(path);
   f << "scene,fidelity,ok,cpu_s_per_sim_s,tip_rms_m,force_rel,tracking_rms,tracking_diff,within_tolerance,"
        "recommended,failure\n";
   for (const FidelityRow& r : rows) {
@@ -96,6 +97,7 @@ void write_fidelity_csv(const std::string& path, const std::vector<FidelityRow>&
     f << r.scene << ',' << r.fidelity << ',' << r.ok << ',' << r.cpu_per_s << ',' << r.tip_rms << ',' << r.force_rel << ','
       << r.tracking << ',' << r.tracking_diff << ',' << r.within << ',' << r.recommended << ",\"" << failure << "\"\n";
   }
+  output::finish_file(f, path);
 }
 
 }  // namespace exc::bench

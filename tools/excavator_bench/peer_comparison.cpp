@@ -8,6 +8,7 @@
 
 #include "control/make_controller.hpp"
 #include "mjcf_export.hpp"
+#include "output_file.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
 #ifdef EXC_HAVE_MUJOCO
@@ -98,10 +99,7 @@ void run_mujoco(const BenchScene& s, const EffortProfile& profile, const OpenLoo
                 const std::string& out_dir, const std::function<double()>& plant_pass, PeerResult& out) {
   const Model model = build_model(s.scene.machine);
   const std::string xml_path = out_dir + "/" + s.name + ".mjcf.xml";
-  {
-    std::ofstream f(xml_path);
-    f << export_mjcf(model, profile.q_a0);
-  }
+  output::write_file(xml_path, export_mjcf(model, profile.q_a0));
   std::string error;
   std::unique_ptr<MujocoPeer> peer = MujocoPeer::load(model, xml_path, error);
   if (!peer) {
@@ -228,9 +226,9 @@ std::vector<PeerResult> peer_comparison(const std::vector<BenchScene>& scenes,
 }
 
 void write_peer_csvs(const std::string& dir, const std::vector<PeerResult>& peers) {
-  std::ofstream f(dir + "/peer.csv");
+  std::ofstream f = output::open_file(dir + "/peer.csv");
   f << "scene,engine,step_us,constraint_error_m,tip_rms_vs_reference_m,inverse_us,status\n";
-  std::ofstream t(dir + "/peer_tip.csv");
+  std::ofstream t = output::open_file(dir + "/peer_tip.csv");
   t << "scene,t,reference_x,reference_z,plant_x,plant_z,mujoco_x,mujoco_z\n";
   for (const PeerResult& p : peers) {
     f << p.scene << ",plant," << p.plant_step_us << ',' << p.constraint_error << ',' << p.tip_rms << ','
@@ -248,6 +246,8 @@ void write_peer_csvs(const std::string& dir, const std::vector<PeerResult>& peer
         << xz(p.ours_tip) << ',' << xz(p.mujoco_tip) << '\n';
     }
   }
+  output::finish_file(f, dir + "/peer.csv");
+  output::finish_file(t, dir + "/peer_tip.csv");
 }
 
 }  // namespace exc::bench

@@ -9,6 +9,7 @@
 
 #include "app/firmware_node.hpp"
 #include "bench_common.hpp"
+#include "output_file.hpp"
 #include "harness/lockstep_run.hpp"
 #include "sim_plant/plant.hpp"
 
@@ -202,7 +203,7 @@ PressureChart pressure_integration(const std::vector<ValveInput>& inputs, const 
 }
 
 void write_pressure_csv(const std::string& path, const PressureChart& chart) {
-  std::ofstream f(path);
+  std::ofstream f = output::open_file(path);
   f << "input,method,step_s,ok,cpu_s_per_sim_s,tip_rms_m,pressure_rms_Pa,iterations_per_substep,cavitation_s,"
        "failed_at_s,failure\n";
   f.precision(6);
@@ -214,6 +215,7 @@ void write_pressure_csv(const std::string& path, const PressureChart& chart) {
       << p.tip_rms << ',' << p.pressure_rms << ',' << p.iterations << ',' << p.cavitation << ',' << p.failed_at
       << ",\"" << failure << "\"\n";
   }
+  output::finish_file(f, path);
 }
 
 }  // namespace exc::bench

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "bench_common.hpp"
+#include "output_file.hpp"
 #include "sweep.hpp"
 
 namespace exc::bench {
@@ -185,20 +186,22 @@ StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& s
 
 void write_stability_csvs(const std::string& dir, const std::vector<StepStability>& steps,
                           const std::vector<ControlStability>& control) {
-  std::ofstream f(dir + "/stability_step.csv");
+  std::ofstream f = output::open_file(dir + "/stability_step.csv");
   f << "method,axis,value,largest_stable_step_s,failure_at_next_larger_step\n";
   for (const StepStability& r : steps) {
     std::string failure = r.failure_above;
     std::replace(failure.begin(), failure.end(), ',', ';');
     f << r.method << ',' << r.axis << ',' << r.value << ',' << r.largest_stable_step << ",\"" << failure << "\"\n";
   }
-  std::ofstream g(dir + "/stability_control.csv");
+  output::finish_file(f, dir + "/stability_step.csv");
+  std::ofstream g = output::open_file(dir + "/stability_control.csv");
   g << "controller,axis,value,ok,tracking_rms_worst,failure\n";
   for (const ControlStability& r : control) {
     std::string failure = r.failure;
     std::replace(failure.begin(), failure.end(), ',', ';');
     g << r.controller << ',' << r.axis << ',' << r.value << ',' << r.ok << ',' << r.tracking << ",\"" << failure << "\"\n";
   }
+  output::finish_file(g, dir + "/stability_control.csv");
 }
 
 }  // namespace exc::bench

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "bench_common.hpp"
+#include "output_file.hpp"
 
 namespace exc::bench {
 
@@ -57,7 +58,7 @@ std::vector<WorkPoint> work_precision(const std::vector<BenchScene>& scenes, con
 }
 
 void write_work_csv(const std::string& path, const std::vector<WorkPoint>& points) {
-  std::ofstream f(path);
+  std::ofstream f = output::open_file(path);
   f << "scene,method,step_s,ok,cpu_s_per_sim_s,tip_rms_m,constraint_residual_m,energy_drift_J,pareto,failure\n";
   f.precision(6);
   for (const WorkPoint& p : points) {
@@ -67,6 +68,7 @@ void write_work_csv(const std::string& path, const std::vector<WorkPoint>& point
     f << p.scene << ',' << p.method << ',' << p.step << ',' << (p.ok ? 1 : 0) << ',' << p.cpu_per_s << ','
       << p.tip_rms << ',' << p.constraint << ',' << p.energy << ',' << (p.pareto ? 1 : 0) << ",\"" << failure << "\"\n";
   }
+  output::finish_file(f, path);
 }
 
 }  // namespace exc::bench

@@ -7,6 +7,7 @@
 
 #include "model/scene_common.hpp"
 #include "option_checks.hpp"
+#include "output_file.hpp"
 
 #include <atomic>
 #include <csignal>
@@ -260,7 +261,7 @@ int main(int argc, char** argv) {
                           {"dropped_by_channel", dropped}, {"ring_high_water", tcn.ring_high_water},
                           {"ring_capacity", tcn.ring_capacity}, {"overflow_policy", exc::telemetry::to_string(overflow)}};
       }
-      std::ofstream(json_path) << j.dump(2) << "\n";
+      exc::output::write_file(json_path, j.dump(2) + "\n");
     }
     return ok ? 0 : 1;
   } catch (const std::exception& e) {

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <stdexcept>
 
+#include "output_file.hpp"
 #include "run_report.hpp"
 #include "settings/section_reader.hpp"
 
@@ -33,7 +34,7 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   fs::create_directories(result.out_dir);
   // What the run used, every default filled in: it loads back to the same run.
-  std::ofstream(result.out_dir / "effective.yaml") << settings::emit(bundle.effective);
+  output::write_file(result.out_dir / "effective.yaml", settings::emit(bundle.effective));
   options.lcm_url =
       job.lcm_url.empty() ? "file://" + (fs::absolute(result.out_dir) / "run.lcm").string() + "?mode=w" : job.lcm_url;
 
@@ -41,8 +42,8 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   print_summary(result.summary, std::cout);
   const nlohmann::json j = to_json(result.summary);
   const fs::path summary_path = result.out_dir / "summary.json";
-  std::ofstream(summary_path) << j.dump(2) << "\n";
-  if (!job.json_path.empty()) std::ofstream(job.json_path) << j.dump(2) << "\n";
+  output::write_file(summary_path, j.dump(2) + "\n");
+  if (!job.json_path.empty()) output::write_file(job.json_path, j.dump(2) + "\n");
   result.exit_code = result.summary.all_ok ? 0 : 1;
   if (job.report && options.lcm_url.rfind("file://", 0) == 0) {
     const std::string title = bundle.name + ": " + bundle.scene.description;

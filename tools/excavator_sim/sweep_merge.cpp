@@ -9,6 +9,7 @@
 #include <regex>
 #include <stdexcept>
 
+#include "output_file.hpp"
 #include "run_report.hpp"
 #include "fault_campaign.hpp"
 #include "sweep.hpp"
@@ -124,7 +125,7 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
                                                              {"soil_stiffness", &spec.soil_stiffness},
                                                              {"position_noise", &spec.position_noise},
                                                              {"delay_cycles", &spec.delay_cycles}};
-  std::ofstream csv(out_dir / "sweep.csv");
+  std::ofstream csv = output::open_file(out_dir / "sweep.csv");
   csv << "case";
   if (spec.scenes.size() > 1) csv << ",scene";
   if (!spec.variants.empty()) csv << ",variant";
@@ -202,10 +203,10 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
     grids.push_back(axes);
   }
   summary["chart"] = {{"runs", runs}, {"grids", grids}, {"search", spec.search.knob}, {"variants", !spec.variants.empty()}};
-  std::ofstream(out_dir / "sweep.json") << summary.dump(2) << "\n";
-  csv.close();
+  output::write_file(out_dir / "sweep.json", summary.dump(2) + "\n");
+  output::finish_file(csv, out_dir / "sweep.csv");
   if (charts && spec.records("robustness") && !spec.variants.empty()) {
-    std::ofstream(out_dir / "robustness.json") << robustness_rows(spec, cases).dump(2) << "\n";
+    output::write_file(out_dir / "robustness.json", robustness_rows(spec, cases).dump(2) + "\n");
     if (plot_robustness(out_dir / "robustness.json", out_dir) != 0) {
       std::fprintf(stderr, "sweep merge: the robustness chart failed (%s)\n", (out_dir / "robustness.png").c_str());
       outcome.charts_ok = false;

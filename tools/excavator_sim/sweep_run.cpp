@@ -8,6 +8,7 @@
 
 #include "control/controller_kinds.hpp"
 #include "fault_campaign.hpp"
+#include "output_file.hpp"
 #include "run_report.hpp"
 #include "sweep.hpp"
 
@@ -140,8 +141,7 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c) {
 int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path& out, bool progress,
                     const SweepRunner& runner) {
   if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
-  std::ofstream file(out);
-  if (!file) throw std::runtime_error("cannot write " + out.string());
+  std::ofstream file = output::open_file(out);
   // A fault the scenes cannot take (pump_loss without the hydraulic machine) before any run.
   if (!spec.faults.empty())
     for (const std::string& scene : spec.scenes) check_faults_fit(spec.faults, cached_scene(scene));
@@ -149,10 +149,11 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
   const int total = spec.total_cases();
   for (int id = shard; id < total; id += shards) {
     file << runner(spec, sweep_case(spec, id)).dump() << "\n";
-    file.flush();  // a shard that dies keeps the cases it finished
+    if (!file.flush()) output::finish_file(file, out);  // a shard that dies keeps the cases it finished; throws
     ++done;
     if (progress && done % 10 == 0) std::fprintf(stderr, "sweep shard %d/%d: %d cases done\n", shard, shards, done);
   }
+  output::finish_file(file, out);
   return done;
 }
 

@@ -1,0 +1,44 @@
+#pragma once
+// The programs' output files. An std::ofstream that failed to open swallows every write, so a
+// summary sent to a directory that does not exist was lost while the program exited 0. These throw
+// std::runtime_error naming the file instead; the programs' handlers turn that into a non-zero exit.
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+
+namespace exc::output {
+
+namespace detail {
+inline std::runtime_error cannot_write(const std::filesystem::path& path, int error) {
+  return std::runtime_error(path.string() + ": cannot write" + (error != 0 ? std::string(" (") + std::strerror(error) + ")" : ""));
+}
+}  // namespace detail
+
+// A file opened for writing (truncated), or an exception naming it.
+inline std::ofstream open_file(const std::filesystem::path& path) {
+  errno = 0;
+  std::ofstream f(path);
+  if (!f) throw detail::cannot_write(path, errno);
+  return f;
+}
+
+// A file written in pieces, flushed, checked and closed; throws when any write failed (disk full).
+inline void finish_file(std::ofstream& f, const std::filesystem::path& path) {
+  errno = 0;
+  f.flush();
+  if (!f) throw detail::cannot_write(path, errno);
+  f.close();
+  if (!f) throw detail::cannot_write(path, errno);
+}
+
+// The whole of `text` in the file at `path`, or an exception naming it.
+inline void write_file(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream f = open_file(path);
+  f << text;
+  finish_file(f, path);
+}
+
+}  // namespace exc::output
