@@ -48,12 +48,13 @@ int main(int argc, char** argv) {
   doctest::Context context(argc, argv);
   const int result = context.run();
   if (context.shouldExit() || !g_run_ended) return result;  // --help, --list-test-cases and the like
+  const char* program = argc > 0 ? argv[0] : "test";
   if (g_cases_run == 0) {
-    std::fprintf(stderr, "%s: no test case matches the filters given; nothing was tested\n", argc > 0 ? argv[0] : "test");
+    std::fprintf(stderr, "%s: no test case matches the filters given; nothing was tested\n", program);
     return result != 0 ? result : 1;
   }
   for (const std::string& name : g_assertless)
-    std::fprintf(stderr, "%s: test case '%s' asserted nothing: it cannot fail\n", argc > 0 ? argv[0] : "test", name.c_str());
+    std::fprintf(stderr, "%s: test case '%s' asserted nothing: it cannot fail\n", program, name.c_str());
   if (!g_assertless.empty()) return result != 0 ? result : 1;
   return result;
 }

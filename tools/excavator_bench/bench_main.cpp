@@ -14,9 +14,9 @@
 #include <nlohmann/json.hpp>
 
 #include "bench_common.hpp"
-#include "output_file.hpp"
 #include "bench_runs.hpp"
 #include "fidelity_chart.hpp"
+#include "output_file.hpp"
 #include "peer_comparison.hpp"
 #include "pressure_integration.hpp"
 #include "stability_map.hpp"

@@ -9,8 +9,8 @@
 
 #include "app/firmware_node.hpp"
 #include "bench_common.hpp"
-#include "output_file.hpp"
 #include "harness/lockstep_run.hpp"
+#include "output_file.hpp"
 #include "sim_plant/plant.hpp"
 
 namespace exc::bench {

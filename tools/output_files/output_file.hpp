@@ -25,11 +25,17 @@ inline std::ofstream open_file(const std::filesystem::path& path) {
   return f;
 }
 
-// A file written in pieces, flushed, checked and closed; throws when any write failed (disk full).
-inline void finish_file(std::ofstream& f, const std::filesystem::path& path) {
+// What has been written so far on its way to the file (a shard keeps each case it finished), or an
+// exception naming it when a write failed (disk full).
+inline void flush_file(std::ofstream& f, const std::filesystem::path& path) {
   errno = 0;
   f.flush();
   if (!f) throw detail::cannot_write(path, errno);
+}
+
+// A file written in pieces, flushed, checked and closed; throws when any write failed.
+inline void finish_file(std::ofstream& f, const std::filesystem::path& path) {
+  flush_file(f, path);
   f.close();
   if (!f) throw detail::cannot_write(path, errno);
 }
