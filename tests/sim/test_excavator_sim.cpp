@@ -833,12 +833,15 @@ TEST_CASE("tools/excavator-sim: the hydraulic dig run for 40 s holds its final p
   }
 }
 
-TEST_CASE("tools/excavator-sim: an output file that cannot be written is an error naming it (run --json, sweep-merge's table), not a quiet success") {
+TEST_CASE("tools/excavator-sim: an output file that cannot be written is an error naming it (run --json before the run, sweep-merge's table, excavator-firmware --json before the bus), not a quiet success") {
   // --json into a directory that does not exist: the run itself tracked, the summary is lost.
   const Run json = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out --json no/such/dir/run.json");
   INFO(json.err);
   CHECK(json.status == 2);
   CHECK(json.err.find("no/such/dir/run.json: cannot write") != std::string::npos);
+  // ...refused before the run: no log, no summary, no tracking printed.
+  CHECK_FALSE(fs::exists(json.dir / "out" / "run.lcm"));
+  CHECK_FALSE(fs::exists(json.dir / "out" / "summary.json"));
   // The control: the same run with a writable path writes it and exits 0.
   const Run ok = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out --json run.json");
   CHECK(ok.status == 0);
@@ -854,4 +857,21 @@ TEST_CASE("tools/excavator-sim: an output file that cannot be written is an erro
   CHECK(WIFEXITED(merged));
   CHECK(WEXITSTATUS(merged) == 2);
   CHECK(read_text_file(dir / "merge.err").find("sweep.csv: cannot write") != std::string::npos);
+  // excavator-firmware's --json too is refused before the bus is opened: with an interface that does
+  // not exist, the unwritable path is what it names; the control (a writable path) gets to the bus.
+  const std::string firmware = in_dir + EXC_FIRMWARE_TOOL + " --can exc_no_such_if --scene " + kDig;
+  const int fw_bad = std::system((firmware + " --json no/such/dir/fw.json > /dev/null 2> fw_bad.err").c_str());
+  const std::string fw_bad_err = read_text_file(dir / "fw_bad.err");
+  INFO(fw_bad_err);
+  CHECK(WIFEXITED(fw_bad));
+  CHECK(WEXITSTATUS(fw_bad) == 2);
+  CHECK(fw_bad_err.find("no/such/dir/fw.json: cannot write") != std::string::npos);
+  CHECK(fw_bad_err.find("exc_no_such_if") == std::string::npos);
+  const int fw_good = std::system((firmware + " --json fw.json > /dev/null 2> fw_good.err").c_str());
+  const std::string fw_good_err = read_text_file(dir / "fw_good.err");
+  INFO(fw_good_err);
+  CHECK(WIFEXITED(fw_good));
+  CHECK(WEXITSTATUS(fw_good) != 0);
+  CHECK(fw_good_err.find("exc_no_such_if") != std::string::npos);
+  CHECK(fw_good_err.find("cannot write") == std::string::npos);
 }

@@ -123,6 +123,10 @@ int main(int argc, char** argv) {
     }
     const double wait_ms = sensor_timeout_ms > 0 ? sensor_timeout_ms : (realtime ? rt_wait_ms : 250.0);
 
+    // The summary's file is opened before the bus: a path that cannot be written costs no run.
+    std::ofstream json_file;
+    if (!json_path.empty()) json_file = exc::output::open_file(json_path);
+
     exc::app::NodeIo io;
     std::string error;
     // Real time: a full telemetry ring must not stall the loop (refused and counted); lockstep has
@@ -261,7 +265,8 @@ int main(int argc, char** argv) {
                           {"dropped_by_channel", dropped}, {"ring_high_water", tcn.ring_high_water},
                           {"ring_capacity", tcn.ring_capacity}, {"overflow_policy", exc::telemetry::to_string(overflow)}};
       }
-      exc::output::write_file(json_path, j.dump(2) + "\n");
+      json_file << j.dump(2) << "\n";
+      exc::output::finish_file(json_file, json_path);
     }
     return ok ? 0 : 1;
   } catch (const std::exception& e) {

@@ -17,6 +17,7 @@
 
 #include "control/controller_kinds.hpp"
 #include "in_process_run.hpp"
+#include "output_file.hpp"
 #include "robustness.hpp"
 #include "paper_report.hpp"
 #include "run_report.hpp"
@@ -172,20 +173,21 @@ int main(int argc, char** argv) {
       options.duration_override = robust_duration;
       options.progress = !robust_quiet;
       const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(spec.scenes.front());
-      const auto rows = exc::sim::run_robustness(spec, options);
-      exc::sim::print_robustness(rows, std::cout);
+      // Both output files are opened before the variants run: a path that cannot be written costs no run time.
       if (robust_out.empty()) robust_out = (fs::path("out") / (bundle.name + "-robustness")).string();
       fs::create_directories(robust_out);
       const fs::path table = fs::path(robust_out) / "robustness.json";
+      std::ofstream table_file = exc::output::open_file(table);
+      std::ofstream json_file;
+      if (!robust_json.empty()) json_file = exc::output::open_file(robust_json);
+      const auto rows = exc::sim::run_robustness(spec, options);
+      exc::sim::print_robustness(rows, std::cout);
       const std::string text = exc::sim::robustness_json(rows).dump(2) + "\n";
-      for (const std::string& path : {table.string(), robust_json}) {
-        if (path.empty()) continue;
-        std::ofstream f(path);
-        f << text;
-        if (!f) {
-          std::cerr << "excavator-sim: cannot write " << path << "\n";
-          return 2;
-        }
+      table_file << text;
+      exc::output::finish_file(table_file, table);
+      if (!robust_json.empty()) {
+        json_file << text;
+        exc::output::finish_file(json_file, robust_json);
       }
       if (!robust_no_plots) {
         const int rc = exc::sim::plot_robustness(table, robust_out);

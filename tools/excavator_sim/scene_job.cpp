@@ -32,6 +32,9 @@ SceneJobResult run_scene_job(const SceneJob& job) {
                             ? std::vector<std::string>{"pid", "adaptive", "flow"}
                             : std::vector<std::string>{"pid", "adaptive"};
   result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
+  // The --json file is opened before the run, so a path that cannot be written costs no run time.
+  std::ofstream json_file;
+  if (!job.json_path.empty()) json_file = output::open_file(job.json_path);
   fs::create_directories(result.out_dir);
   // What the run used, every default filled in: it loads back to the same run.
   output::write_file(result.out_dir / "effective.yaml", settings::emit(bundle.effective));
@@ -43,7 +46,10 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   const nlohmann::json j = to_json(result.summary);
   const fs::path summary_path = result.out_dir / "summary.json";
   output::write_file(summary_path, j.dump(2) + "\n");
-  if (!job.json_path.empty()) output::write_file(job.json_path, j.dump(2) + "\n");
+  if (!job.json_path.empty()) {
+    json_file << j.dump(2) << "\n";
+    output::finish_file(json_file, job.json_path);
+  }
   result.exit_code = result.summary.all_ok ? 0 : 1;
   if (job.report && options.lcm_url.rfind("file://", 0) == 0) {
     const std::string title = bundle.name + ": " + bundle.scene.description;
