@@ -86,7 +86,7 @@ TEST_CASE("model/Ad and ad agree with conjugation and the matrix commutator") {
   }
 }
 
-TEST_CASE("model/the duals Ad* and ad* preserve power V . F") {
+TEST_CASE("model/the dual adjoints (Ad transposed, ad transposed) preserve power V . F") {
   for (int trial = 0; trial < 50; ++trial) {
     const SE3 T = random_pose();
     const Twist V = random_twist();  // a twist in the parent frame A

@@ -143,7 +143,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   CHECK(r.safe_stops == 0);
 }
 
-TEST_CASE("plant/hydraulics: a full-speed boom-down cavitates exactly where it falls faster than the pump and the make-up valves fill its rod side, v* = v_max + Q_makeup(p_tank) / A_B") {
+TEST_CASE("plant/hydraulics: a full-speed boom-down cavitates exactly where it falls faster than the pump and the make-up valves fill its rod side, at v_max + Q_makeup(p_tank) / A_B") {
   // Valve fully open downwards: the boom's weight drives it faster than the pump's A_B v_max fills
   // the rod side; the make-up valves supply the rest from the tank line, at most their sizing flow
   // scaled by the orifice law, Q_makeup = Q_pump f(p_tank - p_vapour) / f(dp_mk) (f linear below
