@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "scratch_files.hpp"
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -27,8 +28,8 @@ struct Row {
 }  // namespace
 
 TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the nodes account for the loop") {
-  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "bench" / ("loop_split_" + std::to_string(getpid()));
-  fs::create_directories(dir);
+  const fs::path dir =
+      exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "bench" / ("loop_split_" + std::to_string(getpid())));
   const std::string cmd = std::string(EXC_LOOP_BENCH_EXE) +
                           " --split --split-duration 0.5 --duration 0.2 --repeats 1 --no-pin > '" +
                           (dir / "out.txt").string() + "' 2> '" + (dir / "err.txt").string() + "'";

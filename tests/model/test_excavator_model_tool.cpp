@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "model_fixture.hpp"
+#include "scratch_files.hpp"
 
 namespace {
 
@@ -25,6 +26,7 @@ Run run_tool(const std::string& args, const std::string& input) {
   static int call = 0;
   const std::string base = std::string(EXC_BINARY_DIR) + "/tests/model/tool_run_" + std::to_string(getpid()) + "_" +
                            std::to_string(call++);
+  for (const char* ext : {".in", ".out", ".err"}) exc::test::scratch_file(base + ext);
   { std::ofstream(base + ".in") << input; }
   const std::string cmd = std::string(EXC_MODEL_TOOL) + " " + args + " < " + base + ".in > " + base + ".out 2> " + base + ".err";
   const int raw = std::system(cmd.c_str());
@@ -148,7 +150,8 @@ TEST_CASE("tools/excavator-model --help and --machine") {
   CHECK(same.status == 0);
   CHECK(same.out == builtin.out);
 
-  const std::string bad = std::string(EXC_BINARY_DIR) + "/tests/model/bad_machine_" + std::to_string(getpid()) + ".yaml";
+  const std::string bad =
+      exc::test::scratch_file(std::string(EXC_BINARY_DIR) + "/tests/model/bad_machine_" + std::to_string(getpid()) + ".yaml");
   { std::ofstream(bad) << "name: x\ngravity: -3\n"; }
   const Run bad_run = run_tool("--machine " + bad + " fk", "0 2 2 2\n");
   CHECK(bad_run.status == 2);

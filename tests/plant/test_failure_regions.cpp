@@ -21,6 +21,7 @@
 #include "hal/memory_bus.hpp"
 #include "harness/lockstep_run.hpp"
 #include "plant_scenes.hpp"
+#include "scratch_files.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "telemetry/lcm_output.hpp"
 
@@ -79,8 +80,8 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   Scenario s = move("[0.0, 2.10, 3.00, 2.30]", "[0.0, 2.50, 2.40, 1.90]", 2.0);
   const Machine& m = s.scene.machine;
   const double pumps = m.hydraulics.pump_flow, dt = s.scene.cycle;
-  const fs::path log_path = fs::path(EXC_BINARY_DIR) / "tests" / ("saturation_" + std::to_string(getpid()) + ".lcm");
-  fs::create_directories(log_path.parent_path());
+  const fs::path log_path =
+      exc::test::scratch_file(fs::path(EXC_BINARY_DIR) / "tests" / ("saturation_" + std::to_string(getpid()) + ".lcm"));
   std::string error;
   sim::LockstepOptions o;
   o.telemetry = telemetry::LcmOutput::open("file://" + log_path.string() + "?mode=w", &error);

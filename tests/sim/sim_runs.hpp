@@ -12,6 +12,7 @@
 #include <utility>
 #include <vector>
 
+#include "scratch_files.hpp"
 #include "text_file.hpp"
 
 namespace exc::test {
@@ -24,13 +25,12 @@ struct Run {
   fs::path dir;
 };
 
-// Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel).
+// Runs excavator-sim with 'args' in a fresh directory of its own (test cases run in parallel),
+// removed when the test process passes.
 inline Run run_sim(const std::string& args) {
   static int call = 0;
   Run r;
-  r.dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("run_" + std::to_string(getpid()) + "_" + std::to_string(call++));
-  fs::remove_all(r.dir);
-  fs::create_directories(r.dir);
+  r.dir = scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("run_" + std::to_string(getpid()) + "_" + std::to_string(call++)));
   const std::string cmd = "cd '" + r.dir.string() + "' && " + EXC_SIM_TOOL + " " + args + " > out.txt 2> err.txt";
   const int raw = std::system(cmd.c_str());
   r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -44,7 +44,7 @@ inline const std::string kDig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml"
 inline const std::string kPaperDig = std::string(EXC_SOURCE_DIR) + "/scenes/paper_dig.yaml";
 
 // A shipped scene with edits (each must apply exactly once), written next to the test's runs under a
-// name of this process; returns its path.
+// name of this process (a scratch file); returns its path.
 inline fs::path edited_scene(const std::string& scene, const std::vector<std::pair<std::string, std::string>>& edits,
                              const std::string& stem) {
   std::string text = read_text_file(scene);
@@ -54,9 +54,7 @@ inline fs::path edited_scene(const std::string& scene, const std::vector<std::pa
     REQUIRE(text.find(from, pos + 1) == std::string::npos);
     text.replace(pos, from.size(), to);
   }
-  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
-  fs::create_directories(dir);
-  const fs::path path = dir / (stem + "_" + std::to_string(getpid()) + ".yaml");
+  const fs::path path = scratch_file(fs::path(EXC_BINARY_DIR) / "tests" / "sim" / (stem + "_" + std::to_string(getpid()) + ".yaml"));
   std::ofstream(path) << text;
   return path;
 }

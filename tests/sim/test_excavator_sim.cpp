@@ -279,8 +279,7 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
   REQUIRE(pos != std::string::npos);
   text.replace(pos, from.size(), "    - {t: 2.5, q: [2.0, 2.70, 2.60, 1.90]}");
   const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
-  fs::create_directories(dir);
-  const fs::path refused = dir / ("fast_swing_" + std::to_string(getpid()) + ".yaml");
+  const fs::path refused = exc::test::scratch_file(dir / ("fast_swing_" + std::to_string(getpid()) + ".yaml"));
   std::ofstream(refused) << text;
   const Run r = run_sim("run " + refused.string() + " --quiet --no-report");
   INFO(r.err);
@@ -293,7 +292,7 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
   const auto at = forced_text.find(type);
   REQUIRE(at != std::string::npos);
   forced_text.insert(at + type.size(), "\n  efforts: {check: false}");
-  const fs::path forced = dir / ("fast_swing_forced_" + std::to_string(getpid()) + ".yaml");
+  const fs::path forced = exc::test::scratch_file(dir / ("fast_swing_forced_" + std::to_string(getpid()) + ".yaml"));
   std::ofstream(forced) << forced_text;
   const Run f = run_sim("run " + forced.string() + " --quiet --no-report --json summary.json");
   INFO(f.err);
@@ -354,8 +353,8 @@ TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback reco
                   "ip link set lo multicast on; ip route add 239.255.0.0/16 dev lo (tools/install-deps test does)");
   const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim";
   fs::create_directories(dir);
-  const fs::path log_path = (fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : dir) /
-                            ("exc-main-job-" + std::to_string(getpid()) + ".lcm");
+  const fs::path log_path = exc::test::scratch_file((fs::is_directory("/dev/shm") ? fs::path("/dev/shm") : dir) /
+                                         ("exc-main-job-" + std::to_string(getpid()) + ".lcm"));
   fs::remove(log_path);
   const std::string log_arg = log_path.string(), url_arg = "--lcm-url=" + url;
   const char* argv[] = {"lcm-logger", "-f", "-q", url_arg.c_str(), log_arg.c_str(), nullptr};

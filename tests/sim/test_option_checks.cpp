@@ -12,6 +12,7 @@
 
 #include "model/scene_common.hpp"
 #include "option_checks.hpp"
+#include "scratch_files.hpp"
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -38,8 +39,8 @@ struct Exit {
 };
 
 Exit run(const std::string& command) {
-  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("option_checks_" + std::to_string(getpid()));
-  fs::create_directories(dir);
+  static const fs::path dir =
+      exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("option_checks_" + std::to_string(getpid())));
   const std::string cmd = "cd '" + dir.string() + "' && " + command + " > out.txt 2> err.txt";
   const int raw = std::system(cmd.c_str());
   Exit e;

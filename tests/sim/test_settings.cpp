@@ -20,6 +20,7 @@
 #include "harness/lockstep_run.hpp"
 #include "settings/section_reader.hpp"
 #include "sweep_tables.hpp"
+#include "scratch_files.hpp"
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -66,10 +67,7 @@ Run run(const std::string& command, const fs::path& dir) {
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::path(EXC_BINARY_DIR) / "tests" / "sim" / (name + "_" + std::to_string(getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
+  return exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" / (name + "_" + std::to_string(getpid())));
 }
 
 const char* const kScenes[] = {"dig.yaml", "free_motion.yaml", "truck_loading.yaml"};

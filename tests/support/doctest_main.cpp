@@ -1,13 +1,16 @@
 // The tests' main: doctest's own, plus two refusals. ctest runs each case by name
 // (--test-case=NAME); a name that no longer matches (a ';' in it splits the ctest entry, a renamed
 // case) would run nothing and pass: a run that passed no case through its filters fails instead. And
-// a case that asserted nothing (a stub, an early return) fails: a test must be able to fail.
+// a case that asserted nothing (a stub, an early return) fails: a test must be able to fail. Last,
+// the files the cases registered (scratch_files.hpp) are removed if the run passed.
 #define DOCTEST_CONFIG_IMPLEMENT
 #include <doctest/doctest.h>
 
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "scratch_files.hpp"
 
 namespace {
 
@@ -42,13 +45,7 @@ struct FilterCount : doctest::IReporter {
 
 REGISTER_LISTENER("filter_count", 1, FilterCount);
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  doctest::Context context(argc, argv);
-  const int result = context.run();
-  if (context.shouldExit() || !g_run_ended) return result;  // --help, --list-test-cases and the like
-  const char* program = argc > 0 ? argv[0] : "test";
+int verdict(int result, const char* program) {
   if (g_cases_run == 0) {
     std::fprintf(stderr, "%s: no test case matches the filters given; nothing was tested\n", program);
     return result != 0 ? result : 1;
@@ -57,4 +54,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "%s: test case '%s' asserted nothing: it cannot fail\n", program, name.c_str());
   if (!g_assertless.empty()) return result != 0 ? result : 1;
   return result;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  doctest::Context context(argc, argv);
+  const int result = context.run();
+  if (context.shouldExit() || !g_run_ended) return result;  // --help, --list-test-cases and the like
+  const int code = verdict(result, argc > 0 ? argv[0] : "test");
+  // The files the cases wrote: gone when the run passed, kept (and named) when it failed.
+  exc::test::finish_scratch_files(code == 0);
+  return code;
 }

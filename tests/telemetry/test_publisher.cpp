@@ -29,6 +29,7 @@
 #include "exlcm/machine_state_t.hpp"
 #include "exlcm/telemetry_stats_t.hpp"
 #include "exlcm/timing_t.hpp"
+#include "scratch_files.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
 extern char** environ;
@@ -42,8 +43,7 @@ using exc::telemetry::TelemetryPublisher;
 namespace {
 
 fs::path temp_path(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("exc-telemetry-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
+  static const fs::path dir = exc::test::scratch_dir(fs::temp_directory_path() / ("exc-telemetry-" + std::to_string(::getpid())));
   return dir / name;
 }
 
