@@ -118,10 +118,11 @@ void SectionReader::rethrow_placed(const SettingsError& e) const {
     if (rest.compare(0, path_.size(), path_) != 0) throw e;
     rest = rest.substr(path_.size());
   }
+  YAML::Mark mark = mark_;
+  if (!in_.IsDefined()) fail_at(mark, e.field(), e.reason());  // an absent section: at its parent's line
   // (Node::reset rebinds a handle; assigning one would overwrite the document's node.)
   YAML::Node node;
   node.reset(in_);
-  YAML::Mark mark = mark_;
   while (!rest.empty() && node.IsDefined() && !node.IsNull()) {
     YAML::Node next;
     if (rest[0] == '.') {
@@ -129,7 +130,11 @@ void SectionReader::rethrow_placed(const SettingsError& e) const {
       const std::string key = rest.substr(1, end == std::string::npos ? std::string::npos : end - 1);
       if (!node.IsMap()) break;
       const YAML::Node& map = node;
-      next.reset(map[key]);
+      // A key the file does not have (a generated field such as task.cycle) gives an invalid node,
+      // which reset() refuses with yaml-cpp's own exception: stop at the section's line instead.
+      const YAML::Node child = map[key];
+      if (!child.IsDefined()) break;
+      next.reset(child);
       rest = end == std::string::npos ? "" : rest.substr(end);
     } else if (rest[0] == '[') {
       const std::size_t end = rest.find(']');

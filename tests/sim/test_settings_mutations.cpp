@@ -1,0 +1,230 @@
+// Seeded mutations of every shipped scene and of the machine file, loaded as excavator-sim loads
+// them and, when accepted, run for 3 s (past the start-up, into the task): each is refused with an error naming its file, or
+// it runs and ends ok with finite figures or says why it failed. Never a crash, an exception that is
+// not a std::exception, a message without the file, or a NaN in an accepted run's figures.
+#include <doctest/doctest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <regex>
+#include <string>
+#include <vector>
+
+#include "harness/lockstep_run.hpp"
+#include "scratch_files.hpp"
+#include "text_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Values a typing slip, a copy from another unit or a hostile file puts where a number belongs.
+const char* const kValues[] = {"0",     "-1",    "-0.001", "1e308", "-1e308", "1e-320", ".nan", ".inf",
+                               "-.inf", "1e400", "abc",    "[]",    "{}",     "~",      "\"1\"", "2.5e3",
+                               "[1, 2]", "0x10", "1_000",  "true",  "-7",     "1e6",    "3",     "-3"};
+
+struct Mutant {
+  std::string text;
+  std::string what;  // the mutation, for the failure message
+};
+
+// One mutation of `text`: a number replaced by one of kValues, a line deleted or repeated, a key
+// misspelt, or the file cut short.
+Mutant mutate(const std::string& text, std::mt19937_64& rng) {
+  std::vector<std::string> lines;
+  {
+    std::size_t start = 0;
+    while (start <= text.size()) {
+      const std::size_t end = text.find('\n', start);
+      lines.push_back(text.substr(start, end == std::string::npos ? std::string::npos : end - start));
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+  }
+  auto join = [&]() {
+    std::string out;
+    for (const std::string& l : lines) out += l + "\n";
+    return out;
+  };
+  auto pick = [&](std::size_t n) { return std::uniform_int_distribution<std::size_t>(0, n - 1)(rng); };
+  const int kind = static_cast<int>(pick(10));
+  if (kind < 6) {
+    // A number (outside comments) replaced.
+    static const std::regex number(R"([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)");
+    std::vector<std::pair<std::size_t, std::smatch>> found;
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      const std::string code = lines[i].substr(0, lines[i].find('#'));
+      for (std::sregex_iterator it(code.begin(), code.end(), number), end; it != end; ++it) found.push_back({i, *it});
+    }
+    if (!found.empty()) {
+      const auto& [line, m] = found[pick(found.size())];
+      const std::string value = kValues[pick(std::size(kValues))];
+      const std::string before = lines[line];
+      lines[line] = before.substr(0, static_cast<std::size_t>(m.position())) + value +
+                    before.substr(static_cast<std::size_t>(m.position() + m.length()));
+      return {join(), "line " + std::to_string(line + 1) + ": '" + before + "' -> '" + lines[line] + "'"};
+    }
+  }
+  const std::size_t line = pick(lines.size());
+  if (kind == 6) {
+    const std::string gone = lines[line];
+    lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(line));
+    return {join(), "line " + std::to_string(line + 1) + " deleted: '" + gone + "'"};
+  }
+  if (kind == 7) {
+    lines.insert(lines.begin() + static_cast<std::ptrdiff_t>(line), lines[line]);
+    return {join(), "line " + std::to_string(line + 1) + " repeated: '" + lines[line] + "'"};
+  }
+  if (kind == 8) {
+    const std::size_t colon = lines[line].find(':');
+    if (colon != std::string::npos && colon > 0) {
+      const std::string before = lines[line];
+      lines[line].insert(colon, "x");
+      return {join(), "line " + std::to_string(line + 1) + ": key misspelt: '" + lines[line] + "'"};
+    }
+  }
+  const std::size_t cut = pick(text.size());
+  return {text.substr(0, cut), "cut after byte " + std::to_string(cut)};
+}
+
+bool run_figures_finite(const exc::sim::RunRecord& r) {
+  for (int j = 0; j < 4; ++j)
+    if (!std::isfinite(r.rms_error[j]) || !std::isfinite(r.max_error[j])) return false;
+  for (double t : r.theta_hat)
+    if (!std::isfinite(t)) return false;
+  return std::isfinite(r.peak_soil_force) && std::isfinite(r.simulated_seconds);
+}
+
+struct Tally {
+  int refused = 0, ran_ok = 0, ran_failed = 0;
+};
+
+// Loads `path` and runs it for 3 s if accepted. An error must name one of `files`: the
+// mutated file, or the scene when the mutated machine file is valid and the scene's task no longer
+// fits it.
+void check_mutant(const fs::path& path, const std::vector<fs::path>& files, const std::string& what, Tally& tally) {
+  INFO(files.front().filename().string() << ": " << what);
+  exc::sim::SceneBundle bundle;
+  try {
+    bundle = exc::sim::load_scene_bundle(path.string());
+  } catch (const std::exception& e) {
+    const std::string message = e.what();
+    INFO("error: " << message);
+    bool named = false;
+    for (const fs::path& f : files) named = named || message.find(f.string()) != std::string::npos;
+    CHECK(named);
+    ++tally.refused;
+    return;
+  } catch (...) {
+    FAIL("an exception that is not a std::exception");
+  }
+  exc::sim::LockstepOptions options;
+  options.controller = bundle.firmware.controller.kind;
+  options.duration = std::min(3.0, bundle.scene.duration);  // past the start-up, into the task
+  options.stop_at_safe_state = true;
+  try {
+    const exc::sim::RunRecord r = exc::sim::run_lockstep(bundle.scene, bundle.firmware, options);
+    INFO("run failure: " << r.failure);
+    if (r.ok) {
+      CHECK(run_figures_finite(r));
+      ++tally.ran_ok;
+    } else {
+      CHECK_FALSE(r.failure.empty());
+      if (std::getenv("EXC_MUTANTS") != nullptr) MESSAGE("failed as it should say: " << what << ": " << r.failure);
+      ++tally.ran_failed;
+    }
+  } catch (const std::exception& e) {
+    // A run may refuse what only its start can check (the initial state's assembly): said, not silent.
+    INFO("run refused: " << e.what());
+    CHECK(std::string(e.what()).size() > 0);
+    if (std::getenv("EXC_MUTANTS") != nullptr) MESSAGE("run refused: " << what << ": " << e.what());
+    ++tally.ran_failed;
+  } catch (...) {
+    FAIL("the run threw an exception that is not a std::exception");
+  }
+}
+
+// Per scene (the machine file gets twice as many). EXC_MUTANTS overrides it for a longer search.
+int mutants_per_file() {
+  const char* env = std::getenv("EXC_MUTANTS");
+  return env != nullptr ? std::max(1, std::atoi(env)) : 60;
+}
+
+}  // namespace
+
+TEST_CASE("tools/settings: seeded mutations of every shipped scene are refused naming the scene, or run 3 s with finite figures or a stated failure") {
+  const fs::path dir = exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" /
+                                              ("mutations_" + std::to_string(getpid())));
+  Tally tally;
+  std::uint64_t seed = 1;
+  for (const char* scene : {"dig.yaml", "free_motion.yaml", "truck_loading.yaml", "paper_dig.yaml", "paper_free_motion.yaml"}) {
+    const std::string text = exc::test::read_text_file(fs::path(EXC_SOURCE_DIR) / "scenes" / scene);
+    REQUIRE(!text.empty());
+    std::mt19937_64 rng(seed++);
+    for (int k = 0; k < mutants_per_file(); ++k) {
+      const Mutant m = mutate(text, rng);
+      const fs::path path = dir / ("mutant_" + std::to_string(k) + "_" + scene);
+      std::ofstream(path) << m.text;
+      check_mutant(path, {path}, m.what, tally);
+    }
+  }
+  MESSAGE("scenes: " << tally.refused << " refused, " << tally.ran_ok << " ran ok, " << tally.ran_failed << " ran and failed");
+  // The mutations reach both paths: most are refused, some are harmless edits that run.
+  CHECK(tally.refused > 0);
+  CHECK(tally.ran_ok + tally.ran_failed > 0);
+}
+
+TEST_CASE("tools/settings: seeded mutations of the machine file are refused naming it or the scene, or run 3 s with finite figures or a stated failure") {
+  const fs::path dir = exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" /
+                                              ("machine_mutations_" + std::to_string(getpid())));
+  const std::string machine = exc::test::read_text_file(fs::path(EXC_SOURCE_DIR) / "machines" / "reference-20t.yaml");
+  const std::string dig = exc::test::read_text_file(fs::path(EXC_SOURCE_DIR) / "scenes" / "dig.yaml");
+  REQUIRE(!machine.empty());
+  REQUIRE(dig.find("\nmachine:") == std::string::npos);
+  Tally tally;
+  std::mt19937_64 rng(101);
+  for (int k = 0; k < 2 * mutants_per_file(); ++k) {
+    const Mutant m = mutate(machine, rng);
+    const fs::path machine_path = dir / ("machine_" + std::to_string(k) + ".yaml");
+    const fs::path scene_path = dir / ("scene_" + std::to_string(k) + ".yaml");
+    std::ofstream(machine_path) << m.text;
+    std::ofstream(scene_path) << "machine: " << machine_path.filename().string() << "\n" << dig;
+    check_mutant(scene_path, {machine_path, scene_path}, m.what, tally);
+  }
+  MESSAGE("machine file: " << tally.refused << " refused, " << tally.ran_ok << " ran ok, " << tally.ran_failed
+                           << " ran and failed");
+  CHECK(tally.refused > 0);
+  CHECK(tally.ran_ok + tally.ran_failed > 0);
+}
+
+// Found by the mutations above: a check on a generated field (the truck cycle's knots, task.cycle)
+// was placed by looking the field up in the file, and the lookup of a key the file does not have
+// threw yaml-cpp's "invalid node" with no file, line or field.
+TEST_CASE("tools/settings: a truck cycle whose dump leaves the bucket's stroke is refused at the task's line, naming the generated cycle") {
+  const fs::path dir = exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" /
+                                              ("truck_cycle_" + std::to_string(getpid())));
+  std::string text = exc::test::read_text_file(fs::path(EXC_SOURCE_DIR) / "scenes" / "truck_loading.yaml");
+  const std::string from = "open_pitch_deg: 50";
+  const auto at = text.find(from);
+  REQUIRE(at != std::string::npos);
+  text.replace(at, from.size(), "open_pitch_deg: 1");
+  const fs::path path = dir / "truck_loading.yaml";
+  std::ofstream(path) << text;
+  std::string message;
+  try {
+    (void)exc::sim::load_scene_bundle(path.string());
+  } catch (const std::exception& e) {
+    message = e.what();
+  }
+  INFO(message);
+  CHECK(message.rfind(path.string() + ":", 0) == 0);  // file:line:column first
+  CHECK(message.find("task.cycle[") != std::string::npos);
+  CHECK(message.find("bucket cylinder length") != std::string::npos);
+  CHECK(message.find("invalid node") == std::string::npos);
+}
