@@ -7,6 +7,9 @@
 namespace exc::settings {
 
 Document Document::load(const std::string& path) {
+  // A directory opens as a stream that reads nothing: it would pass for an empty file.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw SettingsError(path, 0, 0, "", "is a directory, not a file");
   std::ifstream in(path);
   if (!in) throw SettingsError(path, 0, 0, "", "cannot open the file");
   std::ostringstream text;

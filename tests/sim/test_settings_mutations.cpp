@@ -1,5 +1,6 @@
-// Seeded mutations of every shipped scene and of the machine file, loaded as excavator-sim loads
-// them and, when accepted, run for 3 s (past the start-up, into the task): each is refused with an error naming its file, or
+// Seeded mutations of every shipped scene, of the machine file and of the sweep specs, loaded as
+// excavator-sim loads them and, when accepted, run (a scene for 3 s, past the start-up and into the
+// task; a sweep's first and last case for 0.3 s): each is refused with an error naming its file, or
 // it runs and ends ok with finite figures or says why it failed. Never a crash, an exception that is
 // not a std::exception, a message without the file, or a NaN in an accepted run's figures.
 #include <doctest/doctest.h>
@@ -18,6 +19,7 @@
 
 #include "harness/lockstep_run.hpp"
 #include "scratch_files.hpp"
+#include "sweep.hpp"
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -141,9 +143,10 @@ void check_mutant(const fs::path& path, const std::vector<fs::path>& files, cons
     }
   } catch (const std::exception& e) {
     // A run may refuse what only its start can check (the initial state's assembly): said, not silent.
-    INFO("run refused: " << e.what());
-    CHECK(std::string(e.what()).size() > 0);
-    if (std::getenv("EXC_MUTANTS") != nullptr) MESSAGE("run refused: " << what << ": " << e.what());
+    const std::string message = e.what();  // (doctest would print a char pointer's address)
+    INFO("run refused: " << message);
+    CHECK_FALSE(message.empty());
+    if (std::getenv("EXC_MUTANTS") != nullptr) MESSAGE("run refused: " << what << ": " << message);
     ++tally.ran_failed;
   } catch (...) {
     FAIL("the run threw an exception that is not a std::exception");
@@ -227,4 +230,102 @@ TEST_CASE("tools/settings: a truck cycle whose dump leaves the bucket's stroke i
   CHECK(message.find("task.cycle[") != std::string::npos);
   CHECK(message.find("bucket cylinder length") != std::string::npos);
   CHECK(message.find("invalid node") == std::string::npos);
+}
+
+namespace {
+// A sweep case's line: each controller's run ok with finite (or no) figures, or failed saying why.
+bool case_line_sound(const nlohmann::json& line, const std::vector<std::string>& controllers, std::string& why) {
+  for (const std::string& name : controllers) {
+    if (!line.contains(name)) return why = "no entry for " + name, false;
+    const nlohmann::json& run = line[name];
+    if (run.value("ok", false)) {
+      for (const char* key : {"rms_error", "max_error"})
+        if (run.contains(key))
+          for (const auto& v : run[key])
+            if (!v.is_null() && !(v.is_number() && std::isfinite(v.get<double>())))
+              return why = name + "." + key + " holds " + v.dump(), false;
+    } else if (run.value("failure", std::string()).empty()) {
+      return why = name + " failed without a reason: " + run.dump(), false;
+    }
+  }
+  return true;
+}
+}  // namespace
+
+TEST_CASE("tools/sweep: seeded mutations of every shipped sweep spec are refused naming the spec, or number their cases and run the first and last with finite figures or a stated failure") {
+  const fs::path dir = exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" /
+                                              ("sweep_mutations_" + std::to_string(getpid())));
+  const std::string scenes = (fs::path(EXC_SOURCE_DIR) / "scenes").string() + "/";
+  Tally tally;
+  std::uint64_t seed = 1001;
+  for (const auto& entry : fs::directory_iterator(fs::path(EXC_SOURCE_DIR) / "sweeps")) {
+    if (entry.path().extension() != ".yaml") continue;
+    std::string text = exc::test::read_text_file(entry.path());
+    // The specs name their scenes relative to sweeps/: the mutants live elsewhere.
+    for (std::size_t at = text.find("../scenes/"); at != std::string::npos; at = text.find("../scenes/", at))
+      text.replace(at, 10, scenes);
+    std::mt19937_64 rng(seed++);
+    const int mutants = std::max(1, mutants_per_file() / 3);
+    for (int k = 0; k < mutants; ++k) {
+      const Mutant m = mutate(text, rng);
+      const fs::path path = dir / ("mutant_" + std::to_string(k) + "_" + entry.path().filename().string());
+      std::ofstream(path) << m.text;
+      INFO(entry.path().filename().string() << ": " << m.what);
+      exc::sim::SweepSpec spec;
+      try {
+        spec = exc::sim::load_sweep_spec(path.string());
+      } catch (const std::exception& e) {
+        const std::string message = e.what();
+        INFO("error: " << message);
+        CHECK(message.find(path.string()) != std::string::npos);
+        ++tally.refused;
+        continue;
+      } catch (...) {
+        FAIL("an exception that is not a std::exception");
+      }
+      const int total = spec.total_cases();
+      REQUIRE(total > 0);
+      if (spec.run != exc::sim::SweepRun::closed_loop) {
+        (void)exc::sim::sweep_case(spec, total - 1);
+        ++tally.ran_ok;
+        continue;
+      }
+      spec.duration = 0.3;
+      for (const int id : {0, total - 1}) {
+        try {
+          const nlohmann::json line = exc::sim::run_closed_loop_case(spec, exc::sim::sweep_case(spec, id));
+          std::string why;
+          INFO("case " << id << ": " << line.dump());
+          CHECK_MESSAGE(case_line_sound(line, spec.controllers, why), why);
+          ++tally.ran_ok;
+        } catch (const std::exception& e) {
+          const std::string message = e.what();  // (doctest would print a char pointer's address)
+          INFO("case " << id << " refused: " << message);
+          CHECK_FALSE(message.empty());
+          if (std::getenv("EXC_MUTANTS") != nullptr) MESSAGE("case refused: " << m.what << ": " << message);
+          ++tally.ran_failed;
+        }
+      }
+    }
+  }
+  // Directed: a scene that is not a file is refused at the spec's line (found by the mutations: it
+  // was accepted, and the first case's run named the scene alone).
+  for (const auto& [line, problem] : {std::pair<std::string, std::string>{"scene: " + scenes + "dig.y", "no such file"},
+                                      {"scenes: [" + scenes + "dig.yaml, " + scenes + "]", "is a directory"}}) {
+    const fs::path path = dir / "bad_scene.yaml";
+    std::ofstream(path) << "sweep:\n  " << line << "\n  controllers: [pid]\n";
+    std::string message;
+    try {
+      (void)exc::sim::load_sweep_spec(path.string());
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+    INFO(message);
+    CHECK(message.rfind(path.string() + ":2:", 0) == 0);
+    CHECK(message.find(problem) != std::string::npos);
+  }
+  MESSAGE("sweep specs: " << tally.refused << " refused, " << tally.ran_ok << " cases ran, " << tally.ran_failed
+                          << " cases refused at their run");
+  CHECK(tally.refused > 0);
+  CHECK(tally.ran_ok > 0);
 }

@@ -144,10 +144,17 @@ SweepSpec load_sweep_spec(const std::string& path) {
   SweepSpec spec;
   spec.file = path;
   // One scene, or several: case i runs scene i mod their number.
+  // A scene that is not a file is refused here, at its line, not when the first case runs.
+  auto scene_problem = [](const std::string& resolved) -> std::string {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(resolved, ec)) return "";
+    return resolved + (std::filesystem::is_directory(resolved, ec) ? ": is a directory, not a scene file" : ": no such file");
+  };
   std::string scene;
   if (s.given("scene")) {
     s.text("scene", scene, "the scene file, relative to the spec");
     spec.scenes.push_back(doc.resolve(scene));
+    if (const std::string problem = scene_problem(spec.scenes.back()); !problem.empty()) s.fail("scene", problem);
   }
   if (s.given("scenes")) {
     const YAML::Node list = raw["scenes"];
@@ -155,6 +162,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
     for (std::size_t i = 0; i < list.size(); ++i) {
       if (!list[i].IsScalar()) s.fail("scenes", i, "must be a scene file");
       spec.scenes.push_back(doc.resolve(list[i].Scalar()));
+      if (const std::string problem = scene_problem(spec.scenes.back()); !problem.empty()) s.fail("scenes", i, problem);
     }
   }
   if (s.given("scene") == s.given("scenes")) s.fail_here("name the scenes: scene: FILE or scenes: [FILE, ...] (one of them)");
