@@ -5,6 +5,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -27,6 +28,7 @@
 #include "exlcm/timing_t.hpp"
 #include "lcm_schema.hpp"
 #include "log_export.hpp"
+#include "scratch_files.hpp"
 
 namespace fs = std::filesystem;
 using exc::test::LcmStruct;
@@ -407,4 +409,60 @@ TEST_CASE("tools/excavator-log info gives each channel's rate per second of the 
   CHECK(type == "unknown");
   CHECK(rate == "-");  // no time of its own to count by
   fs::remove_all(dir);
+}
+
+TEST_CASE("tools/excavator-log says how many bytes of a log cut short are in no complete event, and reads the events before them") {
+  // A logger killed mid-event leaves a partial last event: LCM's reader stops before it. The count of
+  // unread bytes is what the file holds beyond the complete events, each 28 header bytes + channel +
+  // data (LCM's log format), known here from what was written.
+  const fs::path dir = exc::test::scratch_dir(fs::temp_directory_path() / ("exc-unread-" + std::to_string(::getpid())));
+  const fs::path whole = dir / "whole.lcm", cut = dir / "cut.lcm";
+  const std::string channel = "EXC_TIMING/pid";
+  std::uint64_t event_size = 0;
+  {
+    lcm::LogFile log(whole.string(), "w");
+    REQUIRE(log.good());
+    std::vector<std::uint8_t> buffer;
+    for (int k = 0; k < 10; ++k) {
+      exlcm::timing_t msg{};
+      msg.utime = 1000 * k;
+      msg.seq = k;
+      buffer.resize(static_cast<std::size_t>(msg.getEncodedSize()));
+      REQUIRE(msg.encode(buffer.data(), 0, static_cast<int>(buffer.size())) >= 0);
+      lcm::LogEvent event{};
+      event.timestamp = 1700000000000000 + k;
+      event.channel = channel;
+      event.datalen = static_cast<std::int32_t>(buffer.size());
+      event.data = buffer.data();
+      REQUIRE(log.writeEvent(&event) == 0);
+      event_size = 28 + channel.size() + buffer.size();
+    }
+  }
+  REQUIRE(fs::file_size(whole) == 10 * event_size);
+  // Cut in the middle of the eighth event: seven complete ones, the rest unread.
+  const std::uint64_t keep = 7 * event_size + event_size / 2;
+  {
+    std::ifstream in(whole, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(cut, std::ios::binary) << bytes.substr(0, keep);
+  }
+  auto info = [&](const fs::path& log, int& status) {
+    const fs::path err = dir / (log.stem().string() + ".err");
+    const std::string cmd = std::string(EXC_EXCAVATOR_LOG) + " info '" + log.string() + "' > '" +
+                            (dir / (log.stem().string() + ".out")).string() + "' 2> '" + err.string() + "'";
+    const int raw = std::system(cmd.c_str());
+    status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    std::ifstream in(err);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  int status = -1;
+  const std::string whole_err = info(whole, status);
+  CHECK(status == 0);
+  CHECK(whole_err.empty());  // the control: a whole log has nothing unread
+  const std::string cut_err = info(cut, status);
+  INFO(cut_err);
+  CHECK(status == 0);
+  CHECK(cut_err.find(cut.string() + ": " + std::to_string(keep - 7 * event_size) +
+                     " bytes are in no complete event") != std::string::npos);
+  CHECK(cut_err.find("the 7 complete events are used") != std::string::npos);
 }

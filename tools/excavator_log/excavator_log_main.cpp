@@ -15,6 +15,16 @@
 
 namespace {
 
+// A log with bytes in no complete event (cut short or damaged) is read up to them; said on stderr.
+void warn_unread(const std::string& log_path, const exc::log::LogSummary& summary) {
+  if (summary.unread_bytes == 0) return;
+  std::fprintf(stderr,
+               "excavator-log: warning: %s: %llu bytes are in no complete event (a log cut short or damaged); "
+               "the %llu complete events are used\n",
+               log_path.c_str(), static_cast<unsigned long long>(summary.unread_bytes),
+               static_cast<unsigned long long>(summary.events));
+}
+
 void print_summary(const std::string& log_path, const exc::log::LogSummary& summary) {
   // Rates are per second of the run (the messages' own utime): a simulated run is logged far faster
   // than real time, so the log's wall-clock stamps would give a 1 kHz channel 100 kHz or more.
@@ -120,6 +130,7 @@ int main(int argc, char** argv) {
       return 1;
     }
     print_summary(info_log, summary);
+    warn_unread(info_log, summary);
     return 0;
   }
   if (reporter->parsed()) {
@@ -128,6 +139,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
       return 1;
     }
+    warn_unread(report_log, summary);
     std::string command = shell_quoted(plot_run_program()) + " " + shell_quoted(csv) + " --out " +
                           shell_quoted(report_dir) + " --title " + shell_quoted(title);
     if (!summary_json.empty()) command += " --summary " + shell_quoted(summary_json);
@@ -143,6 +155,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   print_summary(export_log, summary);
+  warn_unread(export_log, summary);
   for (const auto& [name, channel] : summary.channels) {
     if (channel.type_name == "unknown") {
       std::fprintf(stderr, "excavator-log: channel %s is not an exlcm type: not exported\n",

@@ -86,7 +86,11 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
     return false;
   }
   *summary = LogSummary{};
+  // LCM's event: sync word, event number, timestamp, channel length, data length, channel, data.
+  constexpr std::uint64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;
+  std::uint64_t event_bytes = 0;
   while (const lcm::LogEvent* event = log.readNextEvent()) {
+    event_bytes += kEventHeaderBytes + event->channel.size() + static_cast<std::uint64_t>(event->datalen);
     if (summary->events == 0) summary->first_log_utime = event->timestamp;
     summary->last_log_utime = event->timestamp;
     ++summary->events;
@@ -110,10 +114,12 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
     if (!known) channel.type_name = "unknown";
   }
   std::error_code ec;
-  if (summary->events == 0 && std::filesystem::file_size(log_path, ec) > 0 && !ec) {
+  const std::uintmax_t file_bytes = std::filesystem::file_size(log_path, ec);
+  if (summary->events == 0 && file_bytes > 0 && !ec) {
     *error = log_path + ": not an LCM log (no event found where LCM's log reader expects one)";
     return false;
   }
+  if (!ec && file_bytes > event_bytes) summary->unread_bytes = file_bytes - event_bytes;
   return true;
 }
 

@@ -25,6 +25,9 @@ struct LogSummary {
   std::uint64_t events = 0;
   std::int64_t first_log_utime = 0;
   std::int64_t last_log_utime = 0;
+  // Bytes of the file in no complete event: a log cut short (its writer killed mid-event) or damaged
+  // (LCM's reader skips to the next sync word). The events read are valid; the rest is lost.
+  std::uint64_t unread_bytes = 0;
   double duration_s() const { return events ? (last_log_utime - first_log_utime) * 1e-6 : 0.0; }
 };
 
