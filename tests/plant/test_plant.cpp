@@ -10,7 +10,14 @@
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <iterator>
+
 #include "allocation_counter.hpp"
+#include "scratch_files.hpp"
 #include "plant_scenes.hpp"
 
 using namespace exc;
@@ -175,6 +182,44 @@ TEST_CASE("tools/excavator-plant-replay runs a scene from a CSV of efforts and w
   CHECK(std::system((std::string(EXC_PLANT_REPLAY) + " --help > /dev/null").c_str()) == 0);
   CHECK(std::system((std::string(EXC_PLANT_REPLAY) + " --scene /no/such.yaml --efforts " + efforts +
                      " > /dev/null 2>&1").c_str()) != 0);
+}
+
+TEST_CASE("tools/excavator-plant-replay refuses a non-finite cell, and on a hydraulic scene an opening beyond 1, at its line and column, and a failed write is exit 2") {
+  const std::filesystem::path dir = exc::test::scratch_dir(std::filesystem::path(EXC_BINARY_DIR) / "tests" / "plant" /
+                                                           ("replay_refusals_" + std::to_string(getpid())));
+  // Exit status and stderr of a replay of `csv` on `scene` into `out`.
+  auto replay = [&](const std::string& scene, const std::string& csv, const std::string& out, std::string& err) {
+    const auto efforts = dir / "efforts.csv";
+    std::ofstream(efforts) << "t,swing,boom,arm,bucket\n" << csv;
+    const std::string cmd = std::string(EXC_PLANT_REPLAY) + " --scene " + EXC_SOURCE_DIR + "/scenes/" + scene +
+                            " --efforts " + efforts.string() + " --out " + out + " --duration 0.05 2> " +
+                            (dir / "err.txt").string();
+    const int raw = std::system(cmd.c_str());
+    std::ifstream in(dir / "err.txt");
+    err.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    return WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+  };
+  const std::string out = (dir / "out.csv").string();
+  std::string err;
+  // The controls: finite efforts on a force-commanded scene, openings within 1 on a hydraulic one.
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n0.01,1,2,3,4\n", out, err) == 0);
+  CHECK(err.empty());
+  CHECK(replay("dig.yaml", "0,0,0.5,-0.2,1\n", out, err) == 0);
+  CHECK(err.empty());
+  for (const char* bad : {"nan", "inf", "-inf"}) {
+    CHECK(replay("paper_dig.yaml", std::string("0,0,1,2,3\n0.01,") + bad + ",2,3,4\n", out, err) == 2);
+    INFO(err);
+    CHECK(err.find("efforts.csv:3: column 2 (swing)") != std::string::npos);
+    CHECK(err.find("a finite number is required") != std::string::npos);
+  }
+  CHECK(replay("dig.yaml", "0,0,0.5,-0.2,1.5\n", out, err) == 2);
+  INFO(err);
+  CHECK(err.find("efforts.csv:2: column 5 (bucket) is 1.5") != std::string::npos);
+  CHECK(err.find("allowed range [-1, 1]") != std::string::npos);
+  // A write that fails (a full disk: /dev/full) is an error naming the output, not a short file.
+  REQUIRE(std::filesystem::exists("/dev/full"));
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n", "/dev/full", err) == 2);
+  CHECK(err.find("/dev/full: cannot write") != std::string::npos);
 }
 #endif
 

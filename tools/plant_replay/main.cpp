@@ -1,6 +1,7 @@
 // excavator-plant-replay: run a scene open-loop from a CSV of efforts, without the firmware, and
 // write the plant's state at every cycle. Exit 0: ran to the end; 1: the plant stopped (its message
 // on stderr); 2: bad input (file, line and reason on stderr).
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -22,8 +23,10 @@ struct Row {
   exc::Vec4 value = exc::Vec4::Zero();
 };
 
-// CSV: a header line, then t,swing,boom,arm,bucket with t increasing.
-std::vector<Row> read_efforts(const std::string& path) {
+// CSV: a header line, then t,swing,boom,arm,bucket with t increasing, every value finite; valve
+// openings (a hydraulic scene) within -1..1. A bad cell is named by its line and column here, not by
+// the plant when it reaches it.
+std::vector<Row> read_efforts(const std::string& path, bool valve_openings) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the file");
   std::vector<Row> rows;
@@ -52,6 +55,16 @@ std::vector<Row> read_efforts(const std::string& path) {
     if (n != 5)
       throw std::runtime_error(path + ":" + std::to_string(number) +
                                ": expected 5 columns t,swing,boom,arm,bucket, found " + std::to_string(n));
+    const char* const columns[5] = {"t", "swing", "boom", "arm", "bucket"};
+    for (int c = 0; c < 5; ++c) {
+      const std::string place = path + ":" + std::to_string(number) + ": column " + std::to_string(c + 1) + " (" + columns[c] + ")";
+      std::ostringstream value;
+      value << v[c];
+      if (!std::isfinite(v[c])) throw std::runtime_error(place + " is " + value.str() + ": a finite number is required");
+      if (valve_openings && c > 0 && std::abs(v[c]) > 1)
+        throw std::runtime_error(place + " is " + value.str() +
+                                 ": the scene's actuators are hydraulic, so the columns are valve openings, allowed range [-1, 1]");
+    }
     r.t = v[0];
     r.value = exc::Vec4(v[1], v[2], v[3], v[4]);
     if (!rows.empty() && !(r.t > rows.back().t))
@@ -83,7 +96,7 @@ int main(int argc, char** argv) {
   exc::plant::Scene scene;
   try {
     scene = exc::plant::load_scene(scene_path);
-    rows = read_efforts(efforts_path);
+    rows = read_efforts(efforts_path, scene.actuators.fidelity == exc::plant::ActuatorFidelity::hydraulic);
   } catch (const std::exception& e) {
     std::cerr << "excavator-plant-replay: " << e.what() << "\n";
     return 2;
@@ -135,6 +148,12 @@ int main(int argc, char** argv) {
     for (int i = 1; i < 4; ++i) std::fprintf(out, ",%.8g", s.pressure_b[i]);
     std::fprintf(out, "\n");
   }
-  if (out != stdout) std::fclose(out);
+  // A write that failed (disk full) is an error, not a short file with exit 0.
+  const bool written = std::fflush(out) == 0 && !std::ferror(out) && (out == stdout || std::fclose(out) == 0);
+  if (!written) {
+    std::cerr << "excavator-plant-replay: " << (out_path.empty() ? std::string("standard output") : out_path)
+              << ": cannot write\n";
+    return 2;
+  }
   return rc;
 }
