@@ -4,14 +4,21 @@
 // closed chain's Psi^T tau_r). Without MuJoCo the checks that need it report SKIPPED.
 #include <doctest/doctest.h>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <string>
 
 #include "mjcf_export.hpp"
 #include "model/closed_chain.hpp"
 #include "model/loop_closure.hpp"
+#include "scratch_files.hpp"
 #ifdef EXC_HAVE_MUJOCO
 #include "mujoco_peer.hpp"
 #endif
@@ -48,6 +55,24 @@ TEST_CASE("tools/export-mjcf writes 12 bodies, 12 joints, 4 connect loops and 4 
   CHECK(xml.find("body1=\"arm\" body2=\"arm_rod\"") != std::string::npos);
   CHECK(xml.find("body1=\"arm\" body2=\"link12\"") != std::string::npos);
   CHECK(xml.find("body1=\"bucket\" body2=\"link11\"") != std::string::npos);
+}
+
+TEST_CASE("tools/excavator-bench export-mjcf writes the file it is given, and a write that fails (a full disk) is exit 1 naming it") {
+  const std::string dir = exc::test::scratch_dir(std::string(EXC_BINARY_DIR) + "/tests/bench/mjcf_out_" +
+                                                 std::to_string(getpid())).string();
+  const std::string good = std::string(EXC_BENCH_EXE) + " export-mjcf -o " + dir + "/m.xml 2> " + dir + "/good.err";
+  CHECK(std::system(good.c_str()) == 0);
+  std::ifstream in(dir + "/m.xml");
+  const std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(count(xml, "<connect ") == 4);
+  REQUIRE(std::filesystem::exists("/dev/full"));
+  const std::string full = std::string(EXC_BENCH_EXE) + " export-mjcf -o /dev/full 2> " + dir + "/full.err";
+  const int raw = std::system(full.c_str());
+  CHECK(WIFEXITED(raw));
+  CHECK(WEXITSTATUS(raw) == 1);
+  std::ifstream err(dir + "/full.err");
+  const std::string message((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+  CHECK(message.find("/dev/full: cannot write") != std::string::npos);
 }
 
 TEST_CASE("tools/export-mjcf refuses a pose where the loops cannot close") {

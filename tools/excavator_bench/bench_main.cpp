@@ -220,9 +220,7 @@ int export_command(const std::string& machine_file, const std::string& out, std:
   if (out == "-") {
     std::cout << xml;
   } else {
-    std::ofstream f(out);
-    if (!f) throw std::runtime_error(out + ": cannot write");
-    f << xml;
+    output::write_file(out, xml);
     std::fprintf(stderr, "export-mjcf: wrote %s\n", out.c_str());
   }
   return 0;

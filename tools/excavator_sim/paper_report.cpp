@@ -146,6 +146,7 @@ bool write_paper_report(const fs::path& out, const SceneJobResult& free_motion, 
      << image(out, free_motion, "tracking_error.png") << ") ![digging](" << image(out, dig, "tracking_error.png")
      << ")).\n\n";
   write_hydraulic_section(md, out, hydraulic_dig, dig);
+  md.flush();  // a write that fails at the end (disk full) is a failure too
   return static_cast<bool>(md);
 }
 
