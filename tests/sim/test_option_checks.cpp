@@ -38,10 +38,10 @@ struct Exit {
   std::string err;
 };
 
-Exit run(const std::string& command) {
+Exit run(const std::string& command, const std::string& stdout_to = "out.txt") {
   static const fs::path dir =
       exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("option_checks_" + std::to_string(getpid())));
-  const std::string cmd = "cd '" + dir.string() + "' && " + command + " > out.txt 2> err.txt";
+  const std::string cmd = "cd '" + dir.string() + "' && " + command + " > " + stdout_to + " 2> err.txt";
   const int raw = std::system(cmd.c_str());
   Exit e;
   e.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -98,5 +98,30 @@ TEST_CASE("tools/every program refuses a NaN or zero count on its numeric option
     CHECK(e.status > 0);
     CHECK(e.status < 128);  // refused, not killed by a signal
     CHECK(e.err.find(c.message) != std::string::npos);
+  }
+}
+
+TEST_CASE("tools/every program exits non-zero naming standard output when its output cannot be written (a full disk), and 0 with the same command into /dev/null") {
+  REQUIRE(fs::exists("/dev/full"));
+  const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+  const std::vector<std::string> commands = {
+      std::string(EXC_SIM_TOOL) + " config " + dig,
+      std::string(EXC_SIM_TOOL) + " --help",
+      std::string(EXC_FIRMWARE_TOOL) + " --print-config --scene " + dig,
+      std::string(EXC_PLANT_TOOL) + " --help",
+      std::string(EXC_PLANT_REPLAY_TOOL) + " --help",
+      std::string(EXC_LOG_TOOL) + " --help",
+      std::string(EXC_LOOP_BENCH_TOOL) + " --help",
+      std::string(EXC_PLANT_BENCH_TOOL) + " --help",
+  };
+  for (const std::string& command : commands) {
+    INFO(command);
+    const Exit lost = run(command, "/dev/full");
+    INFO(lost.err);
+    CHECK(lost.status > 0);
+    CHECK(lost.status < 128);
+    CHECK(lost.err.find("standard output: cannot write") != std::string::npos);
+    const Exit kept = run(command, "/dev/null");  // the control
+    CHECK(kept.status == 0);
   }
 }

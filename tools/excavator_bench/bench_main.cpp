@@ -230,6 +230,7 @@ int export_command(const std::string& machine_file, const std::string& out, std:
 }  // namespace exc::bench
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-bench", 1);  // stdout lost to a full disk is not exit 0
   CLI::App app{
       "excavator-bench: work-precision chart, pressure-integration chart, fidelity chart, stability maps and MuJoCo as "
       "a peer.\n"

@@ -58,6 +58,7 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-firmware");  // stdout lost to a full disk is not exit 0
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
   std::string iface, scene_path, controller, json_path, lcm_url;
   double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "log_export.hpp"
+#include "output_file.hpp"
 
 namespace {
 
@@ -76,6 +77,7 @@ std::string shell_quoted(const std::string& text) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-log");  // stdout lost to a full disk is not exit 0
   CLI::App app{"excavator-log: summarise LCM telemetry logs and export them to CSV"};
   app.require_subcommand(1);
 

@@ -16,6 +16,7 @@
 
 #include "model/closed_chain.hpp"
 #include "model/forward_dynamics.hpp"
+#include "output_file.hpp"
 
 namespace {
 
@@ -66,6 +67,7 @@ void print_row(const double* values, int n) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-model");  // stdout lost to a full disk is not exit 0
   CLI::App app{
       "excavator-model: the excavator's closed-chain model (paper Tables 1-2, eqs. 1, 14-17).\n"
       "Reads one case per line from standard input (whitespace-separated numbers) and writes one line\n"

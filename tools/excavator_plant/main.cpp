@@ -15,6 +15,7 @@
 
 #include "app/node_io.hpp"
 #include "hal/can_protocol.hpp"
+#include "output_file.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/telemetry_publisher.hpp"
@@ -25,6 +26,7 @@ void on_signal(int) { g_stop = true; }
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-plant");  // stdout lost to a full disk is not exit 0
   CLI::App app{"excavator-plant: the simulated excavator on a SocketCAN interface (see README)."};
   std::string iface, scene_path, lcm_url;
   double duration = 0, silence_ms = 500, startup_s = 120;

@@ -28,6 +28,7 @@
 namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-sim");  // stdout lost to a full disk is not exit 0
   CLI::App app{
       "excavator-sim: runs the firmware against the simulated excavator over the in-memory CAN bus.\n"
       "  excavator-sim run scenes/dig.yaml            PID and adaptive, summary, log, plots, report\n"

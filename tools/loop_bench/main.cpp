@@ -24,6 +24,7 @@
 #include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
 #include "model/forward_dynamics.hpp"
+#include "output_file.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/lcm_output.hpp"
 
@@ -120,6 +121,7 @@ double timed(int repeats, Body&& body) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-loop-bench", 1);  // stdout lost to a full disk is not exit 0
   CLI::App app{"The closed loop's real-time factor: the dig scene's firmware, CAN and plant in one process with "
                "every telemetry message recorded, medians over repeats; the floor of its model evaluations; "
                "--split: the per-stage instruction split of one cycle under callgrind.",

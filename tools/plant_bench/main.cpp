@@ -13,6 +13,7 @@
 
 #include "control/task.hpp"
 #include "model/closed_chain.hpp"
+#include "output_file.hpp"
 #include "sim_plant/plant.hpp"
 
 using namespace exc;
@@ -105,6 +106,7 @@ bool stable_in_stiff_clay(const Scene& base, IntegrationMethod m, Formulation f,
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::output::check_stdout_at_exit("excavator-plant-bench");  // stdout lost to a full disk is not exit 0
   CLI::App app{"Plant figures: step time per integrator x formulation (dig scene with force actuators, 1 kHz), the "
                "hydraulic step per pressure method and the dig scene's real-time factor through its valves, and the "
                "largest stable step per integrator in stiff clay.",
