@@ -265,13 +265,21 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     raise(FirmwareFault::model);
     std::snprintf(pending_text_, sizeof pending_text_, "model: the closed-chain model refused the state at t = %.3f s", t);
   }
-  // Far from where it was told to go: stop (the state machine takes the safe state next cycle).
+  // Far from where it was told to go: stop (the state machine takes the safe state next cycle). In
+  // the first cycle of the task the machine is not standing where the task starts: said as such.
+  const bool task_start = mode == control::Mode::track && transition.changed;
   for (int j = 0; j < 4 && !fault_; ++j) {
     const double limit = config_.controller.tracking_error_limit[j];
     if (std::abs(out_.e[j]) > limit) {
       raise(FirmwareFault::tracking_error);
-      std::snprintf(pending_text_, sizeof pending_text_, "tracking error: %s %.4f %s > limit %.4f at t = %.3f s",
-                    kActiveNames[static_cast<std::size_t>(j)], std::abs(out_.e[j]), j == 0 ? "rad" : "m", limit, t);
+      const char* const name = kActiveNames[static_cast<std::size_t>(j)];
+      const char* const unit = j == 0 ? "rad" : "m";
+      if (task_start)
+        std::snprintf(pending_text_, sizeof pending_text_, "tracking error at the task's start: %s %.4f %s from its first point > limit %.4f",
+                      name, std::abs(out_.e[j]), unit, limit);
+      else
+        std::snprintf(pending_text_, sizeof pending_text_, "tracking error: %s %.4f %s > limit %.4f at t = %.3f s", name,
+                      std::abs(out_.e[j]), unit, limit, t);
     }
   }
 

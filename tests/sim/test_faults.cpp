@@ -188,3 +188,20 @@ TEST_CASE("tools/excavator-sim: in issue 16's saturated swing with no soil the a
     CHECK(ratio > 10);
   }
 }
+
+TEST_CASE("firmware/node: a machine not standing where its task starts is stopped in the task's first cycle, the fault saying so") {
+  const std::string start = "  q_a: [0.0, 2.5021, 2.9255, 1.7856]";
+  // 1 rad of swing away from the path's first point: stopped at once, named as the start.
+  const fs::path far = edited_dig(start, "  q_a: [1.0, 2.5021, 2.9255, 1.7856]", "far_start");
+  const Run r = run_sim("run " + far.string() + " --controller pid --no-report --quiet --out out");
+  INFO(r.out << r.err);
+  CHECK(r.status == 1);
+  CHECK(r.out.find("tracking error at the task's start: swing 1.0000 rad from its first point > limit 0.1000") !=
+        std::string::npos);
+  // The control: 0.05 rad away, within the limit, the law pulls it onto the path and the task runs.
+  const fs::path near = edited_dig(start, "  q_a: [0.05, 2.5021, 2.9255, 1.7856]", "near_start");
+  const Run n = run_sim("run " + near.string() + " --controller pid --no-report --quiet --out out");
+  INFO(n.out << n.err);
+  CHECK(n.status == 0);
+  CHECK(n.out.find("task's start") == std::string::npos);
+}
