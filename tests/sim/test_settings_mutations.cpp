@@ -95,6 +95,17 @@ Mutant mutate(const std::string& text, std::mt19937_64& rng) {
   return {text.substr(0, cut), "cut after byte " + std::to_string(cut)};
 }
 
+// The message of what `load` throws ("" when it does not).
+template <class Load>
+std::string error_of(Load&& load) {
+  try {
+    load();
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return "";
+}
+
 bool run_figures_finite(const exc::sim::RunRecord& r) {
   for (int j = 0; j < 4; ++j)
     if (!std::isfinite(r.rms_error[j]) || !std::isfinite(r.max_error[j])) return false;
@@ -219,12 +230,7 @@ TEST_CASE("tools/settings: a truck cycle whose dump leaves the bucket's stroke i
   text.replace(at, from.size(), "open_pitch_deg: 1");
   const fs::path path = dir / "truck_loading.yaml";
   std::ofstream(path) << text;
-  std::string message;
-  try {
-    (void)exc::sim::load_scene_bundle(path.string());
-  } catch (const std::exception& e) {
-    message = e.what();
-  }
+  const std::string message = error_of([&] { (void)exc::sim::load_scene_bundle(path.string()); });
   INFO(message);
   CHECK(message.rfind(path.string() + ":", 0) == 0);  // file:line:column first
   CHECK(message.find("task.cycle[") != std::string::npos);
@@ -314,12 +320,7 @@ TEST_CASE("tools/sweep: seeded mutations of every shipped sweep spec are refused
                                       {"scenes: [" + scenes + "dig.yaml, " + scenes + "]", "is a directory"}}) {
     const fs::path path = dir / "bad_scene.yaml";
     std::ofstream(path) << "sweep:\n  " << line << "\n  controllers: [pid]\n";
-    std::string message;
-    try {
-      (void)exc::sim::load_sweep_spec(path.string());
-    } catch (const std::exception& e) {
-      message = e.what();
-    }
+    const std::string message = error_of([&] { (void)exc::sim::load_sweep_spec(path.string()); });
     INFO(message);
     CHECK(message.rfind(path.string() + ":2:", 0) == 0);
     CHECK(message.find(problem) != std::string::npos);
