@@ -16,6 +16,7 @@
 // it. Errors are SettingsErrors at the offending node's line and column: a bad value at the value,
 // an unknown key at the key, a missing one at its section. Numbers are recorded in the shortest form
 // that reads back to the same double. Start-up code: allocates, throws.
+#include <algorithm>
 #include <cstddef>
 #include <initializer_list>
 #include <string>
@@ -118,14 +119,18 @@ class SectionReader {
     given = this->given(key);
     if (given) choice(key, value, table, what);
   }
-  // A list of at least `min` names of an enumeration (kept as names, each checked against the table).
+  // A list of at least `min` names of an enumeration (kept as names, each checked against the table,
+  // none twice).
   template <typename E, std::size_t N>
   void choices(const char* key, std::vector<std::string>& names, const EnumTable<E, N>& table, std::size_t min,
                const char* what) {
     if (given(key)) {
       names = read_names(key, min, std::string("a list of names from: ") + table.names() + " (" + what + ")");
-      for (std::size_t i = 0; i < names.size(); ++i)
+      for (std::size_t i = 0; i < names.size(); ++i) {
         if (!table.named(names[i])) fail(key, i, "is '" + names[i] + "'; allowed values: " + table.names());
+        if (std::find(names.begin(), names.begin() + static_cast<std::ptrdiff_t>(i), names[i]) != names.begin() + static_cast<std::ptrdiff_t>(i))
+          fail(key, i, "'" + names[i] + "' is listed twice; each name once");
+      }
     }
     record_names(key, names);
   }

@@ -874,3 +874,30 @@ TEST_CASE("tools/excavator-sim: an output file that cannot be written is an erro
   CHECK(fw_good_err.find("exc_no_such_if") != std::string::npos);
   CHECK(fw_good_err.find("cannot write") == std::string::npos);
 }
+
+TEST_CASE("tools/excavator-sim refuses a controller named twice (run --controller, a sweep spec's list) and an unknown one, before any run") {
+  // Two runs of one controller would share its telemetry channels and its summary entry.
+  const Run twice = run_sim("run " + kDig + " --controller pid,pid --duration 0.1 --no-report --out out");
+  INFO(twice.err);
+  CHECK(twice.status == 2);
+  CHECK(twice.err.find("--controller: 'pid' is given twice") != std::string::npos);
+  CHECK(twice.out.find("pid  ") == std::string::npos);  // no run's table
+  // An unknown name after a valid one: refused before the valid one runs.
+  const Run unknown = run_sim("run " + kDig + " --controller pid,bogus --duration 0.1 --no-report --out out");
+  INFO(unknown.err);
+  CHECK(unknown.status == 2);
+  CHECK(unknown.err.find("unknown controller 'bogus'") != std::string::npos);
+  CHECK(unknown.err.find("excavator-sim: dig with pid") == std::string::npos);  // no run's progress line
+  // A sweep spec's list, at its line and element; the control runs.
+  const fs::path dir = twice.dir;
+  std::ofstream(dir / "twice.yaml") << "sweep:\n  scene: " << kDig << "\n  controllers: [pid, pid]\n  duration: 0.1\n";
+  std::ofstream(dir / "once.yaml") << "sweep:\n  scene: " << kDig << "\n  controllers: [pid]\n  duration: 0.1\n";
+  const Run spec = run_sim("sweep " + (dir / "twice.yaml").string() + " --quiet --out s.jsonl");
+  INFO(spec.err);
+  CHECK(spec.status == 2);
+  CHECK(spec.err.find("twice.yaml:3:22: sweep.controllers[1]: 'pid' is listed twice") != std::string::npos);
+  const Run control = run_sim("sweep " + (dir / "once.yaml").string() + " --quiet --out s.jsonl");
+  CHECK(control.status == 0);
+  const Run control_run = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out");
+  CHECK(control_run.status == 0);
+}

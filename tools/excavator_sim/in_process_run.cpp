@@ -19,6 +19,15 @@ control::ControllerKind parse_kind(const std::string& name) {
 
 }  // namespace
 
+void check_controller_names(const std::vector<std::string>& names) {
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    (void)parse_kind(names[i]);
+    for (std::size_t k = 0; k < i; ++k)
+      if (names[k] == names[i])
+        throw std::invalid_argument("--controller: '" + names[i] + "' is given twice; each controller runs once");
+  }
+}
+
 // The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of it,
 // the integrator.
 std::string describe_setup(const SceneBundle& bundle) {
@@ -51,6 +60,7 @@ std::string describe_setup(const SceneBundle& bundle) {
 }
 
 Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
+  check_controller_names(options.controllers);  // all of them, before the first run
   Summary summary;
   summary.scene = bundle.name;
   summary.setup = describe_setup(bundle);

@@ -30,6 +30,10 @@ struct Summary {
 // it, the integrator.
 std::string describe_setup(const SceneBundle& bundle);
 
+// Each name a controller kind, none twice (their runs share one log, a channel per controller):
+// std::invalid_argument naming --controller otherwise.
+void check_controller_names(const std::vector<std::string>& names);
+
 Summary run_all(const SceneBundle& bundle, const RunOptions& options);
 
 }  // namespace exc::sim

@@ -30,6 +30,7 @@ bool pid_over_adaptive(const Summary& s, double& arm, double& bucket) {
 }  // namespace
 
 std::vector<RobustnessRow> run_robustness(const SweepSpec& spec, const RunOptions& options) {
+  check_controller_names(options.controllers);
   std::vector<RobustnessRow> rows;
   std::vector<SceneBundle> scenes;
   for (const std::string& path : spec.scenes) scenes.push_back(load_scene_bundle(path));
