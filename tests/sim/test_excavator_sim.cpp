@@ -901,3 +901,21 @@ TEST_CASE("tools/excavator-sim refuses a controller named twice (run --controlle
   const Run control_run = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out");
   CHECK(control_run.status == 0);
 }
+
+TEST_CASE("tools/excavator-sim sweep refuses a --shard that is not exactly I/N with 0 <= I < N (trailing text, a third part, overflow, a sign), and runs one that is") {
+  const Run first = run_sim("sweep --help");
+  REQUIRE(first.status == 0);
+  std::ofstream(first.dir / "spec.yaml") << "sweep:\n  scene: " << kDig << "\n  controllers: [pid]\n  duration: 0.05\n  cases: 2\n";
+  const std::string spec = (first.dir / "spec.yaml").string();
+  for (const char* bad : {"1/2/3", "0/2x", "0/100000000000", "+0/2", "-1/2", "2/2", "0/0", "1", "/2", " 0/2"}) {
+    INFO("--shard '" << bad << "'");
+    const Run r = run_sim("sweep " + spec + " --quiet --out s.jsonl --shard '" + bad + "'");
+    CHECK(r.status == 2);
+    CHECK(r.err.find("must be I/N with 0 <= I < N") != std::string::npos);
+    CHECK_FALSE(fs::exists(r.dir / "s.jsonl"));
+  }
+  const Run good = run_sim("sweep " + spec + " --quiet --out s.jsonl --shard 1/2");  // the control: case 1 of 2
+  INFO(good.err);
+  CHECK(good.status == 0);
+  CHECK(good.out.find("sweep shard 1/2: 1 cases") != std::string::npos);
+}

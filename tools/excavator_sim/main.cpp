@@ -145,7 +145,7 @@ int main(int argc, char** argv) {
         return merged.ok() ? 0 : 1;
       }
       int shard = 0, shards = 1;
-      if (std::sscanf(sweep_shard.c_str(), "%d/%d", &shard, &shards) != 2 || shards < 1 || shard < 0 || shard >= shards) {
+      if (!exc::sim::parse_shard(sweep_shard, shard, shards)) {
         std::cerr << "excavator-sim sweep: --shard '" << sweep_shard << "': must be I/N with 0 <= I < N\n";
         return 2;
       }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <random>
@@ -134,6 +135,19 @@ const SweepValue* SweepCase::value(const std::string& knob) const {
   for (const SweepSetting& s : set)
     if (s.first == knob) return &s.second;
   return nullptr;
+}
+
+bool parse_shard(const std::string& text, int& shard, int& shards) {
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) return false;
+  auto whole = [](const char* first, const char* last, int& value) {
+    if (first == last || *first < '0' || *first > '9') return false;  // from_chars takes a '-'
+    const auto [end, error] = std::from_chars(first, last, value);
+    return error == std::errc() && end == last;
+  };
+  const char* const begin = text.data();
+  return whole(begin, begin + slash, shard) && whole(begin + slash + 1, begin + text.size(), shards) && shards >= 1 &&
+         shard < shards;
 }
 
 SweepSpec load_sweep_spec(const std::string& path) {

@@ -91,6 +91,9 @@ struct SweepSpec {
 // Reads a sweep spec (opened and parsed once; errors name file, line, column and field).
 SweepSpec load_sweep_spec(const std::string& path);
 
+// "I/N" with 0 <= I < N, two whole decimal numbers and nothing else (no sign, blank or overflow).
+bool parse_shard(const std::string& text, int& shard, int& shards);
+
 struct SweepCase {
   int id = 0;
   int scene = 0, variant = -1, grid = -1;  // indices into the spec (-1: none)
