@@ -65,10 +65,12 @@ json read_shards(const SweepSpec& spec, const std::vector<fs::path>& files, std:
       json entry = {{"file", f.string()}};
       std::smatch m;
       const std::string stem = f.stem().string();
-      if (std::regex_match(stem, m, shard_name)) {
-        const int i = std::stoi(m[1]), n = m[2].matched ? std::stoi(m[2]) : static_cast<int>(files.size());
+      int i = 0, n = 0;
+      // The shard its name tells, when it does (a number too long for an int tells none).
+      if (std::regex_match(stem, m, shard_name) &&
+          parse_shard(m[1].str() + "/" + (m[2].matched ? m[2].str() : std::to_string(files.size())), i, n)) {
         json ids = json::array();
-        for (int id = i; i < n && id < spec.total_cases(); id += n) ids.push_back(id);
+        for (int id = i; id < spec.total_cases(); id += n) ids.push_back(id);
         entry["shard"] = std::to_string(i) + "/" + std::to_string(n);
         entry["cases"] = ids;
       }
