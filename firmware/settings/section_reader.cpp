@@ -80,6 +80,18 @@ bool SectionReader::has(const std::string& key) const {
   return n.IsDefined() && !n.IsNull();
 }
 
+bool SectionReader::value_given(const std::string& key) const {
+  const YAML::Node n = get(key);
+  if (n.IsDefined() && n.IsNull()) {
+    // At the key: an empty value's own mark is where the parser found the next token (the next line).
+    YAML::Mark mark = mark_of(key);
+    for (const auto& kv : in_)
+      if (kv.first.IsScalar() && kv.first.Scalar() == key) mark = kv.first.Mark();
+    fail_at(mark, field(key), "has no value (empty or ~); give one");
+  }
+  return n.IsDefined();
+}
+
 YAML::Mark SectionReader::mark_of(const std::string& key) const {
   const YAML::Node n = get(key);
   return n.IsDefined() ? n.Mark() : mark_;
@@ -170,7 +182,7 @@ double SectionReader::to_number(const YAML::Node& n, const std::string& name, do
 
 void SectionReader::number(const char* key, double& value, Bounds b, const char* unit, const char* what, Need need) {
   declare(key);
-  if (has(key)) {
+  if (value_given(key)) {
     value = to_number(get(key), field(key), b.lo, b.hi, unit);
   } else if (need == Need::required) {
     fail(key, std::string("missing: ") + what + "; a number in " + range_text(b.lo, b.hi, unit));
@@ -184,7 +196,7 @@ void SectionReader::read_whole(const char* key, double& value, double lo, double
                                const char* what, Need need) {
   const std::string allowed = "a whole number in " + range_text(lo, hi, unit);
   declare(key);
-  if (has(key)) {
+  if (value_given(key)) {
     const YAML::Node n = get(key);
     double v = 0;
     if (!scalar_number(n, v) || !std::isfinite(v) || v != std::floor(v) || v < lo || v > hi)
@@ -200,7 +212,7 @@ void SectionReader::read_whole(const char* key, double& value, double lo, double
 
 void SectionReader::flag(const char* key, bool& value, const char* /*what*/) {
   declare(key);
-  if (has(key)) {
+  if (value_given(key)) {
     const YAML::Node n = get(key);
     bool v = false;
     if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v))
@@ -212,7 +224,7 @@ void SectionReader::flag(const char* key, bool& value, const char* /*what*/) {
 
 void SectionReader::text(const char* key, std::string& value, const char* what, Need need) {
   declare(key);
-  if (has(key)) {
+  if (value_given(key)) {
     const YAML::Node n = get(key);
     if (!n.IsScalar()) fail(key, std::string("must be a string: ") + what);
     value = n.Scalar();
@@ -233,7 +245,7 @@ void SectionReader::read_list(const char* key, double* values, int n, const doub
   const bool scalar_bounds = stride == 0;
   const std::string shape = "a list of " + std::to_string(n) + " numbers" +
                             (scalar_bounds ? " in " + range_text(lo[0], hi[0], unit) : std::string());
-  if (has(key)) {
+  if (value_given(key)) {
     const YAML::Node list = get(key);
     if (!list.IsSequence() || static_cast<int>(list.size()) != n) fail(key, "must be " + shape);
     for (int i = 0; i < n; ++i)
@@ -258,7 +270,7 @@ std::size_t SectionReader::begin_rows(const char* key, std::size_t min, std::siz
   const std::string shape = "a list of " + std::to_string(min) + ".." + std::to_string(max) + " rows of " +
                             std::to_string(columns) + " numbers";
   out_[key] = YAML::Node(YAML::NodeType::Sequence);
-  if (!has(key)) {
+  if (!value_given(key)) {
     if (need == Need::required) fail(key, std::string("missing: ") + what + "; " + shape);
     return kAbsent;
   }
@@ -324,7 +336,7 @@ std::size_t SectionReader::begin_sections(const char* key, std::size_t min, std:
   out_[key] = YAML::Node(YAML::NodeType::Sequence);
   const std::string shape = max == min ? "a list of " + std::to_string(min)
                                        : "a list of " + std::to_string(min) + ".." + std::to_string(max);
-  if (!has(key)) {
+  if (!value_given(key)) {
     if (need == Need::required) fail(key, std::string("missing: ") + what + "; " + shape + " entries");
     return 0;
   }

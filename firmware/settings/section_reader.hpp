@@ -57,10 +57,13 @@ class SectionReader {
   std::string field(const std::string& key) const;  // "controller" + "kp" -> "controller.kp"
   bool present() const;                             // the section is in the file and not empty
   bool has(const std::string& key) const;           // the key is given (and not null)
+  // The key is given with a value; a key left without one (`key:`, `key: ~`) is refused rather than
+  // read as absent: it would take the default silently. (A section may be empty: its defaults.)
+  bool value_given(const std::string& key) const;
   // Declares a field that has no default and is read only when given (then with the reads below).
   bool given(const char* key) {
     declare(key);
-    return has(key);
+    return value_given(key);
   }
   YAML::Node effective() const { return out_; }     // the values read, defaults filled in
 
@@ -106,7 +109,7 @@ class SectionReader {
   void choice(const char* key, E& value, const EnumTable<E, N>& table, const char* what) {
     declare(key);
     std::string name = table.name_of(value);
-    if (has(key)) {
+    if (value_given(key)) {
       name = scalar(key, std::string("one of: ") + table.names() + " (" + what + ")");
       if (!table.named(name)) fail(key, "is '" + name + "'; allowed values: " + table.names());
       value = *table.named(name);
