@@ -15,7 +15,10 @@ void SensorModel::reset() {
 }
 
 double SensorModel::quantise(double v, double quantum) {
-  return quantum > 0 ? quantum * std::round(v / quantum) : v;
+  if (!(quantum > 0)) return v;
+  // A quantum too fine to count the value in (a denormal: v / quantum overflows) resolves it fully.
+  const double steps = v / quantum;
+  return std::isfinite(steps) ? quantum * std::round(steps) : v;
 }
 
 void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a,

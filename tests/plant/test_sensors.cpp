@@ -31,6 +31,20 @@ TEST_CASE("plant/sensors quantise positions") {
   CHECK(s.latest().position[3] == doctest::Approx(2.000));
 }
 
+TEST_CASE("plant/sensors: a quantum too fine to count a value in (a denormal the schema admits) reports the value, not infinity") {
+  // Found by the settings mutations: position_quantum 1e-320 is in [0, 0.1], and v / 1e-320
+  // overflowed to inf, so quantum * round(inf) reported an infinite position.
+  SensorParameters p;
+  p.position_quantum = Vec4(1e-320, 1e-320, 1e-300, 0.001);
+  SensorModel s(p);
+  s.sample(0, Vec4(0.5, 2.34567, 2.0004, 1.9996), Vec4::Zero(), Vec4::Zero(), Vec4::Zero());
+  CHECK(s.latest().position[0] == 0.5);
+  CHECK(s.latest().position[1] == 2.34567);
+  CHECK(std::isfinite(s.latest().position[2]));
+  CHECK(s.latest().position[2] == doctest::Approx(2.0004).epsilon(1e-12));
+  CHECK(s.latest().position[3] == doctest::Approx(2.000));  // the control: a real quantum still rounds
+}
+
 TEST_CASE("plant/sensor noise is seeded, reproducible and of the configured size") {
   SensorParameters p;
   p.velocity_noise = Vec4(0.01, 0.002, 0.002, 0.002);
