@@ -8,6 +8,8 @@
 #include <limits>
 #include <utility>
 
+#include "model/model.hpp"
+#include "model/reference_poses.hpp"
 #include "settings/section_reader.hpp"
 
 namespace exc {
@@ -202,6 +204,15 @@ Machine read_machine(const settings::Document& doc) {
   terrain.number("flat_height", m.terrain_flat_height, kCoord, "m", "ground plane z");
   terrain.finish();
   r.finish();
+  // The measured poses must be what the geometry assembles: placed at the pose's field.
+  if (!m.reference_poses.empty()) {
+    const Model model = build_model(m);
+    for (std::size_t i = 0; i < m.reference_poses.size(); ++i) {
+      if (const auto mismatch = check_reference_pose(model, m.reference_poses[i]))
+        r.rethrow_placed(SettingsError(doc.file(), 0, 0, "reference_poses[" + std::to_string(i) + "]." + mismatch->field,
+                                       mismatch->reason + ": correct the pose or the geometry, or remove the pose"));
+    }
+  }
   return m;
 }
 

@@ -6,6 +6,7 @@
 #include "model/front_kinematics.hpp"
 #include "model/lie_group.hpp"
 #include "model/newton_euler.hpp"
+#include "model/reference_poses.hpp"
 #include "model_fixture.hpp"
 
 using namespace exc;
@@ -13,23 +14,6 @@ using exc::test::reference_model;
 
 namespace {
 constexpr double kDeg = 180.0 / M_PI;
-
-Vec3 pin_world(const Model& m, const Workspace& ws, const std::string& name) {
-  const Machine& k = m.machine;
-  auto at = [&](int link, const Vec2& p) {
-    return Vec3((ws.X_Wi[link] * Eigen::Vector4d(p.x(), 0.0, p.y(), 1.0)).head<3>());
-  };
-  if (name == "C") return translation(ws.X_Wi[kBoom]);
-  if (name == "E") return translation(ws.X_Wi[kBoomRod]);  // rod-end frame origin
-  if (name == "H") return translation(ws.X_Wi[kArm]);
-  if (name == "G") return translation(ws.X_Wi[kArmRod]);
-  if (name == "M") return translation(ws.X_Wi[kBucket]);
-  if (name == "J") return translation(ws.X_Wi[kBucketRod]);
-  if (name == "L") return at(kBucket, k.L);
-  if (name == "T") return ws.tip_world;
-  FAIL("unknown pin " << name);
-  return Vec3::Zero();
-}
 }  // namespace
 
 TEST_CASE("model/both reference poses are reproduced (0.5 mm, 0.01 deg)") {
@@ -46,13 +30,13 @@ TEST_CASE("model/both reference poses are reproduced (0.5 mm, 0.01 deg)") {
     REQUIRE(pose.pins_world.size() == 8);
     for (const auto& [name, p] : pose.pins_world) {
       CAPTURE(name);
-      CHECK((pin_world(m, ws, name) - p).norm() < 0.5e-3);
+      CHECK((pin_in_world(m, ws, name) - p).norm() < 0.5e-3);
     }
     // The cut pins really meet in 3-D: the other side of each loop reaches the same world point.
     const Vec3 E_on_boom = (ws.X_Wi[kBoom] * Eigen::Vector4d(m.machine.E.x(), 0, m.machine.E.y(), 1)).head<3>();
-    CHECK((E_on_boom - pin_world(m, ws, "E")).norm() < 1e-12);
+    CHECK((E_on_boom - pin_in_world(m, ws, "E")).norm() < 1e-12);
     const Vec3 L_on_link = (ws.X_Wi[kLink11] * Eigen::Vector4d(m.machine.JL, 0, 0, 1)).head<3>();
-    CHECK((L_on_link - pin_world(m, ws, "L")).norm() < 1e-12);
+    CHECK((L_on_link - pin_in_world(m, ws, "L")).norm() < 1e-12);
   }
 }
 

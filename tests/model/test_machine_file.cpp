@@ -116,6 +116,28 @@ TEST_CASE("model/machine file errors name the file, the line and column, the fie
               "reference_poses, terrain");
   check_error(edited("q_a: [0.5, 1.9, 3.0, 1.8]", "q_a: [0.5, 1.9, 3.0]"), "reference_poses[1].q_a", "[0.5, 1.9, 3.0]",
               "list of 4 numbers");
+  // The measured poses against the geometry: a link edited without its poses, a pose's pin or angle
+  // edited without the geometry, a pose the geometry cannot assemble.
+  check_error(edited("JL: 0.6595", "JL: 0.6695"), "reference_poses[0].bucket_angle_deg", "69.875",
+              "the geometry gives 68.844 deg at this q_a, the pose 69.875 (tolerance 0.01 deg)");
+  check_error(edited("G: [5.7662, 3.1501, 0.9126]", "G: [5.7672, 3.1501, 0.9126]"), "reference_poses[1].pins_world.G",
+              "[5.7672, 3.1501, 0.9126]", "the geometry puts pin G at (5.7662, 3.1501, 0.9126), the pose at (5.7672, 3.1501, 0.9126), 1.0 mm away");
+  check_error(edited("arm_angle_deg: -60.012", "arm_angle_deg: -60.5"), "reference_poses[0].arm_angle_deg", "-60.5",
+              "the geometry gives -60.012 deg");
+  check_error(edited("q_a: [0.5, 1.9, 3.0, 1.8]", "q_a: [0.5, 9.9, 3.0, 1.8]"), "reference_poses[1].q_a", "[0.5, 9.9, 3.0, 1.8]",
+              "the geometry does not assemble at it: no assembly");
+  {
+    // The controls: a pin moved by 0.4 mm is within the file's tolerance; the edited link loads once
+    // its poses are removed (a machine without measured poses is still a machine).
+    CHECK_NOTHROW(load_machine_from_string(edited("G: [5.7662, 3.1501, 0.9126]", "G: [5.7666, 3.1501, 0.9126]"), "ok.yaml"));
+    std::string no_poses = edited("JL: 0.6595", "JL: 0.6695");
+    const auto poses = no_poses.find("reference_poses:");
+    const auto terrain = no_poses.find("\nterrain:");
+    REQUIRE(poses != std::string::npos);
+    REQUIRE(terrain != std::string::npos);
+    no_poses.erase(poses, terrain + 1 - poses);
+    CHECK(load_machine_from_string(no_poses, "no_poses.yaml").reference_poses.empty());
+  }
   check_error(edited("bulk_modulus: 1.0e9", "bulk_modulus: 1.0e6"), "hydraulics.bulk_modulus", "1.0e6",
               "is 1000000 Pa; allowed range [1e+07, 5e+09] Pa");
   check_error(edited("pump_of: [1, 0, 1, 0]", "pump_of: [1, 0, 0.5, 0]"), "hydraulics.pump_of[2]", "0.5, 0]",
