@@ -35,21 +35,18 @@ fs::path scratch_file(const fs::path& file) {
   return file;
 }
 
-std::size_t finish_scratch_files(bool passed) {
+void finish_scratch_files(bool passed) {
   const std::lock_guard<std::mutex> lock(g_mutex);
   const char* keep = std::getenv("EXC_KEEP_TEST_FILES");
   const bool remove = passed && !(keep != nullptr && std::string(keep) == "1");
-  std::size_t left = 0;
   for (const fs::path& path : registered()) {
     std::error_code ec;
-    if (remove) fs::remove_all(path, ec);
-    if (fs::exists(path, ec)) {
-      ++left;
-      if (!passed) std::fprintf(stderr, "kept for inspection: %s\n", path.c_str());
-    }
+    if (remove)
+      fs::remove_all(path, ec);
+    else if (!passed && fs::exists(path, ec))
+      std::fprintf(stderr, "kept for inspection: %s\n", path.c_str());
   }
   registered().clear();
-  return left;
 }
 
 }  // namespace exc::test

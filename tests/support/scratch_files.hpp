@@ -14,7 +14,7 @@ std::filesystem::path scratch_dir(const std::filesystem::path& dir);
 std::filesystem::path scratch_file(const std::filesystem::path& file);
 
 // Called by the tests' main when the run has ended: removes every registered path when `passed`,
-// else names them. Returns how many registered paths still exist afterwards.
-std::size_t finish_scratch_files(bool passed);
+// else names those that exist.
+void finish_scratch_files(bool passed);
 
 }  // namespace exc::test
