@@ -43,11 +43,11 @@ void print_summary(const std::string& log_path, const exc::log::LogSummary& summ
   std::printf("%-32s %-20s %10s %10s %10s\n", "channel", "type", "messages", "rate_hz", "undecodable");
   for (const auto& [name, channel] : summary.channels) {
     const std::uint64_t decoded = channel.messages - channel.undecodable;
-    const double span = (channel.max_utime - channel.min_utime) * 1e-6;
+    const double span = (static_cast<double>(channel.max_utime) - static_cast<double>(channel.min_utime)) * 1e-6;
     char rate[32] = "-";  // no decoded message with a time, or all at one instant
     if (channel.type_name != "unknown" && decoded > 1 && span > 0)
       std::snprintf(rate, sizeof rate, "%.1f", static_cast<double>(decoded - 1) / span);
-    std::printf("%-32s %-20s %10llu %10s %10llu\n", name.c_str(), channel.type_name.c_str(),
+    std::printf("%-32s %-20s %10llu %10s %10llu\n", exc::log::printable_channel(name).c_str(), channel.type_name.c_str(),
                 static_cast<unsigned long long>(channel.messages), rate,
                 static_cast<unsigned long long>(channel.undecodable));
   }
@@ -161,11 +161,11 @@ int main(int argc, char** argv) {
   for (const auto& [name, channel] : summary.channels) {
     if (channel.type_name == "unknown") {
       std::fprintf(stderr, "excavator-log: channel %s is not an exlcm type: not exported\n",
-                   name.c_str());
+                   exc::log::printable_channel(name).c_str());
     }
     if (channel.bucketed) {
       std::printf("%s: %llu messages: %s as %d time buckets (first, last, min, max, sums), detail rows "
-                  "in detail/\n", name.c_str(), static_cast<unsigned long long>(channel.messages),
+                  "in detail/\n", exc::log::printable_channel(name).c_str(), static_cast<unsigned long long>(channel.messages),
                   channel.rows_written ? "one row each, and in buckets/" : "written", options.buckets);
     }
   }

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <type_traits>
 #include <utility>
@@ -19,13 +20,60 @@ namespace exc::log {
 
 namespace {
 
+// LCM's log event: sync word, event number, timestamp, channel length, data length (big-endian), then
+// the channel and the data.
+constexpr std::uint32_t kSyncWord = 0xEDA1DA01;
+constexpr std::uint64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;
+
+std::uint64_t big_endian(const std::uint8_t* bytes, int n) {
+  std::uint64_t value = 0;
+  for (int i = 0; i < n; ++i) value = value << 8 | bytes[i];
+  return value;
+}
+
+// Debian's LCM 1.3.1 reader trusts an event's data length up to its +1: at 2^31 - 1 (a damaged log)
+// the sum wraps negative, calloc returns null and the data is read into it (a segfault); a large
+// length allocates up to 2 GB before the file proves too short; and a damaged header, or a damaged
+// sync word after an event (that event is dropped too), ends its reading. So the next event is
+// found here as it finds one (the next sync word from the file position), its header checked, and a
+// damaged one skipped for the sync word after it: the events after the damage are read too, and the
+// bytes skipped are counted unread. The file is left at the sync word for LCM's reader. False: no
+// sound event follows.
+bool seek_next_sound_event(std::FILE* file, std::uint64_t file_bytes) {
+  for (;;) {
+    std::uint32_t window = 0;
+    int c = 0;
+    while (window != kSyncWord) {
+      if ((c = std::fgetc(file)) == EOF) return false;
+      window = window << 8 | static_cast<std::uint32_t>(c);
+    }
+    const off_t sync_at = ftello(file) - 4;
+    if (sync_at < 0) return false;
+    std::uint8_t header[kEventHeaderBytes - 4];
+    if (std::fread(header, 1, sizeof header, file) != sizeof header) return false;
+    const auto channel_bytes = static_cast<std::int32_t>(big_endian(header + 16, 4));
+    const auto data_bytes = static_cast<std::int32_t>(big_endian(header + 20, 4));
+    // LCM's own rule for the channel (1 to 999 bytes); the data must fit in what the file holds.
+    const bool sound = channel_bytes > 0 && channel_bytes < 1000 && data_bytes >= 0 &&
+                       static_cast<std::uint64_t>(sync_at) + kEventHeaderBytes +
+                               static_cast<std::uint64_t>(channel_bytes) + static_cast<std::uint64_t>(data_bytes) <=
+                           file_bytes;
+    if (fseeko(file, sound ? sync_at : sync_at + 1, SEEK_SET) != 0) return false;
+    if (sound) return true;
+  }
+}
+
+// t + by, held at int64's ends: a damaged log's utime can lie there, where the sum would wrap.
+std::int64_t shifted(std::int64_t t, std::int64_t by) {
+  std::int64_t sum = 0;
+  if (!__builtin_add_overflow(t, by, &sum)) return sum;
+  return by > 0 ? std::numeric_limits<std::int64_t>::max() : std::numeric_limits<std::int64_t>::min();
+}
+
 // LCM's wire format starts every message with its 8-byte big-endian fingerprint.
 bool fingerprint_of(const void* data, std::int32_t size, std::int64_t* hash) {
   if (size < 8) return false;
-  const auto* bytes = static_cast<const std::uint8_t*>(data);
-  std::uint64_t value = 0;
-  for (int i = 0; i < 8; ++i) value = value << 8 | bytes[i];
-  *hash = static_cast<std::int64_t>(value);
+  *hash = static_cast<std::int64_t>(big_endian(static_cast<const std::uint8_t*>(data), 8));
   return true;
 }
 
@@ -86,40 +134,66 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
     return false;
   }
   *summary = LogSummary{};
-  // LCM's event: sync word, event number, timestamp, channel length, data length, channel, data.
-  constexpr std::uint64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;
+  std::error_code size_error;
+  const std::uintmax_t file_bytes = std::filesystem::file_size(log_path, size_error);
+  if (size_error) {
+    *error = log_path + ": cannot read its size (" + size_error.message() + ")";
+    return false;
+  }
+  // A channel's type is its first exlcm message's; an event of another or no exlcm type on a typed
+  // channel (a damaged fingerprint, or two publishers sharing a channel) is counted undecodable and
+  // left out, so that one damaged event neither retypes the channel nor puts foreign rows under its
+  // header.
+  struct Reading {
+    std::int64_t hash = 0;
+    bool typed = false;
+    std::uint64_t decoded = 0, untyped = 0;
+  };
+  std::map<std::string, Reading> readings;
   std::uint64_t event_bytes = 0;
-  while (const lcm::LogEvent* event = log.readNextEvent()) {
+  while (seek_next_sound_event(log.getFilePtr(), file_bytes)) {
+    const lcm::LogEvent* event = log.readNextEvent();
+    if (event == nullptr) continue;  // no sync word right after it: LCM drops it; go on from there
     event_bytes += kEventHeaderBytes + event->channel.size() + static_cast<std::uint64_t>(event->datalen);
     if (summary->events == 0) summary->first_log_utime = event->timestamp;
     summary->last_log_utime = event->timestamp;
     ++summary->events;
     ChannelSummary& channel = summary->channels[event->channel];
+    Reading& reading = readings[event->channel];
     if (channel.messages == 0) channel.first_log_utime = event->timestamp;
     channel.last_log_utime = event->timestamp;
     ++channel.messages;
     std::int64_t hash = 0;
     const bool known = fingerprint_of(event->data, event->datalen, &hash) &&
         with_type_of_fingerprint(hash, [&](auto prototype) {
-          channel.type_name = prototype.getTypeName();
-          if (prototype.decode(event->data, 0, event->datalen) < 0) {
+          if (!reading.typed) {
+            reading = Reading{hash, true, 0, reading.untyped};
+            channel.type_name = prototype.getTypeName();
+          }
+          if (hash != reading.hash || prototype.decode(event->data, 0, event->datalen) < 0) {
             ++channel.undecodable;
             return;
           }
-          const bool first = channel.messages - channel.undecodable == 1;  // the first decoded one
+          const bool first = ++reading.decoded == 1;
           channel.min_utime = first ? prototype.utime : std::min(channel.min_utime, prototype.utime);
           channel.max_utime = first ? prototype.utime : std::max(channel.max_utime, prototype.utime);
           on_event(*event, prototype);
         });
-    if (!known) channel.type_name = "unknown";
+    if (!known) ++reading.untyped;
   }
-  std::error_code ec;
-  const std::uintmax_t file_bytes = std::filesystem::file_size(log_path, ec);
-  if (summary->events == 0 && file_bytes > 0 && !ec) {
+  for (auto& [name, channel] : summary->channels) {
+    const Reading& reading = readings[name];
+    if (reading.typed) {
+      channel.undecodable += reading.untyped;
+    } else {
+      channel.type_name = "unknown";
+    }
+  }
+  if (summary->events == 0 && file_bytes > 0) {
     *error = log_path + ": not an LCM log (no event found where LCM's log reader expects one)";
     return false;
   }
-  if (!ec && file_bytes > event_bytes) summary->unread_bytes = file_bytes - event_bytes;
+  if (file_bytes > event_bytes) summary->unread_bytes = file_bytes - event_bytes;
   return true;
 }
 
@@ -127,6 +201,21 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
 
 bool summarize_log(const std::string& log_path, LogSummary* summary, std::string* error) {
   return read_log(log_path, summary, error, [](const lcm::LogEvent&, const auto&) {});
+}
+
+std::string printable_channel(const std::string& channel) {
+  std::string out;
+  for (const char c : channel) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f && c != '\\') {
+      out += c;
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof escaped, "\\x%02X", byte);
+      out += escaped;
+    }
+  }
+  return out;
 }
 
 std::string csv_file_name(const std::string& channel) {
@@ -176,10 +265,13 @@ ChannelWriter open_writer(const std::string& channel, const ChannelSummary& coun
   const auto found = worst.find(controller_of(channel));
   if (found != worst.end()) {
     for (const Worst& j : found->second) {
-      if (j.error >= 0) w.windows.push_back({j.utime - us(options.detail_half_width_s), j.utime + us(options.detail_half_width_s)});
+      if (j.error >= 0) {
+        w.windows.push_back({shifted(j.utime, -us(options.detail_half_width_s)),
+                             shifted(j.utime, us(options.detail_half_width_s))});
+      }
     }
   }
-  w.windows.push_back({counts.max_utime - us(options.detail_tail_s), counts.max_utime});
+  w.windows.push_back({shifted(counts.max_utime, -us(options.detail_tail_s)), counts.max_utime});
   w.detail_path = path_in("detail");
   w.detail = open_csv(w.detail_path, error, failed);
   if (w.detail) write_header(w.detail.get(), message);

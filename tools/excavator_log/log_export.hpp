@@ -11,7 +11,8 @@ namespace exc::log {
 struct ChannelSummary {
   std::string type_name;       // exlcm type, or "unknown" if the fingerprint is not an exlcm type
   std::uint64_t messages = 0;  // events on the channel
-  std::uint64_t undecodable = 0;  // events whose payload did not decode as that type
+  std::uint64_t undecodable = 0;  // events not read as the channel's type: a payload that does not
+                                  // decode, or of another or no exlcm type (see read_log)
   std::int64_t first_log_utime = 0;  // log timestamps, microseconds since the UNIX epoch
   std::int64_t last_log_utime = 0;
   std::int64_t min_utime = 0;  // the messages' own utime (us since the run started), decoded ones
@@ -26,13 +27,21 @@ struct LogSummary {
   std::int64_t first_log_utime = 0;
   std::int64_t last_log_utime = 0;
   // Bytes of the file in no complete event: a log cut short (its writer killed mid-event) or damaged
-  // (LCM's reader skips to the next sync word). The events read are valid; the rest is lost.
+  // (an event whose header is damaged is skipped to the next sync word). The events read are whole;
+  // their payloads are checked only by decoding (LCM's messages carry no checksum).
   std::uint64_t unread_bytes = 0;
-  double duration_s() const { return events ? (last_log_utime - first_log_utime) * 1e-6 : 0.0; }
+  // In doubles: a damaged log's stamps can lie at the ends of int64, where their difference wraps.
+  double duration_s() const {
+    return events ? (static_cast<double>(last_log_utime) - static_cast<double>(first_log_utime)) * 1e-6 : 0.0;
+  }
 };
 
 // Reads the whole log. Returns false and sets `error` (naming the file) if it cannot be read.
 bool summarize_log(const std::string& log_path, LogSummary* summary, std::string* error);
+
+// A channel name as printed: bytes outside printable ASCII as \xNN (a damaged log's channel can hold
+// control characters that would rewrite the terminal).
+std::string printable_channel(const std::string& channel);
 
 // The CSV file name of a channel: '/' (the controller suffix separator) becomes "__", so
 // EXC_STATE/pid goes to EXC_STATE__pid.csv; other characters outside [A-Za-z0-9_.-] become '_'.
