@@ -697,3 +697,28 @@ TEST_CASE("tools/excavator-log reads 300 seeded damaged logs without a crash, ea
     CHECK(exported.events == summary.events);
   }
 }
+
+TEST_CASE("telemetry/export gives two channels of one CSV file name two files") {
+  // EXC_TIMING/pid and EXC_TIMING__pid both map to EXC_TIMING__pid.csv: both were opened for writing
+  // at once and their rows interleaved in one file. The second now gets EXC_TIMING__pid~2.csv.
+  const fs::path dir = exc::test::scratch_dir(fs::temp_directory_path() / ("exc-same-name-" + std::to_string(::getpid())));
+  std::vector<Event> events;
+  for (int k = 0; k < 4; ++k) {
+    events.push_back({"EXC_TIMING/pid", timing_message(1000 * k, k), 1700000000000000 + k});
+    events.push_back({"EXC_TIMING__pid", timing_message(1000 * k, 100 + k), 1700000000000000 + k});
+  }
+  write_log(dir / "run.lcm", events);
+  exc::log::LogSummary summary;
+  std::string error;
+  REQUIRE(exc::log::export_log_to_csv((dir / "run.lcm").string(), (dir / "csv").string(), &summary, &error));
+  CHECK(summary.channels.at("EXC_TIMING/pid").csv_file == "EXC_TIMING__pid.csv");
+  CHECK(summary.channels.at("EXC_TIMING__pid").csv_file == "EXC_TIMING__pid~2.csv");
+  const auto first = read_csv(dir / "csv" / "EXC_TIMING__pid.csv");
+  const auto second = read_csv(dir / "csv" / "EXC_TIMING__pid~2.csv");
+  REQUIRE(first.size() == 5);
+  REQUIRE(second.size() == 5);
+  for (std::size_t r = 1; r < 5; ++r) {
+    CHECK(cell(first, r, "seq") == static_cast<double>(r - 1));
+    CHECK(cell(second, r, "seq") == static_cast<double>(100 + r - 1));
+  }
+}

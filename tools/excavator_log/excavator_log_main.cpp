@@ -163,6 +163,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "excavator-log: channel %s is not an exlcm type: not exported\n",
                    exc::log::printable_channel(name).c_str());
     }
+    if (!channel.csv_file.empty() && channel.csv_file != exc::log::csv_file_name(name)) {
+      std::printf("%s: written to %s (another channel's name maps to %s)\n", exc::log::printable_channel(name).c_str(),
+                  channel.csv_file.c_str(), exc::log::csv_file_name(name).c_str());
+    }
     if (channel.bucketed) {
       std::printf("%s: %llu messages: %s as %d time buckets (first, last, min, max, sums), detail rows "
                   "in detail/\n", exc::log::printable_channel(name).c_str(), static_cast<unsigned long long>(channel.messages),

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <set>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -239,14 +240,14 @@ namespace {
 // options.full_rows messages, its bucketed view beyond options.bucket_rows (in buckets/ next to the
 // rows, in place of them beyond full_rows), and then its detail rows around `worst` and at its end.
 template <class Message>
-ChannelWriter open_writer(const std::string& channel, const ChannelSummary& counts, const Message& message,
-                          const WorstErrors& worst, const std::string& out_dir, const ExportOptions& options,
-                          std::string* error, bool* failed) {
+ChannelWriter open_writer(const std::string& channel, const std::string& file_name, const ChannelSummary& counts,
+                          const Message& message, const WorstErrors& worst, const std::string& out_dir,
+                          const ExportOptions& options, std::string* error, bool* failed) {
   namespace fs = std::filesystem;
   const auto path_in = [&](const char* subdirectory) {
     std::error_code ec;
     fs::create_directories(fs::path(out_dir) / subdirectory, ec);
-    return (fs::path(out_dir) / subdirectory / csv_file_name(channel)).string();
+    return (fs::path(out_dir) / subdirectory / file_name).string();
   };
   ChannelWriter w;
   if (counts.messages <= options.full_rows) {
@@ -311,15 +312,24 @@ bool export_log_to_csv(const std::string& log_path, const std::string& out_dir,
   }
   // Second reading: the rows.
   std::map<std::string, ChannelWriter> writers;
+  std::set<std::string> file_names;
   bool write_failed = false;
   LogSummary again;
   const bool read_ok = read_log(log_path, &again, error, [&](const lcm::LogEvent& event, const auto& message) {
     auto it = writers.find(event.channel);
     if (it == writers.end()) {
       ChannelSummary& counts = summary->channels[event.channel];
-      it = writers.emplace(event.channel,
-                           open_writer(event.channel, counts, message, worst, out_dir, options, error, &write_failed))
+      // Two channels can map to one file name (EXC_STATE/pid and EXC_STATE__pid, or two damaged
+      // names): the later one gets a numbered name rather than both writing one file.
+      std::string file_name = csv_file_name(event.channel);
+      for (int n = 2; !file_names.insert(file_name).second; ++n) {
+        file_name = csv_file_name(event.channel);
+        file_name.insert(file_name.size() - 4, "~" + std::to_string(n));
+      }
+      it = writers.emplace(event.channel, open_writer(event.channel, file_name, counts, message, worst, out_dir,
+                                                      options, error, &write_failed))
                .first;
+      counts.csv_file = file_name;
       counts.rows_written = it->second.rows != nullptr;
       counts.bucketed = it->second.view != nullptr;
     }

@@ -19,6 +19,7 @@ struct ChannelSummary {
   std::int64_t max_utime = 0;
   bool rows_written = false;   // export_log_to_csv wrote one row per message (see ExportOptions)
   bool bucketed = false;       // and/or its bucketed view
+  std::string csv_file;        // its file name when exported: csv_file_name, numbered if another took it
 };
 
 struct LogSummary {
@@ -45,6 +46,7 @@ std::string printable_channel(const std::string& channel);
 
 // The CSV file name of a channel: '/' (the controller suffix separator) becomes "__", so
 // EXC_STATE/pid goes to EXC_STATE__pid.csv; other characters outside [A-Za-z0-9_.-] become '_'.
+// A second channel of the same file name is exported as NAME~2.csv (~3, ...).
 std::string csv_file_name(const std::string& channel);
 
 // How export_log_to_csv writes a long channel.
