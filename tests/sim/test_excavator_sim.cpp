@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <lcm/lcm-cpp.hpp>
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/machine_state_t.hpp"
@@ -628,6 +629,89 @@ TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to t
   CHECK(a["missing_shard_files"][0]["cases"] == nlohmann::json::array({1, 5}));
   CHECK(read_text_file(dir / "absent.err").find("nowhere/shard1.jsonl is not there (shard 1/4") != std::string::npos);
   CHECK(a["merged"].get<int>() == 6);
+}
+
+TEST_CASE("tools/excavator-sim sweep-merge takes only this spec's records: shards of another spec or of an edited spec or scene, and lines of the wrong shape, are named and left out, and a case with two different records fails the merge") {
+  // Shard files of an earlier run left in the directory (a shell glob picks them up) merged silently
+  // into a table of another spec; a line with a missing or mistyped field stopped the merge with a
+  // JSON library exception naming no file, or read past a missing field (undefined behaviour).
+  const Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  std::ofstream(dir / "scene.yaml") << read_text_file(kDig);
+  std::string spec = "sweep:\n  scene: scene.yaml\n  controllers: [pid]\n  cases: 2\n  duration: 0.2\n"
+                     "  perturbations:\n    soil_stiffness: [0.5, 3.0]\n    model_mass: [-0.1, 0.1]\n"
+                     "    delay_cycles: [0, 2]\n";
+  std::ofstream(dir / "spec.yaml") << spec;
+  const std::string in_dir = "cd '" + dir.string() + "' && " + EXC_SIM_TOOL;
+  REQUIRE(std::system((in_dir + " sweep spec.yaml --quiet --out one.jsonl > /dev/null 2>&1").c_str()) == 0);
+  const auto merge = [&](const std::string& files, const std::string& out) {
+    const int raw = std::system((in_dir + " sweep-merge spec.yaml " + files + " --out " + out + " --no-charts > /dev/null 2> " +
+                                 out + ".err").c_str());
+    return std::pair<int, nlohmann::json>(WIFEXITED(raw) ? WEXITSTATUS(raw) : -1,
+                                          nlohmann::json::parse(read_text_file(dir / out / "sweep.json")));
+  };
+  // The control: its own records merge whole.
+  auto [status, j] = merge("one.jsonl", "whole");
+  CHECK(status == 0);
+  CHECK(j["merged"] == 2);
+  CHECK(j["ignored_lines"].empty());
+
+  // Edited shapes: a run without its ok, a mistyped failure, a case out of range, a mistyped draw,
+  // no digest; each line named with its file and number.
+  std::vector<nlohmann::json> lines;
+  std::istringstream records(read_text_file(dir / "one.jsonl"));
+  for (std::string l; std::getline(records, l);) lines.push_back(nlohmann::json::parse(l));
+  REQUIRE(lines.size() == 2);
+  const std::vector<std::pair<std::function<void(nlohmann::json&)>, std::string>> edits = {
+      {[](nlohmann::json& l) { l["pid"].erase("ok"); }, "run 'pid' has no ok"},
+      {[](nlohmann::json& l) { l["pid"]["failure"] = 3; }, "run 'pid' has a field of the wrong type"},
+      {[](nlohmann::json& l) { l["case"] = 7; }, "its case is not a whole number in [0, 2)"},
+      {[](nlohmann::json& l) { l["soil_stiffness"] = "stiff"; }, "its soil_stiffness is not a number"},
+      {[](nlohmann::json& l) { l.erase("model_mass"); }, "its model_mass is not a number"},
+      {[](nlohmann::json& l) { l.erase("spec"); }, "no spec digest"},
+  };
+  for (const auto& [edit, why] : edits) {
+    CAPTURE(why);
+    nlohmann::json bad = lines[0];
+    edit(bad);
+    std::ofstream(dir / "edited.jsonl") << bad.dump() << "\n" << lines[1].dump() << "\n";
+    auto [edited_status, e] = merge("edited.jsonl", "edited");
+    CHECK(edited_status == 1);
+    CHECK(e["missing"] == nlohmann::json::array({0}));
+    REQUIRE(e["ignored_lines"].size() == 1);
+    CHECK(e["ignored_lines"][0]["line"] == 1);
+    CHECK(e["ignored_lines"][0]["why"].get<std::string>().find(why) == 0);
+    CHECK(read_text_file(dir / "edited.err").find("edited.jsonl line 1: " + why) != std::string::npos);
+  }
+
+  // A second record of a case: the same one is taken once; a different one fails the merge.
+  std::tie(status, j) = merge("one.jsonl one.jsonl", "twice");
+  CHECK(status == 0);
+  CHECK(j["conflicting_records"].empty());
+  nlohmann::json other = lines[1];
+  other["pid"]["ok"] = !other["pid"]["ok"].get<bool>();
+  std::ofstream(dir / "other.jsonl") << other.dump() << "\n";
+  std::tie(status, j) = merge("one.jsonl other.jsonl", "conflict");
+  CHECK(status == 1);
+  REQUIRE(j["conflicting_records"].size() == 1);
+  CHECK(j["conflicting_records"][0]["case"] == 1);
+
+  // The spec edited (a longer run), or its scene edited (a comment line is enough: the bytes count):
+  // the old records are another sweep's.
+  for (const char* what : {"spec", "scene"}) {
+    CAPTURE(what);
+    if (std::string(what) == "spec") {
+      std::ofstream(dir / "spec.yaml") << spec << "  seed: 2\n";
+    } else {
+      std::ofstream(dir / "spec.yaml") << spec;
+      std::ofstream(dir / "scene.yaml") << read_text_file(kDig) << "# edited\n";
+    }
+    std::tie(status, j) = merge("one.jsonl", std::string("stale-") + what);
+    CHECK(status == 1);
+    CHECK(j["merged"] == 0);
+    REQUIRE(j["ignored_lines"].size() == 2);
+    CHECK(j["ignored_lines"][0]["why"].get<std::string>().find("of another spec, or of this one before it or its scenes were edited") == 0);
+  }
 }
 
 TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the cases deterministically, variants and a second grid follow, the merge writes the table, the failures by value and the stability chart") {

@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
         std::vector<fs::path> files(merge_files.begin(), merge_files.end());
         const exc::sim::MergeOutcome merged = exc::sim::merge_sweep(spec, files, merge_out, !merge_no_charts);
         std::cout << "sweep: " << (fs::path(merge_out) / "sweep.csv").string() << (merged.complete ? "" : " (cases missing)")
-                  << (merged.charts_ok ? "" : " (a chart failed)") << "\n";
+                  << (merged.charts_ok ? "" : " (a chart failed)") << (merged.consistent ? "" : " (records conflict)") << "\n";
         return merged.ok() ? 0 : 1;
       }
       int shard = 0, shards = 1;

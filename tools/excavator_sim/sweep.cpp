@@ -4,7 +4,9 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <random>
 #include <stdexcept>
 
@@ -150,6 +152,22 @@ bool parse_shard(const std::string& text, int& shard, int& shards) {
          shard < shards;
 }
 
+namespace {
+// FNV-1a (64 bit) of the spec's bytes and then its scenes' bytes, as 16 hex digits: what a shard
+// line carries so that the merge can tell a line of this spec from one of another or an edited one.
+std::string content_digest(const std::string& spec_file, const std::vector<std::string>& scenes) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (std::size_t f = 0; f <= scenes.size(); ++f) {
+    std::ifstream in(f == 0 ? spec_file : scenes[f - 1], std::ios::binary);
+    for (char c; in.get(c);) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+    h = (h ^ 0xFF) * 0x100000001b3ULL;  // a file boundary, so that bytes moved between files count
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+}  // namespace
+
 SweepSpec load_sweep_spec(const std::string& path) {
   const settings::Document doc = settings::Document::load(path);
   const YAML::Node raw = doc.root()["sweep"];
@@ -241,6 +259,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
   if (spec.total_cases() > 10'000'000) s.fail_here("more than 10 million cases");
   s.finish();
   top.finish();
+  spec.digest = content_digest(path, spec.scenes);
   return spec;
 }
 

@@ -80,6 +80,9 @@ struct SweepSpec {
   std::vector<SweepVariant> variants;
   SweepAxis search;                 // knob empty: none
   std::vector<std::string> record{"failures"};
+  // The spec file's and its scenes' contents as 16 hex digits: every shard line carries it, and the
+  // merge takes only lines that carry this spec's.
+  std::string digest;
 
   int grid_points() const;  // over all grids (1 without a grid)
   int total_cases() const;
@@ -127,7 +130,8 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const std::fil
 struct MergeOutcome {
   bool complete = true;
   bool charts_ok = true;
-  bool ok() const { return complete && charts_ok; }
+  bool consistent = true;  // no case with two different records (runs are deterministic)
+  bool ok() const { return complete && charts_ok && consistent; }
 };
 
 // Merges shard files (absent ones reported with their cases) into out_dir: sweep.csv, sweep.json

@@ -54,9 +54,59 @@ std::string draw_region(const json& j) {
          : j["delay_cycles"].get<int>() >= 2 ? "delay >= 2 cycles" : "elsewhere";
 }
 
+std::vector<std::string> run_columns(const SweepSpec& spec) {
+  return spec.run == SweepRun::open_loop ? std::vector<std::string>{"plant"} : spec.controllers;
+}
+
+// Why a shard line is not a record of one of this spec's cases, "" when it is one: its spec digest,
+// its case number, and the type of every field the table, the regions and the campaign read (a
+// const json read where a field is missing is undefined behaviour, a wrong type an exception).
+std::string record_problem(const SweepSpec& spec, const json& j) {
+  if (!j.is_object()) return "not a JSON object";
+  const auto digest = j.find("spec");
+  if (digest == j.end() || !digest->is_string()) return "no spec digest (a shard of an older excavator-sim?)";
+  if (*digest != spec.digest)
+    return "of another spec, or of this one before it or its scenes were edited (spec digest " +
+           digest->get<std::string>() + ", this spec's " + spec.digest + ")";
+  const auto id = j.find("case");
+  if (id == j.end() || !id->is_number_integer() || id->get<long long>() < 0 || id->get<long long>() >= spec.total_cases())
+    return "its case is not a whole number in [0, " + std::to_string(spec.total_cases()) + ")";
+  const auto is = [&](const json& o, const char* key, bool (json::*type)() const noexcept) {
+    return !o.contains(key) || (o[key].*type)();
+  };
+  const std::pair<const char*, const SweepRange*> draws[] = {{"model_mass", &spec.model_mass},
+                                                             {"soil_stiffness", &spec.soil_stiffness},
+                                                             {"position_noise", &spec.position_noise},
+                                                             {"delay_cycles", &spec.delay_cycles}};
+  for (const auto& [draw, range] : draws)
+    if (!is(j, draw, &json::is_number) || (range->given && !j.contains(draw)))
+      return std::string("its ") + draw + " is not a number";
+  if (spec.scenes.size() > 1 && !(j.contains("scene") && j["scene"].is_string())) return "no scene name";
+  if (!is(j, "variant", &json::is_string)) return "its variant is not a name";
+  if (j.contains("fault")) {
+    const json& f = j["fault"];
+    if (!f.is_object() || !(f.contains("kind") && f["kind"].is_string()) || !(f.contains("start") && f["start"].is_number()))
+      return "its fault has no kind or start";
+  }
+  for (const std::string& name : run_columns(spec)) {
+    if (!j.contains(name) || !j[name].is_object()) return "no result of run '" + name + "'";
+    const json& r = j[name];
+    if (!(r.contains("ok") && r["ok"].is_boolean())) return "run '" + name + "' has no ok (true or false)";
+    // rms_error: one figure per joint, or null for a run that never tracked.
+    const bool rms_ok = !r.contains("rms_error") || r["rms_error"].is_null() || r["rms_error"].is_object();
+    if (!rms_ok || !is(r, "failure", &json::is_string) || !is(r, "outcome", &json::is_string) ||
+        !is(r, "safe_state_time", &json::is_number) || !is(r, "fault_detected_time", &json::is_number))
+      return "run '" + name + "' has a field of the wrong type";
+  }
+  return "";
+}
+
 // Reads the shard files' lines into `cases`; a file that is not there is named with its cases when
-// its name tells its shard (shard-I.jsonl of the N given, or shard-I-of-N.jsonl).
-json read_shards(const SweepSpec& spec, const std::vector<fs::path>& files, std::map<int, json>& cases) {
+// its name tells its shard (shard-I.jsonl of the N given, or shard-I-of-N.jsonl). A line that is not
+// a record of this spec's cases is named and left out (in `ignored`), and so is a second record of a
+// case (in `conflicts` when it differs from the first).
+json read_shards(const SweepSpec& spec, const std::vector<fs::path>& files, std::map<int, json>& cases,
+                 json& ignored, json& conflicts) {
   json absent = json::array();
   const std::regex shard_name(R"(.*?(\d+)(?:-of-(\d+))?)");
   for (const fs::path& f : files) {
@@ -80,24 +130,40 @@ json read_shards(const SweepSpec& spec, const std::vector<fs::path>& files, std:
       continue;
     }
     std::string line;
-    int n = 0;
+    int n = 0, ignored_here = 0;
+    constexpr int kNamedPerFile = 3;
     while (std::getline(in, line)) {
       ++n;
       if (line.empty()) continue;
+      const std::string at = f.string() + " line " + std::to_string(n);
+      json j;
+      std::string problem;
       try {
-        const json j = json::parse(line);
-        cases[j.at("case").get<int>()] = j;
+        j = json::parse(line);
+        problem = record_problem(spec, j);
       } catch (const json::exception&) {
-        // A shard killed mid-write leaves a torn last line: that case counts as missing.
-        std::fprintf(stderr, "sweep merge: %s line %d: not a complete record, ignored\n", f.string().c_str(), n);
+        problem = "not a complete record";  // a shard killed mid-write leaves a torn last line
+      }
+      if (!problem.empty()) {
+        // The first few of a file on stderr (a stale 1000-case shard is 1000 lines), all in sweep.json.
+        if (++ignored_here <= kNamedPerFile) std::fprintf(stderr, "sweep merge: %s: %s; ignored\n", at.c_str(), problem.c_str());
+        ignored.push_back({{"file", f.string()}, {"line", n}, {"why", problem}});
+        continue;
+      }
+      const int id = j["case"].get<int>();
+      const auto [it, first] = cases.emplace(id, j);
+      if (first) continue;
+      if (it->second != j) {
+        std::fprintf(stderr, "sweep merge: case %d: %s holds a record that differs from an earlier one; the first is kept\n",
+                     id, at.c_str());
+        conflicts.push_back({{"case", id}, {"file", f.string()}, {"line", n}});
       }
     }
+    if (ignored_here > kNamedPerFile)
+      std::fprintf(stderr, "sweep merge: %s: %d more lines ignored (all in sweep.json's ignored_lines)\n", f.string().c_str(),
+                   ignored_here - kNamedPerFile);
   }
   return absent;
-}
-
-std::vector<std::string> run_columns(const SweepSpec& spec) {
-  return spec.run == SweepRun::open_loop ? std::vector<std::string>{"plant"} : spec.controllers;
 }
 
 // robustness.json as `excavator-sim robustness` writes it (the variants' rows), for plot-run.
@@ -120,7 +186,8 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
                          bool charts) {
   MergeOutcome outcome;
   std::map<int, json> cases;
-  const json absent_files = read_shards(spec, shard_files, cases);
+  json ignored = json::array(), conflicts = json::array();
+  const json absent_files = read_shards(spec, shard_files, cases, ignored, conflicts);
   fs::create_directories(out_dir);
   const std::vector<std::string> runs = run_columns(spec), knobs = spec.set_knobs();
   const std::pair<const char*, const SweepRange*> draws[] = {{"model_mass", &spec.model_mass},
@@ -191,7 +258,8 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
     csv << "\n";
   }
   json summary = {{"spec", spec.file}, {"cases", spec.total_cases()}, {"merged", cases.size()}, {"missing", missing},
-                  {"missing_shard_files", absent_files}, {"campaign", campaign}};
+                  {"missing_shard_files", absent_files}, {"ignored_lines", ignored}, {"conflicting_records", conflicts},
+                  {"campaign", campaign}};
   if (spec.records("failures")) {
     summary["failures"] = failures;
     summary["failure_kinds"] = kinds;
@@ -222,6 +290,11 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
       std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", cmd.c_str());
       outcome.charts_ok = false;
     }
+  }
+  if (!conflicts.empty()) {
+    std::fprintf(stderr, "sweep merge: %zu cases have two different records: the runs are not reproducible as merged\n",
+                 conflicts.size());
+    outcome.consistent = false;
   }
   if (!missing.empty()) {
     std::fprintf(stderr, "sweep merge: %zu of %d cases missing (first: %d); rerun their shards\n", missing.size(),

@@ -148,7 +148,9 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
   int done = 0;
   const int total = spec.total_cases();
   for (int id = shard; id < total; id += shards) {
-    file << runner(spec, sweep_case(spec, id)).dump() << "\n";
+    nlohmann::json line = runner(spec, sweep_case(spec, id));
+    line["spec"] = spec.digest;
+    file << line.dump() << "\n";
     output::flush_file(file, out);  // a shard that dies keeps the cases it finished
     ++done;
     if (progress && done % 10 == 0) std::fprintf(stderr, "sweep shard %d/%d: %d cases done\n", shard, shards, done);
