@@ -91,7 +91,7 @@ void print_summary(const Summary& summary, std::ostream& out) {
         r.task_finished ? format("task finished at %.3f s", r.task_finish_time) : std::string("task not finished");
     out << format("%-10s %s; peak soil force %8.1f kN, %d shear re-anchorings; control step median %.1f us, p99 %.1f us, "
                   "max %.1f us; heap allocations in loop %llu; telemetry %llu messages, %llu dropped; "
-                  "%.1f s simulated in %.2f s (%.0fx real time)\n",
+                  "%.1f s simulated in %.3g s (%.0fx real time)\n",
                   r.controller.c_str(), task.c_str(), r.peak_soil_force * 1e-3, r.reanchor_count,
                   r.control_step.median_us, r.control_step.p99_us, r.control_step.max_us,
                   static_cast<unsigned long long>(r.heap_allocations_in_loop),
