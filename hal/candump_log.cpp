@@ -25,12 +25,16 @@ bool parse_candump_line(const std::string& line, CandumpLine& out, std::string& 
   std::size_t i = 0;
   if (line.empty() || line[0] != '(') return fail(error, "expected '(' opening the time stamp", 0);
   ++i;
+  // Seconds up to 9e9 (the year 2255): their nanoseconds fit an int64, and more digits would overflow.
+  constexpr std::int64_t kMaxSeconds = 9'000'000'000;
   std::int64_t seconds = 0;
   std::size_t digits = 0;
   while (i < line.size() && std::isdigit(static_cast<unsigned char>(line[i]))) {
+    if (seconds > kMaxSeconds) return fail(error, "time stamp beyond 9e9 s", 1);
     seconds = seconds * 10 + (line[i++] - '0');
     ++digits;
   }
+  if (seconds > kMaxSeconds) return fail(error, "time stamp beyond 9e9 s", 1);
   if (digits == 0 || i >= line.size() || line[i] != '.') return fail(error, "expected seconds.fraction time stamp", i);
   ++i;
   std::int64_t fraction_ns = 0;

@@ -58,6 +58,14 @@ TEST_CASE("hal/candump log lines parse into frames") {
     CHECK_FALSE(parse_candump_line(bad, line, error));
     CHECK(error.find("column") != std::string::npos);
   }
+  // A time stamp whose nanoseconds would not fit an int64 (the digits overflowed, signed: undefined).
+  CHECK(parse_candump_line("(9000000000.999999) vcan0 123#00", line, error));
+  CHECK(line.frame.timestamp_ns == 9000000000999999000LL);
+  for (const char* far : {"(9000000001.0) vcan0 123#00", "(99999999999999999999999.0) vcan0 123#00"}) {
+    CAPTURE(far);
+    CHECK_FALSE(parse_candump_line(far, line, error));
+    CHECK(error == "time stamp beyond 9e9 s at column 2");
+  }
   // Nine bytes is no CAN FD length.
   CHECK_FALSE(parse_candump_line("(1.0) vcan0 123##1001122334455667788", line, error));
   CHECK(error.find("9 data bytes is not a CAN FD length") != std::string::npos);
