@@ -81,7 +81,7 @@ std::string record_problem(const SweepSpec& spec, const json& j) {
   for (const auto& [draw, range] : draws)
     if (!is(j, draw, &json::is_number) || (range->given && !j.contains(draw)))
       return std::string("its ") + draw + " is not a number";
-  if (spec.scenes.size() > 1 && !(j.contains("scene") && j["scene"].is_string())) return "no scene name";
+  if (!is(j, "scene", &json::is_string) || (spec.scenes.size() > 1 && !j.contains("scene"))) return "no scene name";
   if (!is(j, "variant", &json::is_string)) return "its variant is not a name";
   if (j.contains("fault")) {
     const json& f = j["fault"];
@@ -130,7 +130,7 @@ json read_shards(const SweepSpec& spec, const std::vector<fs::path>& files, std:
       continue;
     }
     std::string line;
-    int n = 0, ignored_here = 0;
+    int n = 0, ignored_here = 0, conflicts_here = 0;
     constexpr int kNamedPerFile = 3;
     while (std::getline(in, line)) {
       ++n;
@@ -154,14 +154,18 @@ json read_shards(const SweepSpec& spec, const std::vector<fs::path>& files, std:
       const auto [it, first] = cases.emplace(id, j);
       if (first) continue;
       if (it->second != j) {
-        std::fprintf(stderr, "sweep merge: case %d: %s holds a record that differs from an earlier one; the first is kept\n",
-                     id, at.c_str());
+        if (++conflicts_here <= kNamedPerFile)
+          std::fprintf(stderr, "sweep merge: case %d: %s holds a record that differs from an earlier one; the first is kept\n",
+                       id, at.c_str());
         conflicts.push_back({{"case", id}, {"file", f.string()}, {"line", n}});
       }
     }
     if (ignored_here > kNamedPerFile)
       std::fprintf(stderr, "sweep merge: %s: %d more lines ignored (all in sweep.json's ignored_lines)\n", f.string().c_str(),
                    ignored_here - kNamedPerFile);
+    if (conflicts_here > kNamedPerFile)
+      std::fprintf(stderr, "sweep merge: %s: %d more differing records (all in sweep.json's conflicting_records)\n",
+                   f.string().c_str(), conflicts_here - kNamedPerFile);
   }
   return absent;
 }
@@ -292,7 +296,7 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
     }
   }
   if (!conflicts.empty()) {
-    std::fprintf(stderr, "sweep merge: %zu cases have two different records: the runs are not reproducible as merged\n",
+    std::fprintf(stderr, "sweep merge: %zu records differ from an earlier record of their case: the runs are not reproducible as merged\n",
                  conflicts.size());
     outcome.consistent = false;
   }
