@@ -321,11 +321,10 @@ bool export_log_to_csv(const std::string& log_path, const std::string& out_dir,
       ChannelSummary& counts = summary->channels[event.channel];
       // Two channels can map to one file name (EXC_STATE/pid and EXC_STATE__pid, or two damaged
       // names): the later one gets a numbered name rather than both writing one file.
-      std::string file_name = csv_file_name(event.channel);
-      for (int n = 2; !file_names.insert(file_name).second; ++n) {
-        file_name = csv_file_name(event.channel);
-        file_name.insert(file_name.size() - 4, "~" + std::to_string(n));
-      }
+      const std::string plain = csv_file_name(event.channel);
+      std::string file_name = plain;
+      for (int n = 2; !file_names.insert(file_name).second; ++n)
+        file_name = plain.substr(0, plain.size() - 4) + "~" + std::to_string(n) + ".csv";
       it = writers.emplace(event.channel, open_writer(event.channel, file_name, counts, message, worst, out_dir,
                                                       options, error, &write_failed))
                .first;

@@ -153,14 +153,19 @@ bool parse_shard(const std::string& text, int& shard, int& shards) {
 }
 
 namespace {
-// FNV-1a (64 bit) of the spec's bytes and then its scenes' bytes, as 16 hex digits: what a shard
-// line carries so that the merge can tell a line of this spec from one of another or an edited one.
-std::string content_digest(const std::string& spec_file, const std::vector<std::string>& scenes) {
+// FNV-1a (64 bit) of the spec's text (as read once by its Document) and then its scenes' bytes, as 16
+// hex digits: what a shard line carries so that the merge can tell a line of this spec from one of
+// another or an edited one.
+std::string content_digest(const std::string& spec_text, const std::vector<std::string>& scenes) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
-  for (std::size_t f = 0; f <= scenes.size(); ++f) {
-    std::ifstream in(f == 0 ? spec_file : scenes[f - 1], std::ios::binary);
-    for (char c; in.get(c);) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
-    h = (h ^ 0xFF) * 0x100000001b3ULL;  // a file boundary, so that bytes moved between files count
+  const auto add = [&h](char c) { h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL; };
+  const auto end_of_file = [&h] { h = (h ^ 0xFF) * 0x100000001b3ULL; };  // so that bytes moved between files count
+  for (const char c : spec_text) add(c);
+  end_of_file();
+  for (const std::string& scene : scenes) {
+    std::ifstream in(scene, std::ios::binary);
+    for (char c; in.get(c);) add(c);
+    end_of_file();
   }
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
@@ -259,7 +264,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
   if (spec.total_cases() > 10'000'000) s.fail_here("more than 10 million cases");
   s.finish();
   top.finish();
-  spec.digest = content_digest(path, spec.scenes);
+  spec.digest = content_digest(doc.text(), spec.scenes);
   return spec;
 }
 

@@ -1,5 +1,6 @@
 // The merge of a sweep's shard files: the table (a row per case), the summary (missing cases and
 // shard files, failures by region, the fault campaign's outcomes) and the charts the spec records.
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -54,6 +55,14 @@ std::string draw_region(const json& j) {
          : j["delay_cycles"].get<int>() >= 2 ? "delay >= 2 cycles" : "elsewhere";
 }
 
+// The Monte-Carlo draws by their name in a shard line and in the table.
+std::array<std::pair<const char*, const SweepRange*>, 4> drawn_ranges(const SweepSpec& spec) {
+  return {{{"model_mass", &spec.model_mass},
+           {"soil_stiffness", &spec.soil_stiffness},
+           {"position_noise", &spec.position_noise},
+           {"delay_cycles", &spec.delay_cycles}}};
+}
+
 std::vector<std::string> run_columns(const SweepSpec& spec) {
   return spec.run == SweepRun::open_loop ? std::vector<std::string>{"plant"} : spec.controllers;
 }
@@ -74,10 +83,7 @@ std::string record_problem(const SweepSpec& spec, const json& j) {
   const auto is = [&](const json& o, const char* key, bool (json::*type)() const noexcept) {
     return !o.contains(key) || (o[key].*type)();
   };
-  const std::pair<const char*, const SweepRange*> draws[] = {{"model_mass", &spec.model_mass},
-                                                             {"soil_stiffness", &spec.soil_stiffness},
-                                                             {"position_noise", &spec.position_noise},
-                                                             {"delay_cycles", &spec.delay_cycles}};
+  const auto draws = drawn_ranges(spec);
   for (const auto& [draw, range] : draws)
     if (!is(j, draw, &json::is_number) || (range->given && !j.contains(draw)))
       return std::string("its ") + draw + " is not a number";
@@ -194,10 +200,7 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   const json absent_files = read_shards(spec, shard_files, cases, ignored, conflicts);
   fs::create_directories(out_dir);
   const std::vector<std::string> runs = run_columns(spec), knobs = spec.set_knobs();
-  const std::pair<const char*, const SweepRange*> draws[] = {{"model_mass", &spec.model_mass},
-                                                             {"soil_stiffness", &spec.soil_stiffness},
-                                                             {"position_noise", &spec.position_noise},
-                                                             {"delay_cycles", &spec.delay_cycles}};
+  const auto draws = drawn_ranges(spec);
   std::ofstream csv = output::open_file(out_dir / "sweep.csv");
   csv << "case";
   if (spec.scenes.size() > 1) csv << ",scene";
