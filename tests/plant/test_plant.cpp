@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -184,13 +185,14 @@ TEST_CASE("tools/excavator-plant-replay runs a scene from a CSV of efforts and w
                      " > /dev/null 2>&1").c_str()) != 0);
 }
 
-TEST_CASE("tools/excavator-plant-replay refuses a non-finite cell, and on a hydraulic scene an opening beyond 1, at its line and column, and a failed write is exit 2") {
+TEST_CASE("tools/excavator-plant-replay refuses a non-finite cell, a wrong column count, and on a hydraulic scene an opening beyond 1, at its line and column, and a failed write is exit 2") {
   const std::filesystem::path dir = exc::test::scratch_dir(std::filesystem::path(EXC_BINARY_DIR) / "tests" / "plant" /
                                                            ("replay_refusals_" + std::to_string(getpid())));
   // Exit status and stderr of a replay of `csv` on `scene` into `out`.
-  auto replay = [&](const std::string& scene, const std::string& csv, const std::string& out, std::string& err) {
+  auto replay = [&](const std::string& scene, const std::string& csv, const std::string& out, std::string& err,
+                    const std::string& header = "t,swing,boom,arm,bucket\n") {
     const auto efforts = dir / "efforts.csv";
-    std::ofstream(efforts) << "t,swing,boom,arm,bucket\n" << csv;
+    std::ofstream(efforts) << header << csv;
     const std::string cmd = std::string(EXC_PLANT_REPLAY) + " --scene " + EXC_SOURCE_DIR + "/scenes/" + scene +
                             " --efforts " + efforts.string() + " --out " + out + " --duration 0.05 2> " +
                             (dir / "err.txt").string();
@@ -216,6 +218,32 @@ TEST_CASE("tools/excavator-plant-replay refuses a non-finite cell, and on a hydr
   INFO(err);
   CHECK(err.find("efforts.csv:2: column 5 (bucket) is 1.5") != std::string::npos);
   CHECK(err.find("allowed range [-1, 1]") != std::string::npos);
+  // A value beyond the double range is infinite, and refused as such; a subnormal one is a number.
+  CHECK(replay("paper_dig.yaml", "0,0,1e999,2,3\n", out, err) == 2);
+  CHECK(err.find("efforts.csv:2: column 3 (boom) is inf: a finite number is required") != std::string::npos);
+  CHECK(replay("paper_dig.yaml", "0,0,1e-320,2,3\n", out, err) == 0);
+  // Column counts are counted whole: seven cells, and a trailing comma's empty sixth.
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3,4,5\n", out, err) == 2);
+  CHECK(err.find("efforts.csv:2: expected 5 columns t,swing,boom,arm,bucket, found 7") != std::string::npos);
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3,\n", out, err) == 2);
+  CHECK(err.find("efforts.csv:2: expected 5 columns t,swing,boom,arm,bucket, found 6") != std::string::npos);
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n0.02,0,1,2,3\n0.01,0,1,2,3\n", out, err) == 2);
+  CHECK(err.find("efforts.csv:4: column 1 (t) is 0.01: t must increase (the line before has 0.02)") !=
+        std::string::npos);
+  // Without a header the first line is data, also when its cells hold an exponent's letter: the
+  // replay equals the one of the same rows under a header, byte for byte.
+  auto text_of = [](const std::string& path) {
+    std::ifstream in(path);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  };
+  CHECK(replay("paper_dig.yaml", "0,1e3,2,3,4\n0.02,0,2e3,3,4\n", out, err) == 0);
+  const std::string with_header = text_of(out);
+  CHECK(replay("paper_dig.yaml", "0,1e3,2,3,4\n0.02,0,2e3,3,4\n", out, err, "") == 0);
+  CHECK(err.empty());
+  CHECK(with_header.size() > 1000);
+  CHECK(text_of(out) == with_header);
+  // A first line whose first cell is a word is the header, whatever its other cells hold.
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n", out, err, "time,tau\n") == 0);
   // A write that fails (a full disk: /dev/full) is an error naming the output, not a short file.
   REQUIRE(std::filesystem::exists("/dev/full"));
   CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n", "/dev/full", err) == 2);

@@ -2,6 +2,7 @@
 // write the plant's state at every cycle. Exit 0: ran to the end; 1: the plant stopped (its message
 // on stderr); 2: bad input (file, line and reason on stderr).
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -24,52 +25,74 @@ struct Row {
   exc::Vec4 value = exc::Vec4::Zero();
 };
 
-// CSV: a header line, then t,swing,boom,arm,bucket with t increasing, every value finite; valve
-// openings (a hydraulic scene) within -1..1. A bad cell is named by its line and column here, not by
-// the plant when it reaches it.
+// The cells of one CSV line, a trailing empty cell included ("1,2," is three cells).
+std::vector<std::string> split_cells(const std::string& line) {
+  std::vector<std::string> cells(1);
+  for (const char ch : line) {
+    if (ch == ',')
+      cells.emplace_back();
+    else
+      cells.back() += ch;
+  }
+  return cells;
+}
+
+// The whole cell as a number (blanks and a CR around it allowed), or false. strtod, not stod: a
+// subnormal value is a number, and one beyond the double range reads as infinite (refused as such).
+bool parse_number(const std::string& cell, double& value) {
+  const char* begin = cell.c_str();
+  char* end = nullptr;
+  value = std::strtod(begin, &end);
+  if (end == begin) return false;
+  return cell.find_first_not_of(" \t\r", static_cast<std::size_t>(end - begin)) == std::string::npos;
+}
+
+std::string shortest(double v) {
+  std::ostringstream s;
+  s.precision(17);
+  s << v;
+  return s.str();
+}
+
+// CSV: an optional header line (the first line whose first cell is not a number: a data line such
+// as "0,1e3,..." is data, not a header), then t,swing,boom,arm,bucket with t increasing, every value
+// finite; valve openings (a hydraulic scene) within -1..1. A bad cell is named by its line and
+// column here, not by the plant when it reaches it.
 std::vector<Row> read_efforts(const std::string& path, bool valve_openings) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open the file");
   std::vector<Row> rows;
   std::string line;
   int number = 0;
+  bool first_content_line = true;
+  const char* const columns[5] = {"t", "swing", "boom", "arm", "bucket"};
   while (std::getline(in, line)) {
     ++number;
-    if (line.empty() || line[0] == '#') continue;
-    if (number == 1 && line.find_first_of("abcdefghijklmnopqrstuvwxyz") != std::string::npos) continue;  // header
-    std::stringstream ss(line);
-    Row r;
-    std::string cell;
+    if (line.find_first_not_of(" \t\r") == std::string::npos || line[0] == '#') continue;
+    const std::vector<std::string> cells = split_cells(line);
     double v[5];
-    int n = 0;
-    while (std::getline(ss, cell, ',') && n < 6) {
-      try {
-        std::size_t used = 0;
-        v[n < 5 ? n : 4] = std::stod(cell, &used);
-        if (cell.find_first_not_of(" \t\r", used) != std::string::npos) throw std::invalid_argument("");
-      } catch (const std::exception&) {
-        throw std::runtime_error(path + ":" + std::to_string(number) + ": column " + std::to_string(n + 1) +
-                                 " is not a number: '" + cell + "'");
-      }
-      ++n;
+    if (first_content_line) {
+      first_content_line = false;
+      if (!parse_number(cells[0], v[0])) continue;  // the header
     }
-    if (n != 5)
-      throw std::runtime_error(path + ":" + std::to_string(number) +
-                               ": expected 5 columns t,swing,boom,arm,bucket, found " + std::to_string(n));
-    const char* const columns[5] = {"t", "swing", "boom", "arm", "bucket"};
+    const std::string at = path + ":" + std::to_string(number);
+    if (cells.size() != 5)
+      throw std::runtime_error(at + ": expected 5 columns t,swing,boom,arm,bucket, found " +
+                               std::to_string(cells.size()));
     for (int c = 0; c < 5; ++c) {
-      const std::string place = path + ":" + std::to_string(number) + ": column " + std::to_string(c + 1) + " (" + columns[c] + ")";
-      std::ostringstream value;
-      value << v[c];
-      if (!std::isfinite(v[c])) throw std::runtime_error(place + " is " + value.str() + ": a finite number is required");
+      const std::string place = at + ": column " + std::to_string(c + 1) + " (" + columns[c] + ")";
+      if (!parse_number(cells[c], v[c])) throw std::runtime_error(place + " is not a number: '" + cells[c] + "'");
+      if (!std::isfinite(v[c])) throw std::runtime_error(place + " is " + shortest(v[c]) + ": a finite number is required");
       if (valve_openings && c > 0 && std::abs(v[c]) > 1)
-        throw std::runtime_error(place + " is " + value.str() +
+        throw std::runtime_error(place + " is " + shortest(v[c]) +
                                  ": the scene's actuators are hydraulic, so the columns are valve openings, allowed range [-1, 1]");
     }
+    Row r;
     r.t = v[0];
     r.value = exc::Vec4(v[1], v[2], v[3], v[4]);
     if (!rows.empty() && !(r.t > rows.back().t))
-      throw std::runtime_error(path + ":" + std::to_string(number) + ": t must increase (" + std::to_string(r.t) + ")");
+      throw std::runtime_error(at + ": column 1 (t) is " + shortest(r.t) + ": t must increase (the line before has " +
+                               shortest(rows.back().t) + ")");
     rows.push_back(r);
   }
   if (rows.empty()) throw std::runtime_error(path + ": no rows of efforts");
@@ -83,7 +106,8 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Runs a scene open-loop from a CSV of efforts (zero-order hold) and writes the plant's state at every "
       "cycle.\nCSV columns: t,swing,boom,arm,bucket: swing torque (N m) and cylinder forces (N, positive pushes "
-      "longer); for actuators.fidelity hydraulic, valve openings -1..1 instead.",
+      "longer); for actuators.fidelity hydraulic, valve openings -1..1 instead. An optional header line (its first "
+      "cell not a number), blank lines and lines starting with # are skipped.",
       "excavator-plant-replay"};
   std::string scene_path, efforts_path, out_path;
   double duration = 0;
