@@ -144,7 +144,11 @@ StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& s
     maps.step.insert(maps.step.end(), rows.begin(), rows.end());
   }
   for (const json& j : run_spec(control, out, sim::run_closed_loop_case, maps.failed_merges)) {
-    const auto& [knob, value] = *j["set"].items().begin();
+    // The case's one set knob, copied out: a binding to `*items().begin()` refers into a temporary
+    // that is gone by the next line (AddressSanitizer: stack-use-after-scope).
+    const json::const_iterator set = j["set"].cbegin();
+    const std::string knob = set.key();
+    const json value = set.value();
     for (const std::string& c : control.controllers) {
       if (c == "pid" && knob == "adaptation_scale") continue;  // PID adapts nothing
       ControlStability row;
