@@ -62,6 +62,8 @@ void write_sweep_spec(const std::string& shipped, int cases, const std::string& 
 // both are read from the bytes as the .lcm files define them, without the generated code.
 struct LogChannel {
   std::int64_t count = 0, first_seq = -1, last_seq = -1, seq_gaps = 0;
+  std::int64_t out_of_order = 0;     // a sequence number not above the one before (a repeat or a step back)
+  std::int64_t stamp_mismatches = 0;  // utime not (seq + 1) ms: cycle seq's message stamped with another cycle
   std::int64_t first_utime = -1, last_utime = -1;
   std::map<std::int64_t, std::int64_t> utime_steps;  // utime difference to the previous message: how often
 };
@@ -84,8 +86,10 @@ std::map<std::string, LogChannel> read_log_channels(const fs::path& path) {
       c.first_utime = utime;
     } else {
       if (seq != c.last_seq + 1) ++c.seq_gaps;
+      if (seq <= c.last_seq) ++c.out_of_order;
       ++c.utime_steps[utime - c.last_utime];
     }
+    if (utime != (seq + 1) * 1000) ++c.stamp_mismatches;
     c.last_seq = seq;
     c.last_utime = utime;
     ++c.count;
@@ -103,8 +107,11 @@ const char* const kOtherChannels[] = {"EXC_TIMING", "EXC_CAN_STATS", "EXC_FAULT"
 // no gap) and stamped with consecutive cycles (utime 1000, 2000, ... us, each cycle's end: no
 // repeat, no gap);
 // and no channel the list above does not know (a new per-cycle channel must be added there).
+// `allowed_missing` > 0 only for a receiver known to drop (lcm-logger over udpm): up to that many
+// messages of a channel may be absent, and what was recorded must still be in order, each message
+// stamped with its own cycle.
 void check_every_cycle_logged(const std::map<std::string, LogChannel>& log, const std::vector<std::string>& controllers,
-                              std::int64_t cycles) {
+                              std::int64_t cycles, std::int64_t allowed_missing = 0) {
   for (const auto& [name, channel] : log) {
     const std::string base = name.substr(0, name.find('/'));
     const std::string suffix = name.find('/') == std::string::npos ? "" : name.substr(name.find('/') + 1);
@@ -121,6 +128,18 @@ void check_every_cycle_logged(const std::map<std::string, LogChannel>& log, cons
       INFO(name);
       REQUIRE(log.count(name) == 1);
       const LogChannel& l = log.at(name);
+      CHECK(l.out_of_order == 0);
+      CHECK(l.stamp_mismatches == 0);
+      if (allowed_missing > 0) {
+        // Sequence numbers 0 .. cycles-1 in order, some absent: what is absent was lost at the receiver.
+        const std::int64_t missing = cycles - l.count;
+        MESSAGE(name << ": " << missing << " of " << cycles << " messages not recorded by the receiver");
+        CHECK(missing >= 0);
+        CHECK(missing <= allowed_missing);
+        CHECK(l.seq_gaps <= missing);
+        CHECK(l.last_seq <= cycles - 1);
+        continue;
+      }
       CHECK(l.count == cycles);
       CHECK(l.first_seq == 0);
       CHECK(l.seq_gaps == 0);
@@ -342,7 +361,7 @@ TEST_CASE("tools/excavator-sim: a run that never tracked (valve commands to a fo
   fs::remove(scene);
 }
 
-TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records every message of every cycle of the 10 s dig, every controller the scene runs") {
+TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records the 10 s dig of every controller the scene runs, in order, losing at most 1 % at the logger") {
   // Multicast on the loopback must work: a machine without it fails here with what to run.
   const int port = 17700 + static_cast<int>(getpid() % 200);
   const std::string url = "udpm://239.255.76.67:" + std::to_string(port) + "?ttl=0";
@@ -385,7 +404,13 @@ TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback reco
   for (const auto& [key, value] : j.items())
     if (value.is_object() && value.contains("telemetry")) controllers.push_back(key);
   CHECK(controllers == std::vector<std::string>{"adaptive", "flow", "pid"});  // the JSON's keys, sorted
-  check_every_cycle_logged(read_log_channels(log_path), controllers, 10100);
+  // lcm-logger (Debian's LCM 1.3.1) keeps LCM's 30-message subscription queue and drops beyond it
+  // when its thread falls behind: a freshly installed CI machine under ctest -j2 lost one message of
+  // each per-cycle channel with the logger at real-time priority, and the kernel's UDP counters no
+  // drop. So up to 1 % may be absent here, as in the telemetry path's own udpm test; the sender's
+  // side must lose nothing (below), and the file:// log of the main job (the paper dig test) must
+  // hold every message.
+  check_every_cycle_logged(read_log_channels(log_path), controllers, 10100, 10100 / 100);
   for (const std::string& c : controllers) {
     INFO(c);
     CHECK(j[c]["telemetry"]["dropped"].get<long long>() == 0);
