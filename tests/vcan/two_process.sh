@@ -349,7 +349,7 @@ scenario_realtime() {
     start_capture_and_plant "$dir" "$duration" --realtime || { scene=$base; return; }
     # An allowance of 10 % of the cycles late or skipped at 10 ms. The emulated vCPU is a host thread:
     # even at real-time priority (--rt-vm) and alone among the tests, a shared host stalls it now and
-    # then (1 + 1 of 300 in one run here, 5 + 5 in the next: over the 3 % this test allowed). What the
+    # then (5 + 5 of 300 in one run here, over the 3 % this test allowed, and 1 + 1 in the next). What the
     # run must show is the mechanism (tracked, ok, misses counted), not a TCG VM's jitter; 0.25 ms, below
     # the firmware's own cycle in the VM (its control step alone takes about 0.1 ms there) and the
     # plant's answer, misses nearly all of its deadlines, far beyond any allowance (docs/vcan.md).
