@@ -330,15 +330,38 @@ TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run,
   fs::remove(forced);
 }
 
-TEST_CASE("tools/excavator-sim: a run that never tracked (valve commands to a force-actuated plant, which sends no pressures and takes no pilots) says so: ok false, the reason, null tracking figures, exit 1") {
-  // The paper dig's force-actuated plant sends no chamber pressures, so its sensor set never has
-  // what the valve stage's force loop needs (the firmware faults, "no pressures"), and it stops at
-  // the first pilot command it gets: neither controller ever tracks.
-  const fs::path scene = edited_scene(
+TEST_CASE("tools/excavator-sim refuses a scene whose firmware commands what its machine does not take, naming the file, the line and both fields (exit 2)") {
+  // The paper dig's force-actuated plant takes efforts; valve commands to it could only fail at the
+  // first one. Given in the file: refused at its line.
+  const fs::path valves = edited_scene(
       kPaperDig, {{"  actuator_lag: 0.02           # s: the firmware compensates the actuators' lag (target 5 ms)",
                    "  command_interface: valve"}},
       "paper_dig_valves");
-  const Run r = run_sim("run " + scene.string() + " --controller pid,adaptive --duration 1 --no-report --quiet --json summary.json --out out");
+  const Run r = run_sim("run " + valves.string() + " --controller pid --duration 1 --no-report --quiet --out out");
+  INFO(r.out << r.err);
+  CHECK(r.status == 2);
+  CHECK(r.err.find(valves.string() + ":25:") != std::string::npos);
+  CHECK(r.err.find("controller.command_interface: is valve but actuators.fidelity is limited") != std::string::npos);
+  CHECK(r.err.find("set command_interface: effort") != std::string::npos);
+  CHECK_FALSE(fs::exists(r.dir / "out" / "summary.json"));
+  // The hydraulic dig without its command_interface line: the default (effort) does not fit, and the
+  // message says it was the default.
+  const fs::path efforts = edited_scene(
+      kDig, {{"  command_interface: valve     # pilot pressures through the valve stage (force loop, orifice map)\n", ""}},
+      "dig_efforts");
+  const Run e = run_sim("run " + efforts.string() + " --controller pid --duration 1 --no-report --quiet --out out");
+  INFO(e.out << e.err);
+  CHECK(e.status == 2);
+  CHECK(e.err.find(efforts.string() + ": controller.command_interface: is effort (not given: the default) but "
+                   "actuators.fidelity is hydraulic, which takes valve (pilot pressure) commands; set command_interface: valve") !=
+        std::string::npos);
+  fs::remove(valves);
+  fs::remove(efforts);
+}
+
+TEST_CASE("tools/excavator-sim: a run that never tracked (it ends before the task starts) says so: ok false, the reason, null tracking figures, exit 1") {
+  // The firmware holds the machine for its first 50 ms and tracks after: a 20 ms run never tracks.
+  const Run r = run_sim("run " + kPaperDig + " --controller pid,adaptive --duration 0.02 --no-report --quiet --json summary.json --out out");
   INFO(r.out << r.err);
   CHECK(r.status == 1);
   const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "summary.json"));
@@ -347,18 +370,17 @@ TEST_CASE("tools/excavator-sim: a run that never tracked (valve commands to a fo
     INFO("controller " << c);
     CHECK_FALSE(j[c]["ok"].get<bool>());
     const std::string failure = j[c]["failure"].get<std::string>();
-    CHECK((failure.find("no pressures") != std::string::npos || failure.find("pilot commands for actuators.fidelity limited") != std::string::npos));
+    CHECK(failure == "the firmware never tracked (mode hold)");
     CHECK(j[c]["tracking_samples"].get<long long>() == 0);
     // A metric of no samples is absent, not 0.
     CHECK(j[c]["rms_error"].is_null());
     CHECK(j[c]["max_error"].is_null());
     CHECK(j[c]["tracking"]["rms_error"].is_null());
     CHECK(j[c]["tracking"]["max_error"].is_null());
-    CHECK(r.out.find("  FAILED: " + j[c]["failure"].get<std::string>() + "\n") != std::string::npos);
+    CHECK(r.out.find("  FAILED: " + failure + "\n") != std::string::npos);
   }
   CHECK(r.out.find("n/a") != std::string::npos);
   CHECK(r.out.find("0.000e+00") == std::string::npos);
-  fs::remove(scene);
 }
 
 TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records the 10 s dig of every controller the scene runs, in order, losing at most 1 % at the logger") {
