@@ -143,6 +143,9 @@ Machine load_machine(const std::string& path);
 Machine load_machine_from_string(const std::string& yaml, const std::string& file_for_errors);
 // The reference machine compiled into the binary (same numbers as machines/reference-20t.yaml).
 Machine reference_machine();
+// The built-in machine's file as it was compiled in (what a sweep's digest covers for scenes without
+// a machine file).
+const char* reference_machine_text();
 // Checks hydraulics built or changed in C++ against the ranges the machine file's reader declares
 // (SettingsError naming machine.source and the field, e.g. "hydraulics.pump_flow").
 void validate_hydraulics(const Machine& machine);

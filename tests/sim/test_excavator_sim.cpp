@@ -678,13 +678,17 @@ TEST_CASE("tools/excavator-sim sweep: shards run through GNU parallel merge to t
   CHECK(a["merged"].get<int>() == 6);
 }
 
-TEST_CASE("tools/excavator-sim sweep-merge takes only this spec's records: shards of another spec or of an edited spec or scene, and lines of the wrong shape, are named and left out, and a case with two different records fails the merge") {
+TEST_CASE("tools/excavator-sim sweep-merge takes only this spec's records: shards of another spec or of an edited spec, scene or machine file, and lines of the wrong shape, are named and left out, and a case with two different records fails the merge") {
   // Shard files of an earlier run left in the directory (a shell glob picks them up) merged silently
   // into a table of another spec; a line with a missing or mistyped field stopped the merge with a
   // JSON library exception naming no file, or read past a missing field (undefined behaviour).
   const Run setup = run_sim("--help");
   const fs::path dir = setup.dir;
-  std::ofstream(dir / "scene.yaml") << read_text_file(kDig);
+  // The scene names its machine file (a copy of the reference one), whose bytes the digest covers too.
+  const std::string machine = read_text_file(std::string(EXC_SOURCE_DIR) + "/machines/reference-20t.yaml");
+  std::ofstream(dir / "machine.yaml") << machine;
+  const std::string scene = read_text_file(kDig) + "machine: machine.yaml\n";
+  std::ofstream(dir / "scene.yaml") << scene;
   std::string spec = "sweep:\n  scene: scene.yaml\n  controllers: [pid]\n  cases: 2\n  duration: 0.2\n"
                      "  perturbations:\n    soil_stiffness: [0.5, 3.0]\n    model_mass: [-0.1, 0.1]\n"
                      "    delay_cycles: [0, 2]\n";
@@ -743,22 +747,27 @@ TEST_CASE("tools/excavator-sim sweep-merge takes only this spec's records: shard
   REQUIRE(j["conflicting_records"].size() == 1);
   CHECK(j["conflicting_records"][0]["case"] == 1);
 
-  // The spec edited (a longer run), or its scene edited (a comment line is enough: the bytes count):
-  // the old records are another sweep's.
-  for (const char* what : {"spec", "scene"}) {
+  // The spec edited (a longer run), its scene or the scene's machine file edited (a comment line is
+  // enough: the bytes count): the old records are another sweep's.
+  for (const std::string what : {"spec", "scene", "machine"}) {
     CAPTURE(what);
-    if (std::string(what) == "spec") {
-      std::ofstream(dir / "spec.yaml") << spec << "  seed: 2\n";
-    } else {
-      std::ofstream(dir / "spec.yaml") << spec;
-      std::ofstream(dir / "scene.yaml") << read_text_file(kDig) << "# edited\n";
-    }
-    std::tie(status, j) = merge("one.jsonl", std::string("stale-") + what);
+    std::ofstream(dir / "spec.yaml") << spec << (what == "spec" ? "  seed: 2\n" : "");
+    std::ofstream(dir / "scene.yaml") << scene << (what == "scene" ? "# edited\n" : "");
+    std::ofstream(dir / "machine.yaml") << machine << (what == "machine" ? "# edited\n" : "");
+    std::tie(status, j) = merge("one.jsonl", "stale-" + what);
     CHECK(status == 1);
     CHECK(j["merged"] == 0);
     REQUIRE(j["ignored_lines"].size() == 2);
-    CHECK(j["ignored_lines"][0]["why"].get<std::string>().find("of another spec, or of this one before it or its scenes were edited") == 0);
+    CHECK(j["ignored_lines"][0]["why"].get<std::string>().find(
+              "of another spec, or of this one before it, its scenes or their machine files were edited") == 0);
   }
+  // All three as they were: the records are this spec's again.
+  std::ofstream(dir / "spec.yaml") << spec;
+  std::ofstream(dir / "scene.yaml") << scene;
+  std::ofstream(dir / "machine.yaml") << machine;
+  std::tie(status, j) = merge("one.jsonl", "restored");
+  CHECK(status == 0);
+  CHECK(j["merged"] == 2);
 }
 
 TEST_CASE("tools/excavator-sim sweep: grids cross their values and number the cases deterministically, variants and a second grid follow, the merge writes the table, the failures by value and the stability chart") {

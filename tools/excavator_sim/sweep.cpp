@@ -12,6 +12,7 @@
 
 #include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
+#include "model/machine.hpp"
 #include "fault_campaign.hpp"
 #include "sweep_tables.hpp"
 
@@ -153,19 +154,40 @@ bool parse_shard(const std::string& text, int& shard, int& shards) {
 }
 
 namespace {
-// FNV-1a (64 bit) of the spec's text (as read once by its Document) and then its scenes' bytes, as 16
-// hex digits: what a shard line carries so that the merge can tell a line of this spec from one of
-// another or an edited one.
+// The machine file a scene names (absolute), "" when it names none (the built-in machine) or does
+// not parse: the scene's own load, when a case runs, says what is wrong with it.
+std::string named_machine_file(const std::string& scene) {
+  try {
+    const settings::Document doc = settings::Document::load(scene);
+    const YAML::Node& root = doc.root();
+    if (root.IsMap() && root["machine"] && root["machine"].IsScalar()) return doc.resolve(root["machine"].Scalar());
+  } catch (const std::exception&) {
+  }
+  return "";
+}
+
+// FNV-1a (64 bit) of the spec's text (as read once by its Document), then each scene's bytes and its
+// machine's (the file it names, or the built-in machine's text), as 16 hex digits: what a shard line
+// carries so that the merge can tell a line of this spec from one of another or an edited one.
 std::string content_digest(const std::string& spec_text, const std::vector<std::string>& scenes) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
   const auto add = [&h](char c) { h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL; };
   const auto end_of_file = [&h] { h = (h ^ 0xFF) * 0x100000001b3ULL; };  // so that bytes moved between files count
+  const auto add_file = [&](const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    for (char c; in.get(c);) add(c);
+    end_of_file();
+  };
   for (const char c : spec_text) add(c);
   end_of_file();
   for (const std::string& scene : scenes) {
-    std::ifstream in(scene, std::ios::binary);
-    for (char c; in.get(c);) add(c);
-    end_of_file();
+    add_file(scene);
+    if (const std::string machine = named_machine_file(scene); !machine.empty()) {
+      add_file(machine);
+    } else {
+      for (const char* c = reference_machine_text(); *c != 0; ++c) add(*c);
+      end_of_file();
+    }
   }
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));

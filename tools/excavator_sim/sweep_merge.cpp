@@ -75,7 +75,7 @@ std::string record_problem(const SweepSpec& spec, const json& j) {
   const auto digest = j.find("spec");
   if (digest == j.end() || !digest->is_string()) return "no spec digest (a shard of an older excavator-sim?)";
   if (*digest != spec.digest)
-    return "of another spec, or of this one before it or its scenes were edited (spec digest " +
+    return "of another spec, or of this one before it, its scenes or their machine files were edited (spec digest " +
            digest->get<std::string>() + ", this spec's " + spec.digest + ")";
   const auto id = j.find("case");
   if (id == j.end() || !id->is_number_integer() || id->get<long long>() < 0 || id->get<long long>() >= spec.total_cases())
