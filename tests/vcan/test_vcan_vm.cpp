@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdlib>
@@ -218,4 +219,42 @@ TEST_CASE("vcan/vcan-vm names the Debian package when QEMU is missing") {
   CHECK(r.status == 125);
   CHECK(r.err.find("qemu-system-x86_64") != std::string::npos);
   CHECK(r.err.find("Debian package qemu-system-x86") != std::string::npos);
+}
+
+TEST_CASE("vcan/vcan-vm removes the run directories that killed runs left, and keeps a live run's and a just-made one's") {
+  // A SIGKILL (ctest's timeout) runs no trap: the run directory stayed in TMPDIR. Each run names its
+  // owner (pid and start time); the next run removes a directory whose owner is gone.
+  const fs::path dir = make_work_dir("stale");
+  const fs::path tmp = dir / "tmp";
+  fs::create_directories(tmp);
+  // This process's start time (field 22 of /proc/self/stat, counted after the name's ')').
+  const std::string stat = read_text_file("/proc/self/stat");
+  std::istringstream fields(stat.substr(stat.rfind(')') + 2));
+  std::string field, started;
+  for (int i = 3; i <= 22 && fields >> field; ++i) started = field;
+  REQUIRE(!started.empty());
+  const std::string self = std::to_string(getpid());
+  const auto make = [&](const std::string& name, const std::string& owner) {
+    const fs::path d = tmp / ("exc-vcan-vm-run." + name);
+    fs::create_directories(d / "out");
+    if (!owner.empty()) std::ofstream(d / "owner") << owner << "\n";
+    return d;
+  };
+  const fs::path gone = make("gone", "4194305 12345");         // above any pid_max: no such process
+  const fs::path reused = make("reused", self + " 1");         // a live pid, but not the process that made it
+  const fs::path live = make("live", self + " " + started);    // this process: a run still going
+  const fs::path old_unowned = make("old", "");                // no owner file, two hours old
+  fs::last_write_time(old_unowned, fs::file_time_type::clock::now() - std::chrono::hours(2));
+  const fs::path new_unowned = make("new", "");                // no owner file yet: a run being set up
+  // --host fails at once on a host without vcan (125) and runs `true` on one with it (0): either way
+  // no VM boots, and the clean-up has run.
+  RunResult r = run("TMPDIR=" + quote(tmp.string()) + " " + kVcanVm + " --host --verbose -- true", dir);
+  INFO(r.err);
+  CHECK((r.status == 0 || r.status == 125));
+  CHECK_FALSE(fs::exists(gone));
+  CHECK_FALSE(fs::exists(reused));
+  CHECK_FALSE(fs::exists(old_unowned));
+  CHECK(fs::exists(live / "owner"));
+  CHECK(fs::exists(new_unowned / "out"));
+  CHECK(r.err.find("removed " + gone.string() + ", left by a run that was killed") != std::string::npos);
 }
