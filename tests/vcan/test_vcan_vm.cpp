@@ -246,6 +246,7 @@ TEST_CASE("vcan/vcan-vm removes the run directories that killed runs left, and k
   const fs::path old_unowned = make("old", "");                // no owner file, two hours old
   fs::last_write_time(old_unowned, fs::file_time_type::clock::now() - std::chrono::hours(2));
   const fs::path new_unowned = make("new", "");                // no owner file yet: a run being set up
+  const fs::path unreadable = make("torn", "4194305");         // an owner line without its start time: left alone
   // --host fails at once on a host without vcan (125) and runs `true` on one with it (0): either way
   // no VM boots, and the clean-up has run.
   RunResult r = run("TMPDIR=" + quote(tmp.string()) + " " + kVcanVm + " --host --verbose -- true", dir);
@@ -256,5 +257,6 @@ TEST_CASE("vcan/vcan-vm removes the run directories that killed runs left, and k
   CHECK_FALSE(fs::exists(old_unowned));
   CHECK(fs::exists(live / "owner"));
   CHECK(fs::exists(new_unowned / "out"));
+  CHECK(fs::exists(unreadable / "owner"));
   CHECK(r.err.find("removed " + gone.string() + ", left by a run that was killed") != std::string::npos);
 }
