@@ -80,27 +80,21 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
 
 // The firmware's commands must be of the kind the machine takes: a hydraulic machine takes pilot
 // pressures (command_interface: valve), force-actuated ones take efforts. A run of the two mismatched
-// could only fail at its first command (or never track), so the file is refused at load, at the
-// interface's line when the file gives it.
+// could only fail at its first command (or never track), so the file is refused at load, placed as
+// the settings reader places any error (at the key, or at its section when the key is absent).
 void check_command_fits(const settings::Document& scene, const SceneBundle& b) {
   const bool hydraulic = b.scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
   const control::CommandInterface wanted = hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort;
   const control::CommandInterface given = b.firmware.controller.command_interface;
   if (given == wanted) return;
-  int line = 0, column = 0;
-  const YAML::Node& root = scene.root();
-  if (root.IsMap() && root["controller"].IsMap() && root["controller"]["command_interface"]) {
-    const YAML::Mark m = root["controller"]["command_interface"].Mark();
-    line = m.line + 1;
-    column = m.column + 1;
-  }
-  throw settings::SettingsError(
-      scene.file(), line, column, "controller.command_interface",
-      std::string("is ") + control::kCommandInterfaces.name_of(given) + (line == 0 ? " (not given: the default)" : "") +
-          " but actuators.fidelity is " +
-          plant::to_string(b.scene.actuators.fidelity) + ", which takes " +
-          (hydraulic ? "valve (pilot pressure) commands" : "efforts") + "; set command_interface: " +
-          control::kCommandInterfaces.name_of(wanted));
+  settings::SectionReader top(scene);
+  const settings::SectionReader controller = top.section("controller", "the control law's settings");
+  controller.fail("command_interface",
+                  std::string("is ") + control::kCommandInterfaces.name_of(given) +
+                      (controller.has("command_interface") ? "" : " (not given: the default)") + " but actuators.fidelity is " +
+                      plant::to_string(b.scene.actuators.fidelity) + ", which takes " +
+                      (hydraulic ? "valve (pilot pressure) commands" : "efforts") +
+                      "; set command_interface: " + control::kCommandInterfaces.name_of(wanted));
 }
 
 }  // namespace

@@ -345,14 +345,26 @@ TEST_CASE("tools/excavator-sim refuses a scene whose firmware commands what its 
   CHECK(r.err.find("set command_interface: effort") != std::string::npos);
   CHECK_FALSE(fs::exists(r.dir / "out" / "summary.json"));
   // The hydraulic dig without its command_interface line: the default (effort) does not fit, and the
-  // message says it was the default.
+  // message says it was the default, placed as the settings reader places a missing key: at its
+  // section (the section's first key).
   const fs::path efforts = edited_scene(
       kDig, {{"  command_interface: valve     # pilot pressures through the valve stage (force loop, orifice map)\n", ""}},
       "dig_efforts");
   const Run e = run_sim("run " + efforts.string() + " --controller pid --duration 1 --no-report --quiet --out out");
   INFO(e.out << e.err);
   CHECK(e.status == 2);
-  CHECK(e.err.find(efforts.string() + ": controller.command_interface: is effort (not given: the default) but "
+  int section_line = 0, line_number = 0;
+  bool in_controller = false;
+  std::istringstream edited(read_text_file(efforts));
+  for (std::string line; section_line == 0 && std::getline(edited, line);) {
+    ++line_number;
+    if (line == "controller:") in_controller = true;
+    else if (in_controller && line.size() > 2 && line.compare(0, 2, "  ") == 0 && line[2] != ' ' && line[2] != '#')
+      section_line = line_number;
+  }
+  REQUIRE(section_line > 0);
+  CHECK(e.err.find(efforts.string() + ":" + std::to_string(section_line) +
+                   ":3: controller.command_interface: is effort (not given: the default) but "
                    "actuators.fidelity is hydraulic, which takes valve (pilot pressure) commands; set command_interface: valve") !=
         std::string::npos);
   fs::remove(valves);
