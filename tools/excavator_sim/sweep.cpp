@@ -13,6 +13,7 @@
 #include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
 #include "model/machine.hpp"
+#include "model/scene_common.hpp"
 #include "fault_campaign.hpp"
 #include "sweep_tables.hpp"
 
@@ -154,14 +155,15 @@ bool parse_shard(const std::string& text, int& shard, int& shards) {
 }
 
 namespace {
-// The machine file a scene names (absolute), "" when it names none (the built-in machine) or does
-// not parse: the scene's own load, when a case runs, says what is wrong with it.
+// The machine file a scene names (absolute, as the scene's reader resolves it), "" when it names none
+// (the built-in machine) or its shared keys do not load: the scene's own load, when a case runs, says
+// what is wrong with it.
 std::string named_machine_file(const std::string& scene) {
   try {
     const settings::Document doc = settings::Document::load(scene);
-    const YAML::Node& root = doc.root();
-    if (root.IsMap() && root["machine"] && root["machine"].IsScalar()) return doc.resolve(root["machine"].Scalar());
-  } catch (const std::exception&) {
+    SectionReader top(doc);
+    return read_scene_common(top, doc).machine_file;
+  } catch (const SettingsError&) {
   }
   return "";
 }
