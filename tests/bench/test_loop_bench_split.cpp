@@ -1,8 +1,9 @@
 // excavator-loop-bench --split end to end: the program profiles itself under valgrind's callgrind and
 // prints one cycle's instructions by stage. The table must be consistent with its own nesting: no
 // stage above the stage that calls it, the parts of a node within the node, and the two nodes with
-// the SYNC stage accounting for most of the loop (the rest is the lockstep's own glue). A parse that
-// matched the wrong function, or a double count, breaks one of these.
+// the SYNC stage accounting for most of the loop (the rest is the lockstep's own glue), the model
+// evaluations within the two stages that call them. A parse that matched the wrong function, a double
+// count or a count from outside the loop breaks one of these.
 #include <doctest/doctest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -63,7 +64,7 @@ TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the
     }
     rows.push_back(r);
   }
-  REQUIRE(rows.size() == 20);  // the stages the README's table names
+  REQUIRE(rows.size() == 21);  // the stages the README's table names
   REQUIRE(rows[0].stage.rfind("the loop", 0) == 0);
   const double loop = rows[0].count;
   REQUIRE(loop > 1e3);
@@ -91,6 +92,18 @@ TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the
       if (rows[j].depth == rows[parent].depth + 1 && rows[j].count > 0) parts += rows[j].count;
     CHECK(parts <= rows[parent].count + 300);
   }
+  // The model evaluations run inside the plant's step and the control law only: counted outside the
+  // loop (the scene's load runs them thousands of times) they would exceed both together.
+  auto count_of = [&](const char* prefix) {
+    for (const Row& r : rows)
+      if (r.stage.rfind(prefix, 0) == 0) return r.count;
+    return -1.0;
+  };
+  const double models = count_of("across the nodes: the two model evaluations");
+  const double step = count_of("Plant::step"), law = count_of("control law");
+  REQUIRE(models > 0);
+  if (step > 0 && law > 0) CHECK(models <= step + law + 200);
+  CHECK(out.find("the loop without them would run at about") != std::string::npos);
   if (nodes == 3) {  // all three calls of the loop kept as functions by the compiler
     CHECK(node_sum <= loop + 300);
     CHECK(node_sum >= 0.85 * loop);

@@ -46,6 +46,8 @@ const std::vector<Stage>& stages() {
       {"across the nodes: frame encode (encode_message)", 0, {"exc::hal::encode_message("}},
       {"across the nodes: frame validate and decode (accept, decode_message)", 0,
        {"exc::hal::CanFrameCodec::accept(", "exc::hal::decode_message("}},
+      {"across the nodes: the two model evaluations (update_closed_chain, mass_matrix, bias_forces)", 0,
+       {"exc::update_closed_chain(", "exc::mass_matrix(", "exc::bias_forces("}},
       {"telemetry thread: LCM log writes (TelemetryPublisher::run)", 0, {"exc::telemetry::TelemetryPublisher::run()"}},
   };
   return s;
@@ -83,7 +85,11 @@ std::vector<StageCount> callgrind_split(const std::string& program, const std::v
   // Without debug information: with it callgrind splits a function by the source file of each inlined
   // piece (Eigen's headers), and the inclusive counts of the pieces no longer add up.
   const bool copied = run({"objcopy", "--strip-debug", program, stripped});
+  // Counted only inside the loop and the telemetry thread: the model functions also run while the
+  // scene loads (the effort-feasibility check), which is not a cycle's cost.
   std::vector<std::string> argv = {"valgrind", "-q", "--tool=callgrind", "--callgrind-out-file=" + profile,
+                                   "--toggle-collect=exc::sim::run_lockstep*",
+                                   "--toggle-collect=exc::telemetry::TelemetryPublisher::run*",
                                    copied ? stripped : program};
   argv.insert(argv.end(), args.begin(), args.end());
   if (!run(argv)) {

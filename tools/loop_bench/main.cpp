@@ -47,6 +47,41 @@ struct Repeat {
   double loop = 0, process = 0, wall = 0;  // real-time factors: loop thread CPU, all threads' CPU, wall
 };
 
+double median_process(const std::vector<Repeat>& set) {
+  std::vector<double> v;
+  for (const Repeat& x : set) v.push_back(x.process);
+  return median(v);
+}
+
+// What the loop would run at if its two model evaluations cost nothing: the instructions left, at the
+// rate (instructions per second of all threads' CPU) this run's timing and the split give together.
+// An estimate (it assumes the model runs at the loop's average rate), printed because it says whether
+// any cheaper model can reach a target factor on this machine.
+void print_bound_without_models(const std::vector<bench::StageCount>& counts, double period,
+                                const std::vector<Repeat>& with, const std::vector<Repeat>& without) {
+  auto find = [&](const char* prefix) {
+    for (const bench::StageCount& c : counts)
+      if (c.stage.rfind(prefix, 0) == 0) return c.per_cycle;
+    return -1.0;
+  };
+  const double loop = counts.front().per_cycle, models = find("across the nodes: the two model evaluations"),
+               thread = find("telemetry thread"), plant_encode = find("telemetry encode (PlantNode"),
+               firmware_encode = find("telemetry encode (publish_cycle");
+  if (models <= 0 || thread < 0 || plant_encode < 0 || firmware_encode < 0) {
+    std::printf("\n(no estimate without the model evaluations: a stage was inlined)\n");
+    return;
+  }
+  const double logged = loop + thread, unlogged = loop - plant_encode - firmware_encode;
+  const double rate_logged = logged * median_process(with) / period;  // instructions per CPU second
+  const double rate_unlogged = unlogged * median_process(without) / period;
+  std::printf("\nThe two model evaluations are %.0f %% of a logged cycle's instructions (%.1fk of %.1fk with the "
+              "telemetry thread). At this run's rates (%.1f and %.1f instructions per ns of CPU, logged and not), "
+              "the loop without them would run at about %.0fx with every telemetry message logged and %.0fx with "
+              "none.\n",
+              100 * models / logged, models * 1e-3, logged * 1e-3, rate_logged * 1e-9, rate_unlogged * 1e-9,
+              period * rate_logged / (logged - models), period * rate_unlogged / (unlogged - models));
+}
+
 // One closed-loop run; with telemetry every message goes into an LCM log file (blocking publisher).
 Repeat closed_loop(const sim::SceneBundle& b, const sim::LockstepOptions& base, bool telemetry, const std::string& log) {
   sim::LockstepOptions o = base;
@@ -263,6 +298,7 @@ int main(int argc, char** argv) {
         else std::printf("| %s%s | %.1fk | %.0f %% |\n", indent.c_str(), c.stage.c_str(), c.per_cycle * 1e-3,
                          100 * c.per_cycle / counts.front().per_cycle);
       }
+      print_bound_without_models(counts, period, with, without);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "excavator-loop-bench: %s\n", e.what());
