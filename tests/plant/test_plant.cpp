@@ -247,7 +247,9 @@ TEST_CASE("tools/excavator-plant-replay refuses a non-finite cell, a wrong colum
   // A write that fails (a full disk: /dev/full) is an error naming the output, not a short file.
   REQUIRE(std::filesystem::exists("/dev/full"));
   CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n", "/dev/full", err) == 2);
-  CHECK(err.find("/dev/full: cannot write") != std::string::npos);
+  CHECK(err.find("/dev/full: cannot write (No space left on device)") != std::string::npos);
+  CHECK(replay("paper_dig.yaml", "0,0,1,2,3\n", "/no/such/dir/out.csv", err) == 2);
+  CHECK(err.find("/no/such/dir/out.csv: cannot write (No such file or directory)") != std::string::npos);
 }
 #endif
 

@@ -3,7 +3,9 @@
 // on stderr); 2: bad input (file, line and reason on stderr).
 #include <cmath>
 #include <cstdlib>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -132,7 +134,7 @@ int main(int argc, char** argv) {
   if (!out_path.empty()) {
     out = std::fopen(out_path.c_str(), "w");
     if (!out) {
-      std::cerr << "excavator-plant-replay: " << out_path << ": cannot write\n";
+      std::cerr << "excavator-plant-replay: " << out_path << ": cannot write (" << std::strerror(errno) << ")\n";
       return 2;
     }
   }
@@ -178,8 +180,11 @@ int main(int argc, char** argv) {
   // output is checked at exit (check_stdout_at_exit).
   if (out != stdout) {
     const bool failed = std::ferror(out) != 0;
+    errno = 0;
     if (std::fclose(out) != 0 || failed) {
-      std::cerr << "excavator-plant-replay: " << out_path << ": cannot write\n";
+      // fclose's errno when it failed (the last flush); a write that failed earlier left none.
+      std::cerr << "excavator-plant-replay: " << out_path << ": cannot write"
+                << (errno != 0 ? std::string(" (") + std::strerror(errno) + ")" : std::string()) << "\n";
       return 2;
     }
   }
