@@ -395,6 +395,30 @@ TEST_CASE("tools/excavator-sim: a run that never tracked (it ends before the tas
   CHECK(r.out.find("0.000e+00") == std::string::npos);
 }
 
+TEST_CASE("tools/excavator-sim: the report reads the log --lcm named, and without a log file says why there is no report") {
+  // The log goes outside the output directory; the report must come from it, not from <out>/run.lcm.
+  const fs::path logs = exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" /
+                                               ("lcm_elsewhere_" + std::to_string(getpid())));
+  const fs::path log = logs / "elsewhere.lcm";
+  const Run r = run_sim("run " + kDig + " --controller adaptive --duration 0.3 --quiet --out out --lcm 'file://" +
+                        log.string() + "?mode=w'");
+  INFO(r.err);
+  REQUIRE(r.status == 0);
+  CHECK(fs::exists(log));
+  CHECK(!fs::exists(r.dir / "out" / "run.lcm"));
+  const std::string report = read_text_file(r.dir / "out" / "report" / "report.md");
+  CHECK(report.find("| RMS error arm (mm) |") != std::string::npos);
+  CHECK(r.out.find("report: out/report/report.md") != std::string::npos);
+  // A provider that writes no file (here LCM's in-process queue, as udpm:// would be) leaves nothing
+  // to report from: said on stderr, and the run is still a success.
+  const Run live = run_sim("run " + kDig + " --controller adaptive --duration 0.05 --quiet --out out --lcm memq://");
+  INFO(live.err);
+  CHECK(live.status == 0);
+  CHECK(live.err.find("no report: the telemetry went to memq://, not to a log file") != std::string::npos);
+  CHECK(!fs::exists(live.dir / "out" / "report"));
+  fs::remove_all(logs);
+}
+
 TEST_CASE("tools/excavator-sim over udpm: a real lcm-logger on the loopback records the 10 s dig of every controller the scene runs, in order, losing at most 1 % at the logger") {
   // Multicast on the loopback must work: a machine without it fails here with what to run.
   const int port = 17700 + static_cast<int>(getpid() % 200);

@@ -195,9 +195,9 @@ int run_program(const std::vector<std::string>& argv) {
 
 }  // namespace
 
-int write_report(const std::filesystem::path& out_dir, const std::filesystem::path& summary_json,
-                 const std::string& title) {
-  return run_program({EXC_LOG_TOOL, "report", (out_dir / "run.lcm").string(), "--out", (out_dir / "report").string(),
+int write_report(const std::filesystem::path& log, const std::filesystem::path& out_dir,
+                 const std::filesystem::path& summary_json, const std::string& title) {
+  return run_program({EXC_LOG_TOOL, "report", log.string(), "--out", (out_dir / "report").string(),
                       "--summary", summary_json.string(), "--title", title});
 }
 

@@ -15,8 +15,9 @@ void print_summary(const Summary& summary, std::ostream& out);
 // (a metric of no samples is not 0): the summary's and the sweeps' records.
 nlohmann::json tracked_per_joint(const RunResult& r, const double (&v)[4]);
 nlohmann::json to_json(const Summary& summary);
-// Runs `excavator-log report` on out_dir/run.lcm; returns its exit status.
-int write_report(const std::filesystem::path& out_dir, const std::filesystem::path& summary_json, const std::string& title);
+// Runs `excavator-log report` on the run's log into out_dir/report; returns its exit status.
+int write_report(const std::filesystem::path& log, const std::filesystem::path& out_dir,
+                 const std::filesystem::path& summary_json, const std::string& title);
 // Runs `plot-run --robustness JSON --out DIR` (robustness.png); returns its exit status.
 int plot_robustness(const std::filesystem::path& json, const std::filesystem::path& out_dir);
 

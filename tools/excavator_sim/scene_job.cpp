@@ -53,7 +53,11 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   result.exit_code = result.summary.all_ok ? 0 : 1;
   if (job.report && options.lcm_url.rfind("file://", 0) == 0) {
     const std::string title = bundle.name + ": " + bundle.scene.description;
-    const int rc = write_report(result.out_dir, summary_path, title);
+    // The report reads the log the telemetry went to: <out>/run.lcm, or the file --lcm named
+    // (file://PATH?mode=w: the path between the scheme and the options).
+    const std::string rest = options.lcm_url.substr(7);
+    const fs::path log = rest.substr(0, rest.find('?'));
+    const int rc = write_report(log, result.out_dir, summary_path, title);
     if (rc != 0) {
       std::cerr << "excavator-sim: the report step failed (exit " << rc << "); the log and summary are in "
                 << result.out_dir.string() << "\n";
@@ -61,6 +65,9 @@ SceneJobResult run_scene_job(const SceneJob& job) {
     } else {
       std::cout << "report: " << (result.out_dir / "report" / "report.md").string() << "\n";
     }
+  } else if (job.report) {
+    std::cerr << "excavator-sim: no report: the telemetry went to " << options.lcm_url
+              << ", not to a log file (log it with lcm-logger, then excavator-log report LOG)\n";
   }
   return result;
 }
