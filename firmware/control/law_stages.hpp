@@ -17,10 +17,11 @@ inline void tracking_errors(const ControlInput& in, ControlOutput& out) {
 
 // The model at (q, v): M_a(q) and h_a(q, v) (v is qd for computed torque, the reference velocity for
 // Slotine-Li). False when the model refuses the state: out then carries the status and holds the last
-// good command (never NaN); the loop decides what follows (safe_stop).
+// good command (never NaN); the loop decides what follows (safe_stop). No law reads the passive
+// joints' angles: they are skipped.
 inline bool model_at(const Model& model, Workspace& ws, const Vec4& q, const Vec4& v, const Vec4& last_tau,
                      ControlOutput& out, Mat4& M_a, Vec4& h_a) {
-  const ModelReport report = update_closed_chain(model, ws, q, v);
+  const ModelReport report = update_closed_chain(model, ws, q, v, PassiveAngles::skipped);
   out.status = report.status;
   if (!report.ok()) {
     out.tau = out.tau_unsaturated = last_tau;

@@ -27,13 +27,14 @@ void times_block_diagonal(const Block8& B, const In& A, Out& out) {
 }
 }  // namespace
 
-ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a) {
+ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a,
+                                PassiveAngles angles) {
   if (!q_a.allFinite() || !qd_a.allFinite()) {
     ws.report = ModelReport{ModelStatus::non_finite_input, -1, 0};
     return ws.report;
   }
   // Position level: q_p from q_a in closed form (Table 2), with each pin's cos q, sin q.
-  ws.report = solve_loop_closure(model, ws, q_a);
+  ws.report = solve_loop_closure(model, ws, q_a, angles);
   if (!ws.report.ok()) return ws.report;
   front_positions_from_joint_trig(model, ws.q, ws);
   front_loop_jacobian(model, ws, ws.H);  // H = dh/dq (eq. 4)

@@ -13,8 +13,10 @@ struct TipLoad {
 };
 
 // Position, velocity and acceleration-bias level: loop closure, H, Psi, gamma, tree twists, and the
-// tip kinematics (rho, rhod, J_t, rhodd_bias). Every other function here needs it called first.
-ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a);
+// tip kinematics (rho, rhod, J_t, rhodd_bias). Every other function here needs it called first;
+// none of them needs the passive angles in ws.q (skipped: 8 atan2 fewer, ws.q's passive entries NaN).
+ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a,
+                                PassiveAngles angles = PassiveAngles::computed);
 
 // tau_a for the real machine (eq. 16b) with the soil force f_soil (bucket on soil, total incl.
 // inertial part) acting at the tip; also fills ws.F_c (eq. 7a). Needs update_closed_chain.

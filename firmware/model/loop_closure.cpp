@@ -3,6 +3,7 @@
 #include "loop_closure.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include "front_kinematics.hpp"
 
@@ -63,7 +64,7 @@ void loop_residual(const Model& model, const Vec12& q, Vec8& h) {
   front_loop_residual(model, scratch, h);
 }
 
-ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_a) {
+ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_a, PassiveAngles angles) {
   if (!q_a.allFinite()) return fail(ModelStatus::non_finite_input, -1, 0);
   const Machine& m = model.machine;
   double conditioning = 1.0;
@@ -105,10 +106,11 @@ ModelReport solve_loop_closure(const Model& model, Workspace& ws, const Vec4& q_
     ws.joint_cos[i] = 1.0;
     ws.joint_sin[i] = 0.0;
   }
+  const bool with_angles = angles == PassiveAngles::computed;
   auto set_pin = [&](int i, const Vec2& unit) {
     ws.joint_cos[i] = unit.x();
     ws.joint_sin[i] = unit.y();
-    q[i] = std::atan2(unit.y(), unit.x());
+    q[i] = with_angles ? std::atan2(unit.y(), unit.x()) : std::numeric_limits<double>::quiet_NaN();
   };
   // The unit vector of 'v' seen from the unit reference direction 'ref' (its angle minus ref's).
   auto relative = [](const Vec2& v, const Vec2& ref) {

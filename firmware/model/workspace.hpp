@@ -8,6 +8,11 @@
 
 namespace exc {
 
+// Whether loop closure writes the passive joints' angles into Workspace::q (one atan2 each). Every
+// algorithm here works from their cosines and sines (joint_cos, joint_sin); the angles are for a
+// reported state (the plant's). A controller skips them: its q's passive entries are then NaN.
+enum class PassiveAngles { computed, skipped };
+
 struct Workspace {
   explicit Workspace(const Model& model);
 
