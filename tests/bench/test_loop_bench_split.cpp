@@ -99,7 +99,7 @@ TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the
       if (r.stage.rfind(prefix, 0) == 0) return r.count;
     return -1.0;
   };
-  const double models = count_of("across the nodes: the two model evaluations");
+  const double models = count_of("across the nodes: the model evaluations");
   const double step = count_of("Plant::step"), law = count_of("control law");
   REQUIRE(models > 0);
   if (step > 0 && law > 0) CHECK(models <= step + law + 200);

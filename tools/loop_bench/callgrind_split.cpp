@@ -46,7 +46,7 @@ const std::vector<Stage>& stages() {
       {"across the nodes: frame encode (encode_message)", 0, {"exc::hal::encode_message("}},
       {"across the nodes: frame validate and decode (accept, decode_message)", 0,
        {"exc::hal::CanFrameCodec::accept(", "exc::hal::decode_message("}},
-      {"across the nodes: the two model evaluations (update_closed_chain, mass_matrix, bias_forces)", 0,
+      {"across the nodes: the model evaluations (update_closed_chain, mass_matrix, bias_forces)", 0,
        {"exc::update_closed_chain(", "exc::mass_matrix(", "exc::bias_forces("}},
       {"telemetry thread: LCM log writes (TelemetryPublisher::run)", 0, {"exc::telemetry::TelemetryPublisher::run()"}},
   };

@@ -53,10 +53,10 @@ double median_process(const std::vector<Repeat>& set) {
   return median(v);
 }
 
-// What the loop would run at if its two model evaluations cost nothing: the instructions left, at the
-// rate (instructions per second of all threads' CPU) this run's timing and the split give together.
-// An estimate (it assumes the model runs at the loop's average rate), printed because it says whether
-// any cheaper model can reach a target factor on this machine.
+// What the loop would run at if its model evaluations (plant and firmware) cost nothing: the
+// instructions left, at the rate (instructions per second of all threads' CPU) this run's timing and
+// the split give together. An estimate (it assumes the model runs at the loop's average rate),
+// printed because it says whether any cheaper model can reach a target factor on this machine.
 void print_bound_without_models(const std::vector<bench::StageCount>& counts, double period,
                                 const std::vector<Repeat>& with, const std::vector<Repeat>& without) {
   auto find = [&](const char* prefix) {
@@ -64,7 +64,7 @@ void print_bound_without_models(const std::vector<bench::StageCount>& counts, do
       if (c.stage.rfind(prefix, 0) == 0) return c.per_cycle;
     return -1.0;
   };
-  const double loop = counts.front().per_cycle, models = find("across the nodes: the two model evaluations"),
+  const double loop = counts.front().per_cycle, models = find("across the nodes: the model evaluations"),
                thread = find("telemetry thread"), plant_encode = find("telemetry encode (PlantNode"),
                firmware_encode = find("telemetry encode (publish_cycle");
   if (models <= 0 || thread < 0 || plant_encode < 0 || firmware_encode < 0) {
@@ -74,7 +74,7 @@ void print_bound_without_models(const std::vector<bench::StageCount>& counts, do
   const double logged = loop + thread, unlogged = loop - plant_encode - firmware_encode;
   const double rate_logged = logged * median_process(with) / period;  // instructions per CPU second
   const double rate_unlogged = unlogged * median_process(without) / period;
-  std::printf("\nThe two model evaluations are %.0f %% of a logged cycle's instructions (%.1fk of %.1fk with the "
+  std::printf("\nThe model evaluations are %.0f %% of a logged cycle's instructions (%.1fk of %.1fk with the "
               "telemetry thread). At this run's rates (%.1f and %.1f instructions per ns of CPU, logged and not), "
               "the loop without them would run at about %.0fx with every telemetry message logged and %.0fx with "
               "none.\n",
