@@ -3,6 +3,7 @@
 #include <fstream>
 #include <iostream>
 #include <stdexcept>
+#include <string_view>
 
 #include "output_file.hpp"
 #include "run_report.hpp"
@@ -38,8 +39,11 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   fs::create_directories(result.out_dir);
   // What the run used, every default filled in: it loads back to the same run.
   output::write_file(result.out_dir / "effective.yaml", settings::emit(bundle.effective));
-  options.lcm_url =
-      job.lcm_url.empty() ? "file://" + (fs::absolute(result.out_dir) / "run.lcm").string() + "?mode=w" : job.lcm_url;
+  // LCM's file provider: file://PATH?mode=w.
+  constexpr std::string_view kFileScheme = "file://";
+  options.lcm_url = job.lcm_url.empty()
+                        ? std::string(kFileScheme) + (fs::absolute(result.out_dir) / "run.lcm").string() + "?mode=w"
+                        : job.lcm_url;
 
   result.summary = run_all(bundle, options);
   print_summary(result.summary, std::cout);
@@ -51,11 +55,11 @@ SceneJobResult run_scene_job(const SceneJob& job) {
     output::finish_file(json_file, job.json_path);
   }
   result.exit_code = result.summary.all_ok ? 0 : 1;
-  if (job.report && options.lcm_url.rfind("file://", 0) == 0) {
+  if (job.report && options.lcm_url.rfind(kFileScheme, 0) == 0) {
     const std::string title = bundle.name + ": " + bundle.scene.description;
-    // The report reads the log the telemetry went to: <out>/run.lcm, or the file --lcm named
-    // (file://PATH?mode=w: the path between the scheme and the options).
-    const std::string rest = options.lcm_url.substr(7);
+    // The report reads the log the telemetry went to: <out>/run.lcm, or the file --lcm named (the
+    // path between the scheme and the options).
+    const std::string rest = options.lcm_url.substr(kFileScheme.size());
     const fs::path log = rest.substr(0, rest.find('?'));
     const int rc = write_report(log, result.out_dir, summary_path, title);
     if (rc != 0) {

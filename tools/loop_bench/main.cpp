@@ -47,18 +47,13 @@ struct Repeat {
   double loop = 0, process = 0, wall = 0;  // real-time factors: loop thread CPU, all threads' CPU, wall
 };
 
-double median_process(const std::vector<Repeat>& set) {
-  std::vector<double> v;
-  for (const Repeat& x : set) v.push_back(x.process);
-  return median(v);
-}
-
 // What the loop would run at if its model evaluations (plant and firmware) cost nothing: the
 // instructions left, at the rate (instructions per second of all threads' CPU) this run's timing and
-// the split give together. An estimate (it assumes the model runs at the loop's average rate),
-// printed because it says whether any cheaper model can reach a target factor on this machine.
-void print_bound_without_models(const std::vector<bench::StageCount>& counts, double period,
-                                const std::vector<Repeat>& with, const std::vector<Repeat>& without) {
+// the split give together (the table's all-threads medians, logged and not). An estimate (it assumes
+// the model runs at the loop's average rate), printed because it says whether any cheaper model can
+// reach a target factor on this machine.
+void print_bound_without_models(const std::vector<bench::StageCount>& counts, double period, double logged_factor,
+                                double unlogged_factor) {
   auto find = [&](const char* prefix) {
     for (const bench::StageCount& c : counts)
       if (c.stage.rfind(prefix, 0) == 0) return c.per_cycle;
@@ -72,8 +67,8 @@ void print_bound_without_models(const std::vector<bench::StageCount>& counts, do
     return;
   }
   const double logged = loop + thread, unlogged = loop - plant_encode - firmware_encode;
-  const double rate_logged = logged * median_process(with) / period;  // instructions per CPU second
-  const double rate_unlogged = unlogged * median_process(without) / period;
+  const double rate_logged = logged * logged_factor / period;  // instructions per CPU second
+  const double rate_unlogged = unlogged * unlogged_factor / period;
   std::printf("\nThe model evaluations are %.0f %% of a logged cycle's instructions (%.1fk of %.1fk with the "
               "telemetry thread). At this run's rates (%.1f and %.1f instructions per ns of CPU, logged and not), "
               "the loop without them would run at about %.0fx with every telemetry message logged and %.0fx with "
@@ -214,6 +209,7 @@ int main(int argc, char** argv) {
     }
     std::printf("| run | real-time factor, loop thread CPU | all threads' CPU (one core) | wall%s | 1 s simulated in |\n"
                 "|---|---|---|---|---|\n", pin ? ", pinned to one core" : "");
+    double process_factor[2] = {};  // all threads' median: with telemetry, without
     for (const auto* set : {&with, &without}) {
       std::vector<double> loop, process, wall;
       for (const Repeat& x : *set) {
@@ -225,6 +221,7 @@ int main(int argc, char** argv) {
                   set == &with ? "telemetry, every message in an LCM log" : "no telemetry", median(loop),
                   *std::min_element(loop.begin(), loop.end()), *std::max_element(loop.begin(), loop.end()),
                   median(process), median(wall), 1e3 / median(process));
+      process_factor[set == &with ? 0 : 1] = median(process);
     }
 
     // The floor: the loop's two model evaluations per cycle on this run's states, and the plant alone.
@@ -298,7 +295,7 @@ int main(int argc, char** argv) {
         else std::printf("| %s%s | %.1fk | %.0f %% |\n", indent.c_str(), c.stage.c_str(), c.per_cycle * 1e-3,
                          100 * c.per_cycle / counts.front().per_cycle);
       }
-      print_bound_without_models(counts, period, with, without);
+      print_bound_without_models(counts, period, process_factor[0], process_factor[1]);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "excavator-loop-bench: %s\n", e.what());
