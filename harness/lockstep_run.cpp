@@ -153,7 +153,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   app::FirmwareNodeConfig fc;
   fc.kind = options.controller;
   fc.controller = firmware.controller;
-  fc.terrain_height = firmware.terrain_height;
+  fc.site_map = firmware.terrain;
   fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
   fc.theta_true = theta_of(scene.soil);
   const Model firmware_model = build_model(firmware.machine);

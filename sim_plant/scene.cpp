@@ -83,9 +83,7 @@ Scene read_scene(const settings::Document& doc) {
   s.machine_file = common.machine_file;
   s.machine = std::move(common.machine);
   s.duration = common.duration;
-  s.terrain.height = common.terrain_height;
-  s.terrain.num_points = static_cast<int>(common.terrain_profile.size());
-  for (std::size_t i = 0; i < common.terrain_profile.size(); ++i) s.terrain.profile[i] = common.terrain_profile[i];
+  s.terrain = common.terrain;
   const Machine& m = s.machine;
 
   SectionReader soil = top.section("soil", "the soil model");

@@ -7,20 +7,9 @@
 
 #include "settings/enum_table.hpp"
 #include "model/closed_chain.hpp"
+#include "model/terrain.hpp"
 
 namespace exc::plant {
-
-// The ground surface: flat at 'height', or piecewise linear in x through up to kMaxPoints points
-// (held flat beyond the ends).
-struct Terrain {
-  static constexpr int kMaxPoints = 64;
-  Terrain() { profile.fill(Vec2::Zero()); }
-  double height = 0.0;  // m, world z of a flat terrain
-  int num_points = 0;   // 0: flat; otherwise the profile below is used
-  std::array<Vec2, kMaxPoints> profile;  // (x, z), x strictly increasing
-
-  double height_at(double x) const;
-};
 
 // Diagonal soil parameters (x, z). All zero means no soil.
 struct SoilParameters {

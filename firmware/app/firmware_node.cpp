@@ -250,16 +250,18 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   input.t = t;
   input.q = estimator_.position();
   input.qd = estimator_.velocity();
+  input.qd_measured = qd;
   input.qdd = estimator_.acceleration();
   input.q_d = q_d_;
   input.qd_d = qd_d_;
   input.qdd_d = qdd_d_;
-  input.soil.terrain_height = config_.terrain_height;
+  input.soil.site_map = &config_.site_map;
   input.soil.theta_known = config_.theta_known;
   input.soil.theta = config_.theta_true;
   // What the stage after the law could not deliver last cycle (a clamped lead, a fully open valve):
   // the adaptive laws leave those joints out of their update, the PID its integrator.
   input.actuator_limited = valve_interface() ? valves_.last().limited : lag_compensator_.clamped();
+  input.applied = restarted ? control::AppliedEffort{} : applied_effort();
   out_ = controller_->update(input);
   if (!fault_ && (out_.status != ModelStatus::ok || !finite(out_.tau))) {
     raise(FirmwareFault::model);
@@ -301,6 +303,31 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   control_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
 }
 
+Vec4 FirmwareNode::seal_friction() const {
+  return model_.machine.hydraulics.viscous_friction.cwiseProduct(estimator_.velocity());
+}
+
+control::AppliedEffort FirmwareNode::applied_effort() const {
+  control::AppliedEffort a;
+  if (valve_interface()) {
+    if (!sensors_.pressure_valid) return a;
+    const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+    // What the cylinders push minus what their seals take (the nominal machine's friction): the
+    // effort the mechanism receives, as the model's M_a qdd + h_a + J_t^T F_soil describes it.
+    a.effort = valves_.measured_force(p_a, p_b) - seal_friction();
+    a.valid = a.measured = true;
+    const control::ValveCommand& v = valves_.last();
+    a.suspect = static_cast<std::uint8_t>(v.limited | valves_.off_map(p_a, p_b) | (v.pump_limited ? 0x0F : 0));
+    return a;
+  }
+  if (command_.mode != hal::CommandMode::effort) return a;  // nothing commanded yet, or valves centred
+  // The command still holds last cycle's efforts (this cycle's are computed after the law).
+  a.effort = lag_compensator_.active() ? lag_compensator_.delivered() : to_vec(command_.value);
+  a.valid = true;
+  a.suspect = static_cast<std::uint8_t>(lag_compensator_.clamped() | out_.saturated);
+  return a;
+}
+
 void FirmwareNode::raise(FirmwareFault fault) {
   fault_ = true;
   pending_fault_ = fault;
@@ -324,7 +351,9 @@ void FirmwareNode::command_valves(const Vec4& q) {
     const Vec4 tau = blender_.apply(time(), out_.tau);
     last_sent_ = tau;
     const Vec4 v_ff = qd_d_ - valves_.settings().position_gain.cwiseProduct(out_.e);
-    v = &valves_.from_force(tau, v_ff, q, p_a, p_b);
+    // The cylinders push what the mechanism needs plus what their seals take (the nominal machine's
+    // friction; applied_effort() takes it back out of the measured force).
+    v = &valves_.from_force(tau + seal_friction(), v_ff, q, p_a, p_b);
   }
   if (v->pump_limited) ++pump_limited_cycles_;
   update_pump_warning(v->pump_limited, v->demanded_flow);

@@ -33,7 +33,7 @@ namespace exc::app {
 struct FirmwareNodeConfig {
   control::ControllerKind kind = control::ControllerKind::adaptive;
   control::ControllerConfig controller;
-  double terrain_height = 0;      // m, world z of the flat terrain (from the scene)
+  Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
   double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
   // Simulation only: the plant's true soil parameters, for telemetry and the Lyapunov value.
   bool theta_known = false;
@@ -136,6 +136,11 @@ class FirmwareNode {
 
  private:
   void compute_command(const control::Transition& transition);
+  // The efforts the machine applied over the last cycle as far as the firmware knows them: measured
+  // (valve interface, from the pressures) or the delivered-effort model of the last command.
+  control::AppliedEffort applied_effort() const;
+  // The effort the hydraulic machine's seals take at the estimated velocity (nominal friction).
+  Vec4 seal_friction() const;
   // The valve interface: the law's effort through the force loop (or a flow law's velocity) to the
   // spools' pilot pressures.
   void command_valves(const Vec4& q);

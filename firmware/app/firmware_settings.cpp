@@ -19,7 +19,7 @@ void check_task_efforts(FirmwareSettings& s) {
   if (!task.efforts.check) return;
   control::FeasibilityOptions o;
   o.soil_margin = task.efforts.soil_margin;
-  o.terrain_height = s.terrain_height;
+  o.terrain = s.terrain;
   const Model model = build_model(s.machine);
   const control::FeasibilityReport r = control::check_effort_feasibility(model, task.trajectory, o);
   if (r.ok) return;
@@ -55,9 +55,10 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene) {
   s.name = common.name;
   s.machine_file = common.machine_file;
   s.machine = std::move(common.machine);
-  s.terrain_height = common.terrain_height;  // a profile's shape is the plant's; the estimator anchors to the flat height
+  s.terrain = common.terrain;
   s.duration = s.scene_duration = common.duration;
   settings::SectionReader controller = top.section("controller", "the control law's settings");
+  s.controller = control::controller_defaults(s.machine);
   control::read_controller_config(controller, s.controller);
   settings::SectionReader task = top.section("task", "what the machine does");
   s.task = control::read_task(task, s.machine);

@@ -12,6 +12,7 @@
 #include "control/controller_config.hpp"
 #include "control/task.hpp"
 #include "model/machine.hpp"
+#include "model/terrain.hpp"
 #include "settings/document.hpp"
 
 namespace exc::app {
@@ -23,7 +24,7 @@ struct FirmwareSettings {
   Machine machine;           // the controller's model of the machine (nominal parameters)
   control::ControllerConfig controller;
   control::Task task;
-  double terrain_height = 0;  // m, world z of the flat ground the soil estimator anchors to
+  Terrain terrain;  // the site map (the scene's terrain: flat or a profile) the soil-contact estimate may use
   // s, how long the run lasts: the scene's `duration`, unless task.efforts.fit_timing stretched a
   // path the scene's duration covered (then longer by the time the path grew)
   double duration = 10;

@@ -20,14 +20,35 @@
 //   is zeroed: P is block-diagonal per joint); the other joints keep adapting. Before, any saturated
 //   joint froze the whole update, so a swing at its torque limit (which the soil regressor does not
 //   even act on: J_t has no swing column) stopped the arm and bucket from learning the soil.
-// - rho_env: SoilAnchorEstimator on the controller's own rho (or given, in simulation tests).
+// - Contact and rho_env: SoilContactEstimator (soil_contact.hpp): the site map, or the observer's tip
+//   force (below), or given (simulation tests).
+// Beyond the paper, on by default (controller.external_force; the paper's law is observer: false,
+// prediction_rate: 0), for the machine the firmware really drives:
+// - An external force observer (external_force_observer.hpp): r = tau_applied - M_a qdd - h_a -
+//   Y Theta_hat, with tau_applied measured (chamber pressures) or modelled (a force-commanded
+//   machine); its low-pass d_hat joins eq. 12: tau = ... + Y Theta_hat + d_hat. Through valves the
+//   force loop drives the cylinders toward this command; a steady error of the model (the soil between
+//   re-anchorings, friction, a wrong mass) would otherwise be a steady force error that the valves
+//   turn into motion.
+// - A composite update (Slotine and Li's composite adaptation, normalised): besides eq. 27's tracking
+//   term, Theta_hat_dot += gamma_p S (Y S)^T W dz(r) / (n0^2 + |W (Y S)|^2), the gradient of the
+//   prediction error of the applied efforts, with S = diag(theta_max) (each parameter in units of its
+//   range), W selecting the cylinders not suspect this cycle, dz a dead zone per cylinder, n0 the
+//   force scale. Normalised, a parameter the residual excites converges at about gamma_p whatever
+//   the soil's scale, so one rate fits every machine and interface. Projection as below.
+// - Pauses: a joint whose applied effort is known not to follow the model (a valve fully open, a
+//   relief or make-up valve open, the pumps short: ControlInput::applied.suspect) is left out of both
+//   terms, as a saturated one is.
 // - Tip acceleration for Y: rhodd = J_t qdd_a + Jd_t qd_a with qdd_a the filtered estimate
 //   (state_estimator.hpp) or qdd_d, by config (regressor_acceleration).
 #include "control/controller_config.hpp"
 #include "control/effort_limits.hpp"
 #include "control/pid.hpp"
 #include "control/regressor.hpp"
-#include "control/soil_anchor_estimator.hpp"
+#include "control/external_force_observer.hpp"
+#include "control/soil_contact.hpp"
+#include "control/soil_identification.hpp"
+#include "control/state_estimator.hpp"
 #include "model/closed_chain.hpp"
 
 namespace exc::control {
@@ -60,8 +81,24 @@ class AdaptiveComputedTorque final : public Controller {
   Pid feedback_;                      // K_p e + K_v ed (+ K_i int e), the integral frozen on saturation
   std::uint8_t saturated_ = 0;
   Vec6 theta_hat_ = Vec6::Zero();
-  SoilAnchorEstimator anchor_;
+  SoilContactEstimator contact_;         // on the measured tip: the command's soil term
+  SoilContactEstimator update_contact_;  // on the filtered tip: the composite update's regressor
+  ExternalForceObserver observer_;
+  Vec2 tip_force_ = Vec2::Zero();     // the observer's tip force of the last cycle (contact without a map)
   Vec4 last_tau_ = Vec4::Zero();
+  // The composite update's signals as the acceleration is filtered: applied efforts, h_a, the tip's
+  // velocity and the soil spring's stretch (x, z).
+  using RegressionSignals = Eigen::Matrix<double, 12, 1>;
+  EstimatorLowPass<12> regression_filter_;
+  SoilLeastSquares identification_;
+  double tip_alpha_ = 1;              // the anchor rule's tip filter (first order at the velocity cut-off)
+  Vec2 tip_filtered_ = Vec2::Zero();
+  bool tip_filter_primed_ = false;
+  // The tip filter's stage for the update's other signals: applied efforts, h_a, the tip's velocity
+  // (all through L first), M_a qdd and the tip's acceleration (through L by the estimator).
+  using TipFilterSignals = Eigen::Matrix<double, 16, 1>;
+  TipFilterSignals tip_chain_ = TipFilterSignals::Zero();
+  bool tip_chain_primed_ = false;
 };
 
 }  // namespace exc::control

@@ -33,7 +33,7 @@ ControlOutput ComputedTorquePid::update(const ControlInput& in) {
   x << out.e, out.ed;
   out.lyapunov = out.lyapunov_tracking = x.dot(P_ * x);
   out.rho = ws_.rho;
-  anchor_.resolve(in.soil, ws_.rho, out.in_soil, out.rho_env);
+  anchor_.resolve(in.soil, ws_.rho, nullptr, out.in_soil, out.rho_env);
   return out;
 }
 

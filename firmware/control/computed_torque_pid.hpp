@@ -7,7 +7,7 @@
 #include "control/controller_config.hpp"
 #include "control/effort_limits.hpp"
 #include "control/pid.hpp"
-#include "control/soil_anchor_estimator.hpp"
+#include "control/soil_contact.hpp"
 #include "model/closed_chain.hpp"
 
 namespace exc::control {
@@ -28,7 +28,7 @@ class ComputedTorquePid final : public Controller {
   EffortLimits limits_;
   Pid pid_;
   Mat8 P_ = Mat8::Identity();
-  SoilAnchorEstimator anchor_;
+  SoilContactEstimator anchor_;
   std::uint8_t saturated_ = 0;
   Vec4 last_tau_ = Vec4::Zero();
 };

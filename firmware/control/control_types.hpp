@@ -5,15 +5,18 @@
 #include <cstdint>
 
 #include "model/model_status.hpp"
+#include "model/terrain.hpp"
 #include "model/types.hpp"
 
 namespace exc::control {
 
 // What the controller knows about the soil beyond its own state (model.md s.5, s.6).
 struct SoilContext {
-  double terrain_height = 0;  // world z of the flat terrain (m), from the scene
-  // false (the firmware): the controller estimates contact and the anchor rho_env itself from its
-  // own tip position (soil_anchor_estimator.hpp). true (simulation truth, tests): take them below.
+  // The site map (the scene's ground, flat or a profile) the contact estimate may use; null: none,
+  // contact is then told by the external force alone (soil_contact.hpp).
+  const Terrain* site_map = nullptr;
+  // false (the firmware): the controller estimates contact and the anchor rho_env itself
+  // (soil_contact.hpp). true (simulation truth, tests): take them below.
   bool anchor_given = false;
   bool in_soil = false;
   Vec2 rho_env = Vec2::Zero();  // anchor (x, z world height) in the swing plane (m)
@@ -23,10 +26,21 @@ struct SoilContext {
   Vec6 theta = Vec6::Zero();
 };
 
+struct AppliedEffort {
+  Vec4 effort = Vec4::Zero();  // N m (swing), N
+  bool valid = false;          // false: nothing known yet (no command sent, no pressures)
+  bool measured = false;       // from chamber pressures (true) or the command's model (false)
+  // Bit j: joint j's effort is known not to follow the law's model this cycle (its valve fully open,
+  // a chamber at its relief or at the make-up valve, the pumps short of flow, its command clamped):
+  // the update leaves the joint out and the observer holds its estimate there.
+  std::uint8_t suspect = 0;
+};
+
 struct ControlInput {
   double t = 0;                  // s
   Vec4 q = Vec4::Zero();         // measured q_a
   Vec4 qd = Vec4::Zero();        // measured (filtered) qd_a
+  Vec4 qd_measured = Vec4::Zero();  // qd_a as the sensors sent it (unfiltered; the composite update's regressor)
   Vec4 qdd = Vec4::Zero();       // filtered qdd_a (state_estimator.hpp); only the adaptive law uses it
   Vec4 q_d = Vec4::Zero(), qd_d = Vec4::Zero(), qdd_d = Vec4::Zero();  // desired
   SoilContext soil;
@@ -34,6 +48,11 @@ struct ControlInput {
   // lead clamped it to its effort limit, or the valve stage opened the valve fully): the adaptive
   // laws leave the joint out of their update and the integrators hold (anti-windup).
   std::uint8_t actuator_limited = 0;
+  // The efforts the machine applied over the last cycle, as the firmware knows them (beyond the
+  // paper): measured from the chamber pressures on a hydraulic machine, else the delivered-effort model
+  // of what was commanded (a force-commanded machine has no pressures). The external force observer
+  // and the composite update read them (external_force_observer.hpp).
+  AppliedEffort applied;
 };
 
 struct ControlOutput {
@@ -46,6 +65,10 @@ struct ControlOutput {
   double lyapunov_tracking = 0;       // the tracking-error part of V alone
   bool in_soil = false;               // contact as the controller sees it
   Vec2 rho = Vec2::Zero(), rho_env = Vec2::Zero();  // tip and anchor as the controller sees them
+  // The external effort observer (laws with one): the part of the applied effort the model and the soil
+  // prediction do not explain, as estimated (its low-pass), and the soil force at the tip it implies.
+  Vec4 disturbance = Vec4::Zero();     // N m, N
+  Vec2 tip_force = Vec2::Zero();       // N, external force on the bucket (x, z)
   ModelStatus status = ModelStatus::ok;  // not ok: tau is the last good command held (never NaN)
   // Flow laws (FlowPositionControl) command each valve's flow instead of an effort: the velocity it
   // should pass (m/s; swing rad/s). Effort laws leave velocity_command false and command tau.

@@ -2,6 +2,8 @@
 // ControllerConfig member's), then the cross-field rules at the offending field's place.
 #include "control/controller_config.hpp"
 
+#include <algorithm>
+
 #include "control/controller_kinds.hpp"
 
 namespace exc::control {
@@ -31,10 +33,6 @@ void check_cross_fields(const SectionReader& r, const ControllerConfig& c) {
       r.fail("ki", j, format_number(c.gains.ki[j]) + " makes the PID loop unstable: must be below kv*kp = " +
                           format_number(c.gains.kv[j] * c.gains.kp[j]));
   }
-  // The leak is integrated by explicit Euler at the control period: below 10 periods it overshoots.
-  if (c.adaptation_leakage_time > 0 && c.adaptation_leakage_time < 10 * c.period)
-    r.fail("adaptation_leakage_time", format_number(c.adaptation_leakage_time) + " s must be 0 (no leakage) or at least 10 "
-                                      "control periods = " + format_number(10 * c.period) + " s");
   // A target slower than the lag would lag more, not less; a lead gain above 20 amplifies the
   // measurement noise that reaches the command twentyfold.
   if (c.actuator_lag > 0 && !(c.actuator_lag_target <= c.actuator_lag && c.actuator_lag <= 20 * c.actuator_lag_target))
@@ -66,12 +64,37 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.numbers("ki", c.gains.ki, {0, 1e8}, "1/s^3", "integral gains (PID baseline; adaptive with integral_action)");
   r.numbers("integral_limit", c.gains.integral_limit, {0, 1e3}, "", "anti-windup bound of the error integral (rad s, m s)");
   r.numbers("lyapunov_q", c.lyapunov_q, kWeight, "", "Q of A^T P + P A + Q = 0, [e; ed] order (eqs. 21-25)");
-  r.numbers("adaptation_rate", c.adaptation_rate, kRate, "", "Gamma^-1 = diag(rate), Theta = [M_x B_x K_x M_z B_z K_z]");
+  r.choice("command_interface", c.command_interface, kCommandInterfaces, "what the firmware commands on the bus");
+  SectionReader v = r.section("valves", "the valve stage between the law and a hydraulic machine's valves");
+  v.number("force_time_constant", c.valves.force_time_constant, {1e-3, 1}, "s", "T_f: the force loop's time constant");
+  v.number("force_integral_time", c.valves.force_integral_time, {0, 100}, "s",
+           "T_i of the force loop's integral (0: none; docs/control.md)");
+  v.number("spool_lag_target", c.valves.spool_lag_target, {0, 1}, "s",
+           "the spool lag the lead aims for (0: no lead); at most the machine's valve_time_constant");
+  v.number("opening_band", c.valves.opening_band, {0, 0.5}, "", "opening below which the dead-zone inverse is linear");
+  // Derived: a fifth of the force loop's bandwidth, so the position correction the flow feedforward
+  // carries stays clear of the loop that delivers it (docs/control.md).
+  if (!v.value_given("position_gain")) c.valves.position_gain = Vec4::Constant(1 / (5 * c.valves.force_time_constant));
+  v.numbers("position_gain", c.valves.position_gain, {0, 1e3}, "1/s",
+            "flow feedforward qd_d - position_gain e: the valve stage's own position correction (default: 1 / (5 T_f))");
+  v.numbers("hold_window", c.valves.hold_window, {0, 0.1}, "",
+            "holding a pose: |e| (rad swing, m) inside which a function's valve stays centred");
+  v.finish();
+  // Derived: eq. 27 reads the tracking error as the soil's doing. Through the valves the effort arrives
+  // through the force loop's T_f, whose lag the update would read as soil: the rates are those of the
+  // force-commanded machine scaled by period / T_f (docs/control.md).
+  c.adaptation_rate_derived = !r.value_given("adaptation_rate");
+  if (c.adaptation_rate_derived && c.command_interface == CommandInterface::valve)
+    c.adaptation_rate *= valve_adaptation_scale(c);
+  if (!r.value_given("tracking_dead_zone") && c.command_interface == CommandInterface::valve)
+    c.tracking_dead_zone = c.valves.hold_window;
+  r.numbers("tracking_dead_zone", c.tracking_dead_zone, {0, 1}, "",
+            "rad (swing), m: eq. 27 leaves a joint out while |e| is below it (default on valves: valves.hold_window)");
+  r.numbers("adaptation_rate", c.adaptation_rate, kRate, "",
+            "Gamma^-1 = diag(rate), Theta = [M_x B_x K_x M_z B_z K_z] (default on valves: x period / T_f)");
   r.numbers("theta_min", c.theta_min, kTheta, "", "lower bounds of the soil parameters (projection)");
   r.numbers("theta_max", c.theta_max, kTheta, "", "upper bounds of the soil parameters");
   r.numbers("theta_initial", c.theta_initial, kTheta, "", "initial soil estimate");
-  r.number("adaptation_leakage_time", c.adaptation_leakage_time, {0, 1e6}, "s",
-           "leakage of the update toward theta_initial while it runs (beyond the paper; 0: none, eq. 27)");
   r.choice("regressor_acceleration", c.regressor_acceleration, kRegressorAccelerations,
            "the joint acceleration in the regressor's M_t term");
   SectionReader sl = r.section("slotine_li", "the Slotine-Li law's gains");
@@ -83,6 +106,23 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   f.number("velocity_cutoff_hz", c.filter.velocity_cutoff_hz, {0.1, 1e4}, "Hz", "velocity filter cut-off");
   f.number("acceleration_cutoff_hz", c.filter.acceleration_cutoff_hz, {0.1, 1e4}, "Hz", "acceleration filter cut-off");
   f.finish();
+  SectionReader ef = r.section("external_force", "the external force observer and the composite update (beyond the paper)");
+  ef.flag("observer", c.external_force.observer, "add the observer's estimate of what the model misses to eq. 12's command");
+  // Derived: the observer differentiates nothing itself, but its residual carries the filtered
+  // acceleration, so it stays well inside that filter's band.
+  if (!ef.value_given("cutoff_hz")) c.external_force.cutoff_hz = c.filter.acceleration_cutoff_hz / 3;
+  ef.number("cutoff_hz", c.external_force.cutoff_hz, {0.01, 1e3}, "Hz",
+            "the observer's low-pass (default: a third of filters.acceleration_cutoff_hz)");
+  ef.number("identification_memory", c.external_force.identification_memory, {0, 1e6}, "s",
+            "the composite update's memory: least squares on the residual of the applied efforts (0: eq. 27 alone)");
+  ef.number("force_scale", c.external_force.force_scale, {1, 1e8}, "N", "the residual's noise (least squares' measurement noise)");
+  ef.number("dead_zone", c.external_force.dead_zone, {0, 1e8}, "N", "per cylinder: residuals below it leave the estimates alone");
+  ef.finish();
+  SectionReader sc = r.section("soil_contact", "how the law tells contact and the soil anchor");
+  sc.flag("use_site_map", c.soil_contact.use_site_map, "contact and depth from the scene's ground when the firmware has it");
+  sc.number("contact_force", c.soil_contact.contact_force, {1, 1e8}, "N",
+            "without a map: the estimated tip force that tells contact (left below half of it)");
+  sc.finish();
   r.number("watchdog_timeout", c.watchdog_timeout, {1e-4, 10}, "s", "without a valid sensor frame -> safe stop");
   r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "", "rad (swing), m: above it the firmware faults");
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
@@ -90,19 +130,6 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.numbers("lyapunov_q_integral", c.lyapunov_q_integral, kWeight, "", "Q of the integral states");
   r.number("actuator_lag", c.actuator_lag, {0, 1}, "s", "the effort lag the firmware compensates (0: none)");
   r.number("actuator_lag_target", c.actuator_lag_target, {1e-4, 1}, "s", "the lag the compensated actuator should show");
-  r.choice("command_interface", c.command_interface, kCommandInterfaces, "what the firmware commands on the bus");
-  SectionReader v = r.section("valves", "the valve stage between the law and a hydraulic machine's valves");
-  v.number("force_time_constant", c.valves.force_time_constant, {1e-3, 1}, "s", "T_f: the force loop's time constant");
-  v.number("force_integral_time", c.valves.force_integral_time, {0, 100}, "s",
-           "T_i of the force loop's integral (0: none; docs/control.md)");
-  v.number("spool_lag_target", c.valves.spool_lag_target, {0, 1}, "s",
-           "the spool lag the lead aims for (0: no lead); at most the machine's valve_time_constant");
-  v.number("opening_band", c.valves.opening_band, {0, 0.5}, "", "opening below which the dead-zone inverse is linear");
-  v.numbers("position_gain", c.valves.position_gain, {0, 1e3}, "1/s",
-            "flow feedforward qd_d - position_gain e: the valve stage's own position correction");
-  v.numbers("hold_window", c.valves.hold_window, {0, 0.1}, "",
-            "holding a pose: |e| (rad swing, m) inside which a function's valve stays centred");
-  v.finish();
   SectionReader fl = r.section("flow", "flow-based position control (controller.type flow)");
   fl.numbers("kp", c.flow_kp, {0, 1e3}, "1/s", "position gains: u = qd_d - kp e");
   fl.finish();
@@ -111,7 +138,28 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
     r.fail("type", "flow commands the valves' flow: it needs command_interface: valve");
   c.filter.period = c.period;
   check_nyquist(f, c);
+  if (!(c.external_force.cutoff_hz < c.filter.acceleration_cutoff_hz))
+    ef.fail("cutoff_hz", format_number(c.external_force.cutoff_hz) + " Hz must be below filters.acceleration_cutoff_hz = " +
+                             format_number(c.filter.acceleration_cutoff_hz) + " Hz (the residual carries that filter's acceleration)");
   check_cross_fields(r, c);
+}
+
+ControllerConfig controller_defaults(const Machine& nominal) {
+  ControllerConfig c;
+  c.valves.force_time_constant = std::max(nominal.hydraulics.valve_time_constant, 0.005);
+  c.valves.spool_lag_target = nominal.hydraulics.valve_time_constant / 3;
+  return c;
+}
+
+double valve_adaptation_scale(const ControllerConfig& c) { return c.period / c.valves.force_time_constant; }
+
+void set_command_interface(ControllerConfig& c, CommandInterface interface) {
+  if (interface == c.command_interface) return;
+  if (c.adaptation_rate_derived) {
+    c.adaptation_rate *= interface == CommandInterface::valve ? valve_adaptation_scale(c) : 1 / valve_adaptation_scale(c);
+    c.tracking_dead_zone = interface == CommandInterface::valve ? c.valves.hold_window : Vec4::Zero();
+  }
+  c.command_interface = interface;
 }
 
 ControllerConfig parse_controller_config(const YAML::Node& node, const std::string& file) {

@@ -10,8 +10,10 @@
 
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
+#include "control/soil_contact.hpp"
 #include "control/state_estimator.hpp"
 #include "control/valve_inner_loop.hpp"
+#include "model/machine.hpp"
 #include "settings/section_reader.hpp"
 
 namespace exc::control {
@@ -32,6 +34,19 @@ inline constexpr settings::EnumTable<CommandInterface, 2> kCommandInterfaces{{{
      "pilot pressures per spool end (CMD_PILOT) from the valve stage: a hydraulic machine's main valves"},
 }}};
 
+// The external force observer and the composite update of the adaptive law (beyond the paper:
+// external_force_observer.hpp, adaptive_computed_torque.hpp). The paper's own law is observer: false,
+// identification_memory: 0.
+struct ExternalForceSettings {
+  bool observer = true;        // add the observer's estimate of what the model misses to the command
+  double cutoff_hz = 5;        // the observer's low-pass; default a third of filters.acceleration_cutoff_hz
+  // s: the composite update's memory, least squares on the residual of the applied efforts
+  // (soil_identification.hpp); 0: eq. 27 alone.
+  double identification_memory = 20;
+  double force_scale = 30000;  // N: the residual's noise n0 per sample (least squares' measurement noise)
+  double dead_zone = 300;      // N: of each cylinder's residual, no update below it (noise, friction)
+};
+
 struct ControllerConfig {
   ControllerKind kind = ControllerKind::adaptive;
   bool kind_given = false;  // the scene set controller.type (it then chooses the controller to run)
@@ -49,16 +64,21 @@ struct ControllerConfig {
   // Adaptation rates Gamma^-1 = diag(rate); Theta = [M_x B_x K_x M_z B_z K_z]. Scaled so that each
   // column of Y (rhodd ~0.5 m/s^2, rhod ~0.5 m/s, rho - rho_env ~0.1 m) adapts at a similar pace.
   Vec6 adaptation_rate = (Vec6() << 6e7, 6e10, 3e12, 6e7, 6e10, 3e12).finished();
+  // Per joint (rad swing, m): eq. 27 leaves a joint whose |e| is below this out of its update (the
+  // standard dead-zone modification). Default on valves: the valve stage's hold window, the error the
+  // valves cannot resolve; 0 on efforts (eq. 27 as published).
+  Vec4 tracking_dead_zone = Vec4::Zero();
+  // The rates above were the default's, derived for the command interface (x period / T_f on valves:
+  // valve_adaptation_scale), not given by the scene.
+  bool adaptation_rate_derived = true;
   // Physical bounds of the soil parameters (machine.md): M 50..500 kg, B 1e3..3e4 N s/m,
   // K 1e4..1e6 N/m; and the initial estimate.
   Vec6 theta_min = (Vec6() << 50, 1e3, 1e4, 50, 1e3, 1e4).finished();
   Vec6 theta_max = (Vec6() << 500, 3e4, 1e6, 500, 3e4, 1e6).finished();
   Vec6 theta_initial = (Vec6() << 100, 2e3, 3e4, 100, 2e3, 3e4).finished();
-  // Beyond the paper: leakage (sigma-modification) in the update, Theta_hat_dot += -(Theta_hat -
-  // theta_initial) / adaptation_leakage_time while the update runs. Over many passes the published
-  // update drifts (the force loop's lag reads as soil); the leak bounds it. 0: eq. 27 as published.
-  double adaptation_leakage_time = 0;  // s
   RegressorAcceleration regressor_acceleration = RegressorAcceleration::filtered;
+  ExternalForceSettings external_force;
+  SoilContactSettings soil_contact;
   // Beyond the paper: integral action in the adaptive law (K_i and integral_limit as the PID's), with
   // Q of the integral states (z = [int e; e; ed] order: these first, then lyapunov_q).
   bool integral_action = false;
@@ -103,12 +123,20 @@ struct ControllerConfig {
   }
 };
 
+// The defaults a nominal machine implies (before the scene's section is read): the force loop's T_f
+// is its spools' time constant (at least 5 ms), the spool lead aims at a third of it.
+ControllerConfig controller_defaults(const Machine& nominal);
 // Reads the `controller:` section into c (a field the section does not give keeps c's value, which
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
 // Hurwitz gains, ...).
 void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
 // The same from a node (which may be null/undefined: defaults). 'file' is named in errors.
 ControllerConfig parse_controller_config(const YAML::Node& controller, const std::string& file);
+// Through the valves eq. 27's default rates are the force-commanded machine's times this (period / T_f).
+double valve_adaptation_scale(const ControllerConfig& c);
+// Switches the command interface of a configuration (a bench variant on other actuators), carrying
+// the default rates that depend on it with it.
+void set_command_interface(ControllerConfig& c, CommandInterface interface);
 // Checks a configuration built in C++ with the same declarations; throws SettingsError.
 void validate(const ControllerConfig& c, const std::string& file);
 

@@ -45,7 +45,7 @@ FeasibilityReport check_effort_feasibility(const Model& model, const JointTrajec
     trajectory.evaluate(t, q, qd, qdd);
     if (!update_closed_chain(model, ws, q, Vec4::Zero()).ok()) continue;  // the task check names such poses
     bias_forces(model, ws, g);  // at rest: gravity alone
-    const bool in_soil = ws.rho.y() < options.terrain_height;
+    const bool in_soil = ws.rho.y() < options.terrain.height_at(ws.rho.x());
     update_closed_chain(model, ws, q, qd);
     inverse_dynamics(model, ws, qdd, Vec2::Zero(), tau);
     const double keep = in_soil ? 1 - options.soil_margin : 1;

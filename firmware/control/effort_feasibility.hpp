@@ -15,13 +15,14 @@
 
 #include "control/trajectory.hpp"
 #include "model/model.hpp"
+#include "model/terrain.hpp"
 
 namespace exc::control {
 
 struct FeasibilityOptions {
   double sample_period = 1e-3;  // s: every control cycle
   double soil_margin = 0.3;     // fraction of each limit kept free for the soil where the tip is below ground
-  double terrain_height = 0;    // m, world z of the ground
+  Terrain terrain;              // the ground (flat or a profile)
 };
 
 struct FeasibilityReport {

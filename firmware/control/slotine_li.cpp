@@ -29,7 +29,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
   if (!model_at(model_, ws_, in.q, qd_r, last_tau_, out, M_a, h_r)) return out;
 
   out.rho = ws_.rho;  // position level: independent of the velocity passed in
-  anchor_.resolve(in.soil, ws_.rho, out.in_soil, out.rho_env);
+  anchor_.resolve(in.soil, ws_.rho, nullptr, out.in_soil, out.rho_env);
   const Vec2 rhod_r = ws_.J_t * qd_r;
   const Vec2 rhodd_r = ws_.J_t * qdd_r + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, rhod_r, rhodd_r, out.rho_env, out.in_soil);

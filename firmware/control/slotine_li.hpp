@@ -14,7 +14,7 @@
 #include "control/controller_config.hpp"
 #include "control/effort_limits.hpp"
 #include "control/regressor.hpp"
-#include "control/soil_anchor_estimator.hpp"
+#include "control/soil_contact.hpp"
 #include "model/closed_chain.hpp"
 
 namespace exc::control {
@@ -33,7 +33,7 @@ class SlotineLi final : public Controller {
   ControllerConfig config_;
   EffortLimits limits_;
   Vec6 theta_hat_ = Vec6::Zero();
-  SoilAnchorEstimator anchor_;
+  SoilContactEstimator anchor_;
   Vec4 last_tau_ = Vec4::Zero();
 };
 

@@ -20,25 +20,74 @@ struct EstimatorConfig {
   double acceleration_cutoff_hz = 15;  // filtered derivative of the filtered velocity
 };
 
+// The two stages' coefficients, by the bilinear (Tustin) transform at the period.
+struct EstimatorCoefficients {
+  double b0 = 0, b1 = 0, b2 = 0, a1 = 0, a2 = 0;  // the velocity's Butterworth biquad (prewarped)
+  // 1 / (tau s + 1) and s / (tau s + 1) of the acceleration stage: y_k = k (x_k + x_{k-1}) - r y_{k-1},
+  // a_k = g (x_k - x_{k-1}) - r a_{k-1}, k = g T / 2.
+  double g = 0, r = 0, k = 0;
+  explicit EstimatorCoefficients(const EstimatorConfig& c) {
+    const double pi = 3.14159265358979323846;
+    const double w = std::tan(pi * c.velocity_cutoff_hz * c.period);
+    const double norm = 1 / (1 + std::sqrt(2.0) * w + w * w);
+    b0 = w * w * norm;
+    b1 = 2 * b0;
+    b2 = b0;
+    a1 = 2 * (w * w - 1) * norm;
+    a2 = (1 - std::sqrt(2.0) * w + w * w) * norm;
+    const double tau = 1 / (2 * pi * c.acceleration_cutoff_hz);
+    g = 2 / (2 * tau + c.period);
+    r = (c.period - 2 * tau) / (2 * tau + c.period);
+    k = g * c.period / 2;
+  }
+};
+
+// N signals through the chain the estimator's acceleration sees (the Butterworth low-pass, then the
+// acceleration stage's 1 / (tau s + 1)): a signal filtered here lines up in time with the filtered
+// acceleration, so a regression may mix them (the adaptive law's composite update does).
+template <int N>
+class EstimatorLowPass {
+ public:
+  using Vec = Eigen::Matrix<double, N, 1>;
+  explicit EstimatorLowPass(const EstimatorConfig& c = {}) : c_(c) {}
+  void reset() { primed_ = false; }
+  const Vec& update(const Vec& x) {
+    if (!primed_) {  // at rest at the first sample: no start-up transient
+      x1_ = x2_ = y1_ = y2_ = out_ = x;
+      primed_ = true;
+      return out_;
+    }
+    const Vec y = c_.b0 * x + c_.b1 * x1_ + c_.b2 * x2_ - c_.a1 * y1_ - c_.a2 * y2_;
+    x2_ = x1_;
+    x1_ = x;
+    y2_ = y1_;
+    out_ = c_.k * (y + y1_) - c_.r * out_;
+    y1_ = y;
+    return out_;
+  }
+  const Vec& value() const { return out_; }
+
+ private:
+  EstimatorCoefficients c_;
+  bool primed_ = false;
+  Vec x1_ = Vec::Zero(), x2_ = Vec::Zero(), y1_ = Vec::Zero(), y2_ = Vec::Zero(), out_ = Vec::Zero();
+};
+
 class StateEstimator {
  public:
   explicit StateEstimator(const EstimatorConfig& c = {}) { configure(c); }
 
   void configure(const EstimatorConfig& c) {
     config_ = c;
-    const double pi = 3.14159265358979323846;
-    // Butterworth biquad by the bilinear transform with prewarping (standard coefficients).
-    const double k = std::tan(pi * c.velocity_cutoff_hz * c.period);
-    const double norm = 1 / (1 + std::sqrt(2.0) * k + k * k);
-    b0_ = k * k * norm;
-    b1_ = 2 * b0_;
-    b2_ = b0_;
-    a1_ = 2 * (k * k - 1) * norm;
-    a2_ = (1 - std::sqrt(2.0) * k + k * k) * norm;
+    const EstimatorCoefficients k(c);
+    b0_ = k.b0;
+    b1_ = k.b1;
+    b2_ = k.b2;
+    a1_ = k.a1;
+    a2_ = k.a2;
     // Filtered derivative a = s/(tau s + 1) v, Tustin: a_k = g (v_k - v_{k-1}) - r a_{k-1}.
-    const double tau = 1 / (2 * pi * c.acceleration_cutoff_hz);
-    g_ = 2 / (2 * tau + c.period);
-    r_ = (c.period - 2 * tau) / (2 * tau + c.period);
+    g_ = k.g;
+    r_ = k.r;
     primed_ = false;
   }
 

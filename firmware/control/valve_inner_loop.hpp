@@ -61,9 +61,9 @@ struct ValveLoopSettings {
   double opening_band = 0.002;        // opening below which the dead-zone inverse is linear
   // 1/s: the flow feedforward v_ff = qd_d - position_gain e also corrects the position, as the flow
   // law does: the force loop alone meters flow only in proportion to a force error, so a small
-  // position error of a stiff oil column is left uncorrected (dig: arm 2.4 -> 1.4 mm, bucket
-  // 4.2 -> 1.3 mm RMS with 2/s; docs/control.md).
-  Vec4 position_gain = Vec4::Constant(2);
+  // position error of a stiff oil column is left uncorrected. Default 1 / (5 T_f) (derived where the
+  // controller section is read: a fifth of the force loop's bandwidth; docs/control.md).
+  Vec4 position_gain = Vec4::Constant(1 / (5 * 0.03));
   // Holding a pose: |e| below which a function's valve stays centred (rad swing, m cylinders).
   Vec4 hold_window = Vec4::Constant(1e-3);
 };
@@ -103,6 +103,10 @@ class ValveInnerLoop {
 
   // The measured effort F of each function.
   Vec4 measured_force(const Vec4& p_a, const Vec4& p_b) const;
+  // Bit i: function i's measured chambers are where its valve cannot do what the map assumes: a load
+  // within the load-sensing margin of the supply limit or at its port relief (the meter-in stalls,
+  // the relief passes flow), or a chamber below tank pressure (the make-up valve feeds it).
+  std::uint8_t off_map(const Vec4& p_a, const Vec4& p_b) const;
   // K_h(q) of each function (N/m per m/s of flow mismatch, i.e. N/m; swing N m/rad).
   Vec4 hydraulic_stiffness(const Vec4& q) const;
   // The opening that passes the velocity u at these pressures (before the dead zone), unclamped.

@@ -24,17 +24,19 @@ SceneCommon read_scene_common(settings::SectionReader& top, const settings::Docu
   settings::SectionReader terrain = top.section("terrain", "the ground");
   if (terrain.has("height") && terrain.has("profile"))
     terrain.fail("profile", "give either 'height' or 'profile', not both");
-  c.terrain_height = c.machine.terrain_flat_height;
+  c.terrain.height = c.machine.terrain_flat_height;
   if (terrain.given("profile")) {
     terrain.others({"height"});
-    terrain.rows("profile", c.terrain_profile, 2, SceneCommon::kMaxProfilePoints, Vec2(-100, -20), Vec2(100, 20), "m",
+    std::vector<Vec2> profile;
+    terrain.rows("profile", profile, 2, Terrain::kMaxPoints, Vec2(-100, -20), Vec2(100, 20), "m",
                  "points [x, z] of a piecewise-linear ground along the swing plane's x");
-    for (std::size_t i = 1; i < c.terrain_profile.size(); ++i)
-      if (!(c.terrain_profile[i].x() > c.terrain_profile[i - 1].x()))
-        terrain.fail("profile", i, "x must increase strictly along the profile");
+    for (std::size_t i = 1; i < profile.size(); ++i)
+      if (!(profile[i].x() > profile[i - 1].x())) terrain.fail("profile", i, "x must increase strictly along the profile");
+    c.terrain.num_points = static_cast<int>(profile.size());
+    for (std::size_t i = 0; i < profile.size(); ++i) c.terrain.profile[i] = profile[i];
   } else {
     terrain.others({"profile"});
-    terrain.number("height", c.terrain_height, {-20, 20}, "m", "flat ground at world z");
+    terrain.number("height", c.terrain.height, {-20, 20}, "m", "flat ground at world z");
   }
   terrain.finish();
   top.number("duration", c.duration, kRunDurationBounds, "s", "how long the run lasts (up to a working shift)", Need::required);

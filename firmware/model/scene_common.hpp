@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "model/machine.hpp"
+#include "model/terrain.hpp"
 #include "settings/section_reader.hpp"
 
 namespace exc {
@@ -25,9 +26,8 @@ struct SceneCommon {
   std::string name, description;
   std::string machine_file;  // absolute path of the machine file, empty for the built-in reference machine
   Machine machine;
-  double terrain_height = 0;           // m, world z of flat ground (the machine's terrain.flat_height by default)
-  std::vector<Vec2> terrain_profile;   // (x, z) points of a profile instead, x strictly increasing
-  static constexpr int kMaxProfilePoints = 64;
+  // The ground: flat at the machine's terrain.flat_height by default, or the scene's height or profile.
+  Terrain terrain;
   double duration = 10;                // s
 };
 

@@ -78,7 +78,7 @@ TEST_CASE("firmware/feasibility passes the shipped scenes' tasks and the test ta
   for (const char* scene : {"dig.yaml", "free_motion.yaml", "paper_dig.yaml", "paper_free_motion.yaml", "truck_loading.yaml"}) {
     const app::FirmwareSettings st = app::load_firmware_settings(std::string(EXC_SOURCE_DIR) + "/scenes/" + scene);
     FeasibilityOptions o;
-    o.terrain_height = st.terrain_height;
+    o.terrain = st.terrain;
     const FeasibilityReport r = check_effort_feasibility(build_model(st.machine), st.task.trajectory, o);
     INFO(scene << ": " << r.message(st.task.waypoint_times, "task"));
     CHECK(r.ok);

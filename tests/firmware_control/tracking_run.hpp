@@ -25,13 +25,16 @@ inline ControlInput estimated_input(StateEstimator& est, const Vec4& q, const Ve
   in.t = t;
   in.q = est.position();
   in.qd = est.velocity();
+  in.qd_measured = qd;
   in.qdd = est.acceleration();
   task.trajectory.evaluate(t, in.q_d, in.qd_d, in.qdd_d);
   return in;
 }
 
+// applied_known: the law is told the efforts the plant applied last step (the model plant's actuators
+// are ideal: what was commanded), as a hydraulic machine's pressures tell the firmware.
 inline TrackingResult run_tracking(const Model& model, const Task& task, ControllerKind kind,
-                                   const ControllerConfig& cfg, const SoilTruth& soil) {
+                                   const ControllerConfig& cfg, const SoilTruth& soil, bool applied_known = false) {
   auto ctrl = make_controller(kind, model, cfg);
   ModelPlant plant(model, soil);
   Vec4 q0, qd0, qdd0;
@@ -41,12 +44,20 @@ inline TrackingResult run_tracking(const Model& model, const Task& task, Control
   TrackingResult r;
   Vec4 sum_sq = Vec4::Zero();
   const int steps = static_cast<int>((task.end_time() + 1.0) / cfg.period);
+  Terrain ground;
+  Vec4 last_tau = Vec4::Zero();
+  ground.height = soil.terrain_height;
   for (int k = 0; k < steps; ++k) {
     const double t = task.start_time() + k * cfg.period;
     ControlInput in = estimated_input(est, plant.q(), plant.qd(), task, t);
-    in.soil.terrain_height = soil.terrain_height;
+    in.soil.site_map = &ground;
+    if (applied_known && k > 0) {
+      in.applied.valid = true;
+      in.applied.effort = last_tau;
+    }
     const TipLoad load = plant.soil_load();
     const ControlOutput out = ctrl->update(in);
+    last_tau = out.tau;
     if (out.status != ModelStatus::ok || !plant.step(out.tau, load, cfg.period)) {
       r.ok = false;
       break;

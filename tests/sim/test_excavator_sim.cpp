@@ -348,7 +348,8 @@ TEST_CASE("tools/excavator-sim refuses a scene whose firmware commands what its 
   // message says it was the default, placed as the settings reader places a missing key: at its
   // section (the section's first key).
   const fs::path efforts = edited_scene(
-      kDig, {{"  command_interface: valve     # pilot pressures through the valve stage (force loop, orifice map)\n", ""}},
+      kDig, {{"  command_interface: valve     # pilot pressures through the valve stage; every law on its defaults\n",
+              "  blend_time: 0.2\n"}},
       "dig_efforts");
   const Run e = run_sim("run " + efforts.string() + " --controller pid --duration 1 --no-report --quiet --out out");
   INFO(e.out << e.err);
@@ -572,40 +573,52 @@ TEST_CASE("tools/excavator-sim truck loading: five cycles of all four actuators,
   CHECK(r.out.find("per work cycle") != std::string::npos);
 }
 
-TEST_CASE("tools/excavator-sim truck loading over fifteen passes: with the scene's leakage the adaptive law's error stays flat, with the published update it drifts") {
-  // Fifteen passes (332 s) of the shipped scene, its telemetry to /dev/null (a million messages a run).
-  const auto passes = [](bool leakage) {
-    std::vector<std::pair<std::string, std::string>> edits = {{"repeat: 5", "repeat: 15"},
-                                                              {"duration: 112.0", "duration: 332.0"}};
-    if (!leakage) edits.push_back({"adaptation_leakage_time: 20", "adaptation_leakage_time: 0"});
-    const fs::path scene = edited_scene(std::string(EXC_SOURCE_DIR) + "/scenes/truck_loading.yaml", edits,
-                                        leakage ? "truck15_leak" : "truck15_published");
+TEST_CASE("tools/excavator-sim truck loading over fifty passes: on its defaults the adaptive law's errors stay flat and the soil's spring and damper estimates within 20 % of the truth, and the paper's update alone runs them to their bounds") {
+  // The shipped scene's passes, its telemetry to /dev/null (a million messages a run).
+  const auto passes = [](int n, const std::string& controller_edit, const std::string& stem) {
+    std::vector<std::pair<std::string, std::string>> edits = {
+        {"repeat: 5", "repeat: " + std::to_string(n)},
+        {"duration: 112.0", "duration: " + std::to_string(22 * n + 2) + ".0"}};
+    if (!controller_edit.empty()) edits.push_back({"\ncontroller:\n", "\ncontroller:\n" + controller_edit});
+    const fs::path scene = edited_scene(std::string(EXC_SOURCE_DIR) + "/scenes/truck_loading.yaml", edits, stem);
     const Run r = run_sim("run " + scene.string() +
                           " --controller adaptive --quiet --no-report --json s.json --lcm 'file:///dev/null?mode=w'");
     fs::remove(scene);
     INFO(r.err);
     REQUIRE(r.status == 0);
     const nlohmann::json j = nlohmann::json::parse(read_text_file(r.dir / "s.json"));
-    REQUIRE(j["adaptive"]["cycles"].size() == 15);
-    CHECK(j["adaptive"]["heap_allocations_in_loop"].get<std::uint64_t>() == 0);  // the leak's branch included
+    REQUIRE(j["adaptive"]["cycles"].size() == static_cast<std::size_t>(n));
+    CHECK(j["adaptive"]["heap_allocations_in_loop"].get<std::uint64_t>() == 0);
     return j["adaptive"]["cycles"];
   };
-  const auto bucket = [](const nlohmann::json& c, int k) { return c[k]["rms_error"]["bucket"].get<double>(); };
+  const auto rms = [](const nlohmann::json& c, int k, const char* joint) { return c[k]["rms_error"][joint].get<double>(); };
   const auto theta = [](const nlohmann::json& c, int k, const char* p) { return c[k]["theta_hat"][p].get<double>(); };
 
-  const nlohmann::json leak = passes(true);
-  for (int k = 2; k < 15; ++k) {
+  const nlohmann::json composite = passes(50, "", "truck50");
+  for (int k = 2; k < 50; ++k) {
     CAPTURE(k);
-    CHECK(bucket(leak, k) < 1.25 * bucket(leak, 1));  // flat from the second pass on
+    for (const char* joint : {"arm", "bucket"}) CHECK(rms(composite, k, joint) < 1.1 * rms(composite, 1, joint));
   }
-  CHECK(theta(leak, 14, "K_x") == doctest::Approx(7e4).epsilon(0.25));  // near the soil's (loam: 70 kN/m)
-  CHECK(theta(leak, 14, "B_z") < 0.5 * 3e4);                            // far from its bound
+  // Loam (machine.md): K 70 kN/m, B 5 kN s/m on both axes; excited by every pass, identified in the
+  // first and held there (the soil's added mass is not excited: not checked).
+  for (int k : {0, 9, 49}) {
+    CAPTURE(k);
+    for (const char* p : {"K_x", "K_z"}) CHECK(theta(composite, k, p) == doctest::Approx(7e4).epsilon(0.2));
+    for (const char* p : {"B_x", "B_z"}) CHECK(theta(composite, k, p) == doctest::Approx(5e3).epsilon(0.2));
+  }
+  MESSAGE("pass 50: bucket RMS " << rms(composite, 49, "bucket") * 1e3 << " mm, K_x " << theta(composite, 49, "K_x")
+                                 << ", K_z " << theta(composite, 49, "K_z") << ", B_x " << theta(composite, 49, "B_x")
+                                 << ", B_z " << theta(composite, 49, "B_z"));
 
-  // The negative control: the published update (eq. 27) on the same passes drifts.
-  const nlohmann::json published = passes(false);
-  CHECK(bucket(published, 14) > 2 * bucket(published, 1));
-  CHECK(theta(published, 14, "K_z") > 2e5);
-  CHECK(theta(published, 14, "B_z") == doctest::Approx(3e4));  // at theta_max
+  // The negative control: the paper's update alone (eq. 27 at a tenth of the force-commanded rate, no
+  // observer, no composite term, no dead zone) on fifteen of the same passes reads the valves' lag as
+  // soil and runs the vertical estimates to their lower bounds (theta_min: 1e4 N/m, 1e3 N s/m).
+  const nlohmann::json paper = passes(
+      15, "  external_force: {observer: false, identification_memory: 0}\n  tracking_dead_zone: [0, 0, 0, 0]\n"
+          "  adaptation_rate: [6e6, 6e9, 3e11, 6e6, 6e9, 3e11]\n", "truck15_paper");
+  CHECK(theta(paper, 14, "K_z") == doctest::Approx(1e4));
+  CHECK(theta(paper, 14, "B_z") == doctest::Approx(1e3));
+  CHECK(theta(paper, 14, "B_x") < 5e3 / 3);
 }
 
 TEST_CASE("tools/excavator-sim sweeps record a never-tracked run's errors as null, and the merged table leaves their cells empty, not 0") {

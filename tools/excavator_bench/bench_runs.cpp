@@ -155,7 +155,7 @@ constexpr std::array<int, 6> kCylinderBodies = {kBoomBarrel, kBoomRod, kArmBarre
 
 void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators) {
   const bool hydraulic = actuators.fidelity == plant::ActuatorFidelity::hydraulic;
-  c.command_interface = hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort;
+  control::set_command_interface(c, hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort);
   c.actuator_lag = actuators.fidelity == plant::ActuatorFidelity::limited ? actuators.lag : 0.0;
   if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
 }
@@ -171,7 +171,7 @@ app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& sc
   fw.name = s.name;
   fw.machine = fw_machine;
   fw.task = s.task;
-  fw.terrain_height = scene.terrain.height;
+  fw.terrain = scene.terrain;
   fw.duration = scene.duration;
   fw.controller = s.controller;
   // The firmware as it is set up for the machine it drives: valves for the hydraulic machine, efforts

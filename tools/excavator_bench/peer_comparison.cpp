@@ -28,7 +28,7 @@ void time_controller(const BenchScene& s, const OpenLoopResult& run, PeerResult&
   Workspace ws(model);
   std::vector<double> control_us, id_us;
   control::ControlInput in;
-  in.soil.terrain_height = s.scene.terrain.height;
+  in.soil.site_map = &s.scene.terrain;
   const int repeats = 2;
   for (int rep = 0; rep < repeats; ++rep)
     for (std::size_t k = 0; k < run.q.size(); ++k) {

@@ -126,7 +126,7 @@ ValveInput four_functions(const BenchScene& dig, double duration) {
   in.scene = dig.scene;
   in.scene.q_a0 = Vec4(0.0, 2.4626, 2.3231, 2.1447);  // the machine's first reference pose
   in.scene.qd_a0.setZero();
-  in.scene.terrain = plant::Terrain{};
+  in.scene.terrain = Terrain{};
   in.scene.terrain.height = -5;  // in the air: the hydraulics alone
   const auto n = static_cast<std::size_t>(std::lround(duration / kProfileHold));
   for (std::size_t k = 0; k < n; ++k) {

@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
       fc.kind = *exc::control::kControllerKinds.named(controller);
     }
     fc.controller = settings.controller;
-    fc.terrain_height = settings.terrain_height;
+    fc.site_map = settings.terrain;
     const char* const kind_name = exc::control::to_string(fc.kind);
 
     const double period_s = settings.controller.period;

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   run->add_option("scene", scene_path, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   run->add_option("--controller", controllers,
                   "controller(s) to run: " + exc::control::kControllerKinds.names() +
-                      " (default: the scene's controller.type, else pid and adaptive, and flow on a valve-commanded scene)")
+                      " (default: the scene's controller.type, else pid and adaptive, and flow on a valve-commanded scene whose task holds the swing)")
       ->delimiter(',');
   run->add_option("--out", out_dir, "output directory (default: out/<scene name>)");
   run->add_option("--json", json_path, "also write the summary as JSON to this file");

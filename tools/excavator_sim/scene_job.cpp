@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string_view>
 
+#include "control/flow_position_control.hpp"
 #include "output_file.hpp"
 #include "run_report.hpp"
 #include "settings/section_reader.hpp"
@@ -27,11 +28,16 @@ SceneJobResult run_scene_job(const SceneJob& job) {
   if (!job.controllers.empty() && cc.kind_given && job.controllers != std::vector<std::string>{scene_kind})
     throw std::invalid_argument("--controller conflicts with " + job.scene_path + "'s controller.type: " + scene_kind +
                                 "; give one of them");
+  const bool valves = cc.command_interface == control::CommandInterface::valve;
+  const bool flow_fits = control::flow_law_fits(bundle.firmware.task);
   options.controllers = !job.controllers.empty() ? job.controllers
                         : cc.kind_given          ? std::vector<std::string>{scene_kind}
-                        : cc.command_interface == control::CommandInterface::valve
-                            ? std::vector<std::string>{"pid", "adaptive", "flow"}
-                            : std::vector<std::string>{"pid", "adaptive"};
+                        : valves && flow_fits    ? std::vector<std::string>{"pid", "adaptive", "flow"}
+                                                 : std::vector<std::string>{"pid", "adaptive"};
+  if (job.controllers.empty() && !cc.kind_given && valves && !flow_fits)
+    std::cerr << "excavator-sim: " << bundle.name
+              << ": flow left out of the default controllers: the task moves the swing, which flow-based control "
+                 "cannot accelerate (docs/control.md); --controller flow runs it\n";
   result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   // The --json file is opened before the run, so a path that cannot be written costs no run time.
   std::ofstream json_file;

@@ -13,7 +13,7 @@ namespace exc::sim {
 struct SceneJob {
   std::string scene_path;
   std::filesystem::path out_dir;         // empty: out/<scene name>
-  // empty: the scene's controller.type, else pid and adaptive (and flow on a valve-commanded machine)
+  // empty: the scene's controller.type, else pid and adaptive (and flow on a valve-commanded machine whose task holds the swing)
   std::vector<std::string> controllers;
   std::string lcm_url;                   // empty: file://<out>/run.lcm?mode=w
   std::string json_path;                 // also write the summary here (optional)
