@@ -60,6 +60,8 @@ class PlantNode {
   std::uint64_t steps() const { return steps_; }
   const plant::Plant& plant() const { return plant_; }
   void publish_counters();
+  // Plant::step's wall time per call, as EXC_TIMING stage 4 reports it.
+  const control::PerfCounter& step_timing() const { return step_timing_; }
 
  private:
   void step(std::uint64_t cycle, bool answer = true);
