@@ -78,8 +78,10 @@ void check_no_subnormal_in_hold(control::ControllerKind kind) {
   INFO("plant: ", where(h.plant));
   CHECK(h.firmware.found() == 0);
   CHECK(h.plant.found() == 0);
-  MESSAGE(law, ": the FPU flushed a tiny result to zero in ", h.underflow_cycles, " of ",
-          h.run.simulated_seconds * 1000, " cycles; control step median ", h.run.first_second.control_step.median_us,
+  const double cycles = h.run.simulated_seconds * 1000;
+  MESSAGE(law, ": ", static_cast<double>(h.firmware.scanned()) / cycles, " firmware and ",
+          static_cast<double>(h.plant.scanned()) / cycles, " plant values scanned per cycle; the FPU flushed a tiny result to zero in ",
+          h.underflow_cycles, " of ", cycles, " cycles; control step median ", h.run.first_second.control_step.median_us,
           " us in the first second, ", h.run.last_second.control_step.median_us, " us in the last");
 }
 
