@@ -34,6 +34,33 @@ struct SimClock {
 
 Timing timing_of(const control::PerfCounter& c) { return Timing{c.median_us(), c.p99_us(), c.max_us(), c.count()}; }
 
+// The timing of the samples `after` recorded since it was `before` (a copy of the same counter taken
+// earlier), from the histograms: the upper edge of the bucket that holds the fraction.
+Timing timing_between(const control::PerfCounter& before, const control::PerfCounter& after) {
+  std::array<std::uint64_t, control::PerfCounter::kBuckets> h{};
+  Timing t;
+  int last = -1;
+  for (int b = 0; b < control::PerfCounter::kBuckets; ++b) {
+    h[static_cast<std::size_t>(b)] = after.histogram()[static_cast<std::size_t>(b)] - before.histogram()[static_cast<std::size_t>(b)];
+    t.count += h[static_cast<std::size_t>(b)];
+    if (h[static_cast<std::size_t>(b)] > 0) last = b;
+  }
+  if (t.count == 0) return t;
+  auto percentile = [&](double fraction) {
+    const double target = fraction * static_cast<double>(t.count);
+    std::uint64_t seen = 0;
+    for (int b = 0; b <= last; ++b) {
+      seen += h[static_cast<std::size_t>(b)];
+      if (static_cast<double>(seen) >= target && seen > 0) return control::PerfCounter::upper_edge_us(b);
+    }
+    return control::PerfCounter::upper_edge_us(last);
+  };
+  t.median_us = percentile(0.5);
+  t.p99_us = percentile(0.99);
+  t.max_us = control::PerfCounter::upper_edge_us(last);
+  return t;
+}
+
 Vec6 theta_of(const plant::SoilParameters& s) {
   Vec6 t;
   t << s.mass[0], s.damping[0], s.stiffness[0], s.mass[1], s.damping[1], s.stiffness[1];
@@ -122,6 +149,9 @@ std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
   RunRecord result;
   result.controller = control::to_string(options.controller);
+  // This thread runs the loop and starts the telemetry thread: subnormals flushed from here on, the
+  // caller's mode back at the end (docs/floating-point.md).
+  const app::LoopFloatModeScope float_mode(options.float_mode);
 
   plant::Plant plant(scene);
   SimClock clock;
@@ -177,6 +207,14 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   if (const std::string why = fault_misfit(options.fault.kind, scene); !why.empty())
     throw std::invalid_argument("fault: " + why);
   if (hydraulic) result.min_pressure = result.peak_pressure = plant.state().hydraulics.min_pressure;
+  // The first and the last simulated second: counter copies at their edges (the loop's own copies, no
+  // allocation). The last second is left empty when the run stops before it begins.
+  const std::int64_t per_second = std::max<std::int64_t>(1, std::llround(1.0 / scene.cycle));
+  const std::int64_t first_end = std::min(cycles, per_second), last_begin = std::max<std::int64_t>(0, cycles - per_second);
+  const control::PerfCounter empty_counter;
+  control::PerfCounter control_first_end, plant_first_end, control_last_begin, plant_last_begin;
+  bool first_taken = false, last_taken = false;
+  std::int64_t cycles_run = 0;
   const double cpu_start = thread_cpu_seconds();
   {
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
@@ -196,9 +234,20 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         if (fault.kind == FaultSchedule::Kind::rock) plant.set_soil_stiffness_scale(fault_on ? fault.magnitude : 1.0);
         if (fault.kind == FaultSchedule::Kind::pump_loss) plant.set_pump_flow_scale(fault_on ? 1 - fault.magnitude : 1.0);
       }
+      if (k == last_begin) {
+        control_last_begin = node.control_timing();
+        plant_last_begin = plant_node.step_timing();
+        last_taken = true;
+      }
       node.begin_cycle();
       if (!plant_node.poll()) plant_node.coast();  // a SYNC lost in a burst: the machine moves on
       node.end_cycle();
+      cycles_run = k + 1;
+      if (cycles_run == first_end) {
+        control_first_end = node.control_timing();
+        plant_first_end = plant_node.step_timing();
+        first_taken = true;
+      }
       const plant::PlantState& s = plant.state();
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
       if (hydraulic) {
@@ -228,6 +277,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         result.first_fault_detected_time = node.fault_detected_time();
       }
       if (options.observer) options.observer(k, plant, node);
+      if (options.node_observer) options.node_observer(k, plant_node, node);
       if (plant_node.failed()) break;
       if (options.stop_at_safe_state && node.safe_stops() > 0) break;
       if (options.progress && (k + 1) % progress_every == 0) {
@@ -268,6 +318,18 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   }
   result.reanchor_count = plant.state().reanchor_count;
   result.control_step = timing_of(node.control_timing());
+  if (!first_taken) {
+    control_first_end = node.control_timing();
+    plant_first_end = plant_node.step_timing();
+  }
+  const double period = scene.cycle;
+  result.first_second = TimingWindow{0, static_cast<double>(std::min(cycles_run, first_end)) * period,
+                                     timing_between(empty_counter, control_first_end),
+                                     timing_between(empty_counter, plant_first_end)};
+  if (last_taken)
+    result.last_second = TimingWindow{static_cast<double>(last_begin) * period, static_cast<double>(cycles_run) * period,
+                                      timing_between(control_last_begin, node.control_timing()),
+                                      timing_between(plant_last_begin, plant_node.step_timing())};
   result.firmware_cycle = timing_of(node.cycle_timing());
   result.heap_allocations_in_loop = allocations;
   result.safe_stops = node.safe_stops();

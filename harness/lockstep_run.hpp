@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "app/firmware_settings.hpp"
+#include "app/float_environment.hpp"
 #include "control/controller_config.hpp"
 #include "settings/enum_table.hpp"
 #include "sim_plant/scene.hpp"
@@ -23,6 +24,7 @@ class Plant;
 }
 namespace exc::app {
 class FirmwareNode;
+class PlantNode;
 }
 
 namespace exc::sim {
@@ -45,6 +47,15 @@ SceneBundle load_scene_bundle(const std::string& path);
 struct Timing {
   double median_us = 0, p99_us = 0, max_us = 0;
   std::uint64_t count = 0;
+};
+
+// The control step's and the plant step's timing over one stretch of a run: a cycle's cost must not
+// depend on the run's history (docs/floating-point.md), so the first and the last simulated second
+// of a long run are compared. From the counters' histograms: each figure is its bucket's upper edge
+// (at most 5 % high), the max too.
+struct TimingWindow {
+  double start = 0, end = 0;  // s of the run
+  Timing control_step, plant_step;
 };
 
 // One work cycle of a run (a task done once has one): while tracking, true q_a against q_d.
@@ -77,6 +88,7 @@ struct RunRecord {
   double peak_soil_force = 0;         // N, |F_soil| maximum
   int reanchor_count = 0;
   Timing control_step;                // estimate + trajectory + control law
+  TimingWindow first_second, last_second;  // of the run (the whole run when it is shorter)
   Timing firmware_cycle;              // read + control + write + telemetry encode
   std::uint64_t heap_allocations_in_loop = 0;
   std::uint64_t safe_stops = 0;
@@ -141,6 +153,11 @@ struct LockstepOptions {
   FaultSchedule fault;
   // Called after every cycle (e.g. to sample the tip for a chart). Must not allocate in the loop.
   std::function<void(std::int64_t cycle, const plant::Plant&, const app::FirmwareNode&)> observer;
+  // Called after every cycle with both nodes (e.g. to scan their state). Must not allocate in the loop.
+  std::function<void(std::int64_t cycle, const app::PlantNode&, const app::FirmwareNode&)> node_observer;
+  // The run's floating-point mode (the thread's own is restored after it): flush_subnormals, the
+  // loop's; ieee only to measure what it saves (docs/floating-point.md).
+  app::FloatMode float_mode = app::FloatMode::flush_subnormals;
 };
 
 // Runs the plant's scene against the firmware's settings (which may differ on purpose: a wrong

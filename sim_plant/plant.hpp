@@ -70,6 +70,7 @@ class Plant {
   const PlantStatus& status() const { return status_; }
   const Scene& scene() const { return scene_; }
   const Model& model() const { return model_; }
+  const Workspace& workspace() const { return ws_; }  // the dynamics' buffers at the last evaluation
   // Efforts that hold the initial state still (gravity only): the hydraulic chambers start there.
   const Vec4& hold_effort() const { return hold_effort_; }
   double energy() const { return state_.kinetic_energy + state_.potential_energy; }

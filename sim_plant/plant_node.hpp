@@ -7,6 +7,7 @@
 // timeout, or on an emergency stop. Nothing allocates after construction.
 #include <cstdint>
 
+#include "app/subnormal_scan.hpp"
 #include "control/perf_counter.hpp"
 #include "hal/can_ports.hpp"
 #include "model/workspace.hpp"
@@ -60,6 +61,12 @@ class PlantNode {
   std::uint64_t steps() const { return steps_; }
   const plant::Plant& plant() const { return plant_; }
   void publish_counters();
+  // Plant::step's wall time per call, as EXC_TIMING stage 4 reports it.
+  const control::PerfCounter& step_timing() const { return step_timing_; }
+  // Every value the plant and this node carry from one step to the next (the machine's state, its
+  // circuit and soil, the sensor and command sets, the dynamics' workspace), for a look for
+  // subnormals (docs/floating-point.md). Not on the loop's path.
+  void scan_state(SubnormalScan& scan) const;
 
  private:
   void step(std::uint64_t cycle, bool answer = true);

@@ -170,6 +170,53 @@ void FirmwareNode::end_cycle() {
   cycle_timing_.record_ns(end_ns - start_ns);
 }
 
+void FirmwareNode::scan_state(SubnormalScan& scan) const {
+  // What came in and went out.
+  scan.scan("firmware sensors.position", sensors_.position);
+  scan.scan("firmware sensors.velocity", sensors_.velocity);
+  scan.scan("firmware sensors.pressure_a", sensors_.pressure_a);
+  scan.scan("firmware sensors.pressure_b", sensors_.pressure_b);
+  scan.scan("firmware sensors.pump_pressure", sensors_.pump_pressure);
+  scan.scan("firmware command.value", command_.value);
+  scan.scan("firmware command.pilot_a", command_.pilot_a);
+  scan.scan("firmware command.pilot_b", command_.pilot_b);
+  // The estimator's filters: their memory is these outputs and the inputs above, one cycle back.
+  scan.scan("estimator position", estimator_.position());
+  scan.scan("estimator velocity (Butterworth)", estimator_.velocity());
+  scan.scan("estimator acceleration (filtered derivative)", estimator_.acceleration());
+  // The path and the hold.
+  scan.scan("q_desired", q_d_);
+  scan.scan("qd_desired", qd_d_);
+  scan.scan("qdd_desired", qdd_d_);
+  scan.scan("held q", held_q_);
+  scan.scan("last effort sent", last_sent_);
+  // The law.
+  scan.scan("law tau", out_.tau);
+  scan.scan("law tau_unsaturated", out_.tau_unsaturated);
+  scan.scan("law e", out_.e);
+  scan.scan("law ed", out_.ed);
+  scan.scan("law theta_hat", out_.theta_hat);
+  scan.scan("law lyapunov", out_.lyapunov);
+  scan.scan("law lyapunov_tracking", out_.lyapunov_tracking);
+  scan.scan("law rho", out_.rho);
+  scan.scan("law rho_env", out_.rho_env);
+  scan.scan("law velocity (flow law)", out_.velocity);
+  if (const auto* pid = dynamic_cast<const control::ComputedTorquePid*>(controller_.get()))
+    scan.scan("pid integral", pid->pid().integral());
+  // The stages after the law: the actuator-lag lead and the valve stage.
+  scan.scan("actuator-lag lead delivered effort", lag_compensator_.delivered());
+  const control::ValveCommand& v = valves_.last();
+  scan.scan("valve stage velocity", v.velocity);
+  scan.scan("valve stage opening", v.opening);
+  scan.scan("valve stage spool command", v.spool);
+  scan.scan("valve stage pilot_a", v.pilot_a);
+  scan.scan("valve stage pilot_b", v.pilot_b);
+  scan.scan("valve stage measured force", v.force);
+  scan.scan("valve stage demanded flow", v.demanded_flow);
+  scan.scan("valve stage spool lead model", valves_.spool_model());
+  scan.scan("valve stage force integral", valves_.force_integral());
+}
+
 void FirmwareNode::publish_fault(FirmwareFault code, std::int8_t severity, bool active, const char* text) {
   if (telemetry_ == nullptr) return;
   exlcm::fault_t f{};

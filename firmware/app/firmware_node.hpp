@@ -21,6 +21,7 @@
 #include "control/valve_inner_loop.hpp"
 #include "hal/can_ports.hpp"
 #include "app/can_stats_message.hpp"
+#include "app/subnormal_scan.hpp"
 #include "app/tracking_metrics.hpp"
 #include "model/model.hpp"
 
@@ -133,6 +134,10 @@ class FirmwareNode {
   double fault_detected_time() const { return fault_detected_time_; }
   // Publishes the timing and CAN counters now (also done every 100 cycles).
   void publish_counters();
+  // Every value the node carries from one cycle to the next (sensors, command, the law's output and
+  // integrator, the estimator's filters, the lead compensators, the desired path), for a look for
+  // subnormals (docs/floating-point.md). Not on the loop's path.
+  void scan_state(SubnormalScan& scan) const;
 
  private:
   void compute_command(const control::Transition& transition);

@@ -20,6 +20,7 @@ class ComputedTorquePid final : public Controller {
   ControlOutput update(const ControlInput& in) override;
   ControllerKind kind() const override { return ControllerKind::pid; }
   Pid& pid() { return pid_; }
+  const Pid& pid() const { return pid_; }
 
  private:
   const Model& model_;

@@ -113,6 +113,8 @@ class ValveInnerLoop {
   double opening_for(int i, double u, double p_a, double p_b) const;
   const ValveCommand& last() const { return command_; }
   const ValveLoopSettings& settings() const { return settings_; }
+  const Vec4& spool_model() const { return spool_lead_.delivered(); }  // the lead's spool positions
+  const Vec4& force_integral() const { return force_integral_; }
 
  private:
   void finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b);

@@ -32,7 +32,7 @@ TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the
   const fs::path dir =
       exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "bench" / ("loop_split_" + std::to_string(getpid())));
   const std::string cmd = std::string(EXC_LOOP_BENCH_EXE) +
-                          " --split --split-duration 0.5 --duration 0.2 --repeats 1 --no-pin > '" +
+                          " --split --split-duration 0.5 --duration 0.2 --repeats 1 --no-pin --history 0 > '" +
                           (dir / "out.txt").string() + "' 2> '" + (dir / "err.txt").string() + "'";
   const int raw = std::system(cmd.c_str());
   const std::string out = exc::test::read_text_file(dir / "out.txt");

@@ -269,6 +269,13 @@ if figures[0] != figures[1]:
 print("tracking figures equal:", json.dumps(figures[0], sort_keys=True))
 PY
   then note "$(cat "$dir/compare.out")"; else fail "$(cat "$dir/compare.out")"; fi
+  # Both processes ran their loops with subnormals flushed (docs/floating-point.md).
+  local float_mode
+  float_mode=$(json_field "$dir/two_process.json" 'j.get("float_mode")')
+  if [ "$float_mode" = flush ]; then note "the firmware's loop and the plant ran with subnormals flushed"
+  else fail "the firmware's loop ran in floating-point mode '${float_mode:-?}', not flush"; fi
+  grep -q 'floating point: flush' "$dir/plant.out" ||
+    fail "the plant does not say it stepped with subnormals flushed: $(tail -1 "$dir/plant.out")"
   # The capture lost nothing: one SYNC on the bus per firmware cycle.
   local syncs cycles
   syncs=$(grep -c ' 080#' "$dir/capture.log")

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <string>
 
+#include "app/float_environment.hpp"
 #include "hal/can_ports.hpp"
 #include "hal/clock.hpp"
 #include "hal/socketcan_bus.hpp"
@@ -47,7 +48,8 @@ struct Figures {
     std::fprintf(f, "{\"cycles\": %ld, \"tracking\": {\"samples\": %ld, \"rms\": [", cycles, samples);
     for (int j = 0; j < kAxisCount; ++j)
       std::fprintf(f, "%s%.17g", j ? ", " : "", samples ? std::sqrt(sum_sq[j] / samples) : 0.0);
-    std::fprintf(f, "]}}\n");
+    // The loop thread's floating-point mode, as excavator-firmware reports it.
+    std::fprintf(f, "]}, \"float_mode\": \"%s\"}\n", exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread()));
     return std::fclose(f) == 0;
   }
 };
@@ -91,7 +93,8 @@ int run_plant(const Options& o) {
       last_sync = monotonic_now_ns();  // repeat the emergency once per silence period
     }
   }
-  std::printf("plant: %ld steps\n", steps);
+  std::printf("plant: %ld steps; floating point: %s\n", steps,
+              exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread()));
   return 0;
 }
 
@@ -153,6 +156,7 @@ int run_reference(const Options& o) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  exc::app::set_loop_float_mode();  // as excavator-plant and excavator-firmware do
   Options o;
   if (argc < 2 || std::strcmp(argv[1], "--help") == 0) {
     std::puts(

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "app/float_environment.hpp"
 #include "bench_common.hpp"
 #include "bench_runs.hpp"
 #include "fidelity_chart.hpp"
@@ -231,6 +232,8 @@ int export_command(const std::string& machine_file, const std::string& out, std:
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-bench", 1);  // stdout lost to a full disk is not exit 0
+  // The plant, the firmware and the peer all in the loop's floating-point mode (docs/floating-point.md).
+  exc::app::set_loop_float_mode();
   CLI::App app{
       "excavator-bench: work-precision chart, pressure-integration chart, fidelity chart, stability maps and MuJoCo as "
       "a peer.\n"

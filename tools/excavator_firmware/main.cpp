@@ -18,6 +18,7 @@
 
 #include "app/firmware_node.hpp"
 #include "app/firmware_settings.hpp"
+#include "app/float_environment.hpp"
 #include "app/node_io.hpp"
 #include "app/realtime_setup.hpp"
 #include "control/controller_kinds.hpp"
@@ -59,6 +60,9 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-firmware");  // stdout lost to a full disk is not exit 0
+  // This thread runs the loop (and starts the telemetry thread): subnormals flushed before anything
+  // is computed, so start-up and the loop share one arithmetic (docs/floating-point.md).
+  exc::app::set_loop_float_mode();
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
   std::string iface, scene_path, controller, json_path, lcm_url;
   double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;
@@ -155,10 +159,11 @@ int main(int argc, char** argv) {
     const auto wait_ns = static_cast<std::int64_t>(wait_ms * 1e6);
     const auto startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
     exc::hal::DeadlineSleeper sleeper(period_ns);
-    std::printf("excavator-firmware: %s on %s, %lld cycles of %.3g ms, %s; sensor wait %.3g ms%s%s\n", kind_name,
-                iface.c_str(), static_cast<long long>(cycles), period_s * 1e3,
+    std::printf("excavator-firmware: %s on %s, %lld cycles of %.3g ms, %s; sensor wait %.3g ms; floating point: %s%s%s\n",
+                kind_name, iface.c_str(), static_cast<long long>(cycles), period_s * 1e3,
                 realtime ? "real time (absolute deadlines)" : "lockstep with the plant", wait_ms,
-                rt_notes.empty() ? "" : "; ", rt_notes.c_str());
+                exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread()), rt_notes.empty() ? "" : "; ",
+                rt_notes.c_str());
     std::fflush(stdout);
 
     std::int64_t last_wake = 0;
@@ -245,6 +250,7 @@ int main(int argc, char** argv) {
       if (!ok) j["failure"] = failure;
       j["controller"] = kind_name;
       j["mode"] = realtime ? "realtime" : "lockstep";
+      j["float_mode"] = exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread());  // the loop thread's, at its end
       j["period_s"] = period_s;
       j["cycles"] = done;
       j["tracking"] = {{"rms_error", per_joint(node.measured_tracking(), true)},

@@ -13,6 +13,7 @@
 #include <iostream>
 #include <memory>
 
+#include "app/float_environment.hpp"
 #include "app/node_io.hpp"
 #include "hal/can_protocol.hpp"
 #include "output_file.hpp"
@@ -27,6 +28,9 @@ void on_signal(int) { g_stop = true; }
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-plant");  // stdout lost to a full disk is not exit 0
+  // This thread steps the plant (and starts the telemetry thread): subnormals flushed, as in the
+  // firmware and the lockstep harness, so the two processes compute what one process computes.
+  exc::app::set_loop_float_mode();
   CLI::App app{"excavator-plant: the simulated excavator on a SocketCAN interface (see README)."};
   std::string iface, scene_path, lcm_url;
   double duration = 0, silence_ms = 500, startup_s = 120;
@@ -109,11 +113,12 @@ int main(int argc, char** argv) {
       publisher->stop();
       tc = publisher->counters();
     }
-    std::printf("excavator-plant: %llu steps, %.3f s simulated, %llu holds, CAN rejects %llu; telemetry (%s) %llu "
-                "messages, %llu dropped, ring high water %zu of %zu\n",
+    std::printf("excavator-plant: %llu steps, %.3f s simulated, %llu holds, CAN rejects %llu; floating point: %s; "
+                "telemetry (%s) %llu messages, %llu dropped, ring high water %zu of %zu\n",
                 static_cast<unsigned long long>(node.steps()), plant.state().time,
                 static_cast<unsigned long long>(node.holds()), static_cast<unsigned long long>(port.rx_stats().rejected()),
-                exc::telemetry::to_string(overflow), static_cast<unsigned long long>(tc.published),
+                exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread()), exc::telemetry::to_string(overflow),
+                static_cast<unsigned long long>(tc.published),
                 static_cast<unsigned long long>(tc.dropped_full_total), tc.ring_high_water, tc.ring_capacity);
     return 0;
   } catch (const std::exception& e) {

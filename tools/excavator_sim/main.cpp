@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/float_environment.hpp"
 #include "control/controller_kinds.hpp"
 #include "in_process_run.hpp"
 #include "output_file.hpp"
@@ -29,6 +30,9 @@ namespace fs = std::filesystem;
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-sim");  // stdout lost to a full disk is not exit 0
+  // Start-up and every run in the loop's floating-point mode, as excavator-firmware and excavator-plant
+  // run (run_lockstep sets it again for each run; docs/floating-point.md).
+  exc::app::set_loop_float_mode();
   CLI::App app{
       "excavator-sim: runs the firmware against the simulated excavator over the in-memory CAN bus.\n"
       "  excavator-sim run scenes/dig.yaml            PID and adaptive, summary, log, plots, report\n"

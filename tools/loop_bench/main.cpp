@@ -19,6 +19,7 @@
 #include "model/scene_common.hpp"
 #include "option_checks.hpp"
 
+#include "app/float_environment.hpp"
 #include "app/firmware_node.hpp"
 #include "callgrind_split.hpp"
 #include "control/controller_kinds.hpp"
@@ -136,6 +137,23 @@ Trace record(const sim::SceneBundle& b, sim::LockstepOptions o, std::size_t cycl
   return t;
 }
 
+// A long run without telemetry in one floating-point mode: its first and last second side by side.
+void print_history_row(const sim::SceneBundle& b, const sim::LockstepOptions& base, double seconds, app::FloatMode mode) {
+  sim::LockstepOptions o = base;
+  o.duration = seconds;
+  o.float_mode = mode;
+  const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+  if (!r.ok) throw std::runtime_error("the " + std::to_string(seconds) + " s run failed: " + r.failure);
+  const sim::TimingWindow &first = r.first_second, &last = r.last_second;
+  std::printf("| %s | %.2f / %.2f us (%.2fx) | %.2f / %.2f us | %.2f / %.2f us (%.2fx) | %.2f / %.2f us | %.0fx |\n",
+              mode == app::FloatMode::flush_subnormals ? "flush-to-zero (the loop's mode)" : "IEEE gradual underflow",
+              first.control_step.median_us, last.control_step.median_us,
+              last.control_step.median_us / first.control_step.median_us, first.control_step.p99_us,
+              last.control_step.p99_us, first.plant_step.median_us, last.plant_step.median_us,
+              last.plant_step.median_us / first.plant_step.median_us, first.plant_step.p99_us, last.plant_step.p99_us,
+              r.simulated_seconds / r.cpu_seconds);
+}
+
 // Thread CPU seconds of `body`, the median of `repeats` runs.
 template <class Body>
 double timed(int repeats, Body&& body) {
@@ -152,13 +170,14 @@ double timed(int repeats, Body&& body) {
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-loop-bench", 1);  // stdout lost to a full disk is not exit 0
+  exc::app::set_loop_float_mode();  // the floor's model evaluations and replays as the loop runs them
   CLI::App app{"The closed loop's real-time factor: the dig scene's firmware, CAN and plant in one process with "
                "every telemetry message recorded, medians over repeats; the floor of its model evaluations; "
                "--split: the per-stage instruction split of one cycle under callgrind.",
                "excavator-loop-bench"};
   std::string scene_path = std::string(EXC_SOURCE_DIR_BENCH) + "/scenes/dig.yaml";
   std::string controller = "adaptive";
-  double duration = 0, split_duration = 2;
+  double duration = 0, split_duration = 2, history = 600;
   int repeats = 7;
   bool split = false, child = false, pin = true;
   app.add_option("--scene", scene_path, "scene (default: scenes/dig.yaml)");
@@ -170,6 +189,10 @@ int main(int argc, char** argv) {
   app.add_flag("--split", split, "also the per-stage instruction split (runs itself under valgrind --tool=callgrind)");
   app.add_option("--split-duration", split_duration, "simulated seconds of the callgrind run (default 2)")
       ->check(exc::cli::number_in({0.01, 600}, "s"));
+  app.add_option("--history", history,
+                 "simulated seconds of a long run without telemetry whose first and last seconds are compared, in "
+                 "the loop's floating-point mode and with gradual underflow (default 600; 0: none)")
+      ->check(exc::cli::number_in({0, 28800}, "s"));
   app.add_flag("!--no-pin", pin, "do not pin the process (loop and telemetry thread) to one core");
   app.add_flag("--child", child, "one run with telemetry and nothing printed (what --split profiles)")->group("");
   CLI11_PARSE(app, argc, argv);
@@ -222,6 +245,18 @@ int main(int argc, char** argv) {
                   *std::min_element(loop.begin(), loop.end()), *std::max_element(loop.begin(), loop.end()),
                   median(process), median(wall), 1e3 / median(process));
       process_factor[set == &with ? 0 : 1] = median(process);
+    }
+
+    if (history > 0) {
+      // A cycle's cost must not depend on the run's history (docs/floating-point.md): the path ends at
+      // 10.05 s and the machine then holds; its decaying states reach the subnormal range unless flushed.
+      std::printf("\n# A long run's first and last second (%s, %.0f s simulated, no telemetry; the path takes %.2f s, "
+                  "then the machine holds)\n\n"
+                  "| floating point | control step median, first / last second | its p99 | plant step median, first / "
+                  "last second | its p99 | real-time factor, loop thread |\n|---|---|---|---|---|---|\n",
+                  controller.c_str(), history, bundle.firmware.task.end_time() - bundle.firmware.task.start_time());
+      print_history_row(bundle, options, history, app::FloatMode::flush_subnormals);
+      print_history_row(bundle, options, history, app::FloatMode::ieee);
     }
 
     // The floor: the loop's two model evaluations per cycle on this run's states, and the plant alone.

@@ -6,6 +6,8 @@
 // realistic mix rather than one repeated state.
 #include <benchmark/benchmark.h>
 
+#include "app/float_environment.hpp"
+
 #include <array>
 #include <random>
 #include <vector>
@@ -129,4 +131,12 @@ BENCHMARK(BM_ForwardDynamicsAugmented);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// The model as the loop evaluates it: in the loop's floating-point mode (docs/floating-point.md).
+int main(int argc, char** argv) {
+  exc::app::set_loop_float_mode();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -11,6 +11,7 @@
 
 #include "option_checks.hpp"
 
+#include "app/float_environment.hpp"
 #include "control/task.hpp"
 #include "model/closed_chain.hpp"
 #include "output_file.hpp"
@@ -107,6 +108,7 @@ bool stable_in_stiff_clay(const Scene& base, IntegrationMethod m, Formulation f,
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-plant-bench");  // stdout lost to a full disk is not exit 0
+  exc::app::set_loop_float_mode();  // the plant steps as in the loop (docs/floating-point.md)
   CLI::App app{"Plant figures: step time per integrator x formulation (dig scene with force actuators, 1 kHz), the "
                "hydraulic step per pressure method and the dig scene's real-time factor through its valves, and the "
                "largest stable step per integrator in stiff clay.",

@@ -17,6 +17,7 @@
 #include "model/scene_common.hpp"
 #include "option_checks.hpp"
 
+#include "app/float_environment.hpp"
 #include "output_file.hpp"
 #include "sim_plant/plant.hpp"
 
@@ -105,6 +106,7 @@ std::vector<Row> read_efforts(const std::string& path, bool valve_openings) {
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-plant-replay");  // stdout lost to a full disk is not exit 0
+  exc::app::set_loop_float_mode();  // the plant steps as in the loop (docs/floating-point.md)
   CLI::App app{
       "Runs a scene open-loop from a CSV of efforts (zero-order hold) and writes the plant's state at every "
       "cycle.\nCSV columns: t,swing,boom,arm,bucket: swing torque (N m) and cylinder forces (N, positive pushes "
