@@ -22,10 +22,12 @@ namespace {
 
 const Vec4 kMid(0.0, 2.2, 2.8, 2.0);  // a mid-stroke q_a
 
-// The reference machine with spools that jump to the command and open from zero, so that a test
-// sees the orifices and chambers alone.
+// The reference machine with spools that jump to the command and open from zero and without
+// internal leakage and dry friction, so that a test sees the orifices and chambers alone (their closed
+// forms leave leakage out: tests/plant/test_friction_leakage.cpp has its own).
 Machine open_spools() {
   Machine m = reference_machine();
+  m.hydraulics = without_dry_friction_and_leakage(m.hydraulics);
   m.hydraulics.valve_time_constant = 0;
   m.hydraulics.dead_zone_extend.setZero();
   m.hydraulics.dead_zone_retract.setZero();
@@ -221,10 +223,14 @@ TEST_CASE("plant/hydraulics: a blocked cylinder's oil column rings at omega_n = 
 TEST_CASE("plant/hydraulics: the swing motor's oil column in the plant rings at sqrt(beta D^2 (1/V_A + 1/V_B) / I)") {
   // The whole plant: the swing given a small speed, every valve closed; I from the model's mass
   // matrix (eq. 17), D the swing's displacement (torque limit over relief pressure).
+  // The closed form is the oil spring's alone: without the swing's breakaway torque (6.6 kN m) the
+  // 0.002 rad/s start sticks within the first cycle, and its motor's leakage would bleed the spring.
   plant::test::SceneText t;
   t.actuators = "fidelity: hydraulic";
   t.qd_a = "[0.002, 0, 0, 0]";
-  Plant plant(t.scene());
+  Scene scene = t.scene();
+  scene.machine.hydraulics = without_dry_friction_and_leakage(scene.machine.hydraulics);
+  Plant plant(scene);
   Workspace ws(plant.model());
   REQUIRE(update_closed_chain(plant.model(), ws, plant.state().q_a, Vec4::Zero()).ok());
   Mat4 M;
@@ -461,7 +467,9 @@ TEST_CASE("plant/hydraulics: energy balance with the hydraulics: pump work in, l
   MESSAGE("4 s, four functions: pump work " << e.pump_work * 1e-3 << " kJ, losses " << e.losses() * 1e-3
                                             << " kJ (meter-in " << e.meter_in_loss * 1e-3 << ", meter-out "
                                             << e.meter_out_loss * 1e-3 << ", relief " << e.relief_loss * 1e-3
-                                            << ", make-up " << e.makeup_loss * 1e-3 << "), oil stored "
+                                            << ", make-up " << e.makeup_loss * 1e-3 << ", leakage "
+                                            << e.leakage_loss * 1e-3 << "), friction " << r.last.friction_loss * 1e-3
+                                            << " kJ, oil stored "
                                             << (e.stored - e.stored0) << " J, soil " << r.last.soil_work * 1e-3
                                             << " kJ, mechanism " << r.mechanism * 1e-3 << " kJ; energy error "
                                             << r.last.energy_error << " J (worst " << r.worst_error
@@ -472,6 +480,8 @@ TEST_CASE("plant/hydraulics: energy balance with the hydraulics: pump work in, l
   CHECK(r.last.hydraulics.saturated_substeps > 0);    // and the pumps saturated on the way
   CHECK(r.last.hydraulics.relief_substeps > 0);       // and a relief opened
   CHECK(r.last.end_stop_events > 0);                  // the cylinders hit their stops (impacts in the books)
+  CHECK(e.leakage_loss > 0);                          // the machine's internal leakage in the books
+  CHECK(r.last.friction_loss > 0);                    // and its friction, viscous and dry
   CHECK(r.worst_error < 1e-3 * r.pump_work);          // stated tolerance: 0.1 % of the pump work
   // First order: a quarter of the step, about a quarter of the error.
   const EnergyRun fine = energy_run(0.25e-3);
@@ -636,6 +646,11 @@ TEST_CASE("plant/hydraulics: parameters outside their ranges are refused naming 
       {[](HydraulicParameters& h) { h.dead_zone_retract[0] = -0.1; }, "hydraulics.dead_zone_retract[0]", "is -0.1 (not from the file); allowed range [0, 0.9]"},
       {[](HydraulicParameters& h) { h.pump_of[3] = 2; }, "hydraulics.pump_of[3]", "is 2 (not from the file); allowed range [0, 1]"},
       {[](HydraulicParameters& h) { h.bulk_modulus = 1; }, "hydraulics.bulk_modulus", "is 1 Pa (not from the file); allowed range [1e+07, 5e+09] Pa"},
+      {[](HydraulicParameters& h) { h.breakaway_ratio = 0.5; }, "hydraulics.breakaway_ratio", "is 0.5 (not from the file); allowed range [1, 3]"},
+      {[](HydraulicParameters& h) { h.stribeck_velocity[3] = 0; }, "hydraulics.stribeck_velocity[3]", "is 0 (not from the file); allowed range [0.0001, 1]"},
+      {[](HydraulicParameters& h) { h.seal_pressure_friction[1] = -1e-4; }, "hydraulics.seal_pressure_friction[1]", "is -0.0001 (not from the file); allowed range [0, 0.01]"},
+      {[](HydraulicParameters& h) { h.spool_leakage[2] = -1e-14; }, "hydraulics.spool_leakage[2]", "is -1e-14 m^3/(s Pa) (not from the file); allowed range [0, 1e-09] m^3/(s Pa)"},
+      {[](HydraulicParameters& h) { h.swing_drain_leakage = 1e-6; }, "hydraulics.swing_drain_leakage", "is 1e-06 m^3/(s Pa) (not from the file); allowed range [0, 1e-09] m^3/(s Pa)"},
       {[](HydraulicParameters& h) { h.tank_pressure = 0, h.vapour_pressure = 0.05e6; }, "hydraulics.vapour_pressure",
        "is 50000 Pa; must not exceed tank_pressure (0 Pa)"},
   };
