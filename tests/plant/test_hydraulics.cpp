@@ -107,19 +107,19 @@ TEST_CASE("plant/hydraulics: a blocked cylinder fills along the closed forms of 
     if (next < 5 && t >= checks[next] - 0.5 * dt) {
       CAPTURE(t);
       // Bore pressure to 0.1 % of its distance from the relief (backward Euler at 1 us).
-      CHECK(relief - c.pressure_a()[1] == doctest::Approx(relief - bore(t)).epsilon(2e-3));
+      CHECK(relief - c.pressure_a()[1] == doctest::Approx(relief - bore(t)).epsilon(2e-3).scale(0));
       ++next;
     }
     if (next_rod < 3 && t >= rod_checks[next_rod] - 0.5 * dt) {
       CAPTURE(t);
-      CHECK(c.pressure_b()[1] - tank == doctest::Approx(rod(t) - tank).epsilon(2e-3));
+      CHECK(c.pressure_b()[1] - tank == doctest::Approx(rod(t) - tank).epsilon(2e-3).scale(0));
       ++next_rod;
     }
   }
   CHECK(next == 5);
   CHECK(next_rod == 3);
   CHECK(highest <= relief);  // the main relief caps it: the meter-in's drop is gone there
-  CHECK(c.report().pump_pressure[0] == doctest::Approx(relief));
+  CHECK(c.report().pump_pressure[0] == doctest::Approx(relief).scale(0));
 }
 
 TEST_CASE("plant/hydraulics: a port relief caps a chamber driven from outside at p_set + A v / K_r, and the make-up refills the other") {
@@ -136,8 +136,8 @@ TEST_CASE("plant/hydraulics: a port relief caps a chamber driven from outside at
   // bore 115 mm, rod 80 mm to within 0.2 %).
   const HydraulicGeometry g = hydraulic_geometry(m);
   const double A = g.area_a[3], Ab = g.area_b[3];
-  CHECK(A == doctest::Approx(M_PI / 4 * 0.115 * 0.115).epsilon(2e-3));
-  CHECK(Ab == doctest::Approx(M_PI / 4 * (0.115 * 0.115 - 0.080 * 0.080)).epsilon(2e-3));
+  CHECK(A == doctest::Approx(M_PI / 4 * 0.115 * 0.115).epsilon(2e-3).scale(0));
+  CHECK(Ab == doctest::Approx(M_PI / 4 * (0.115 * 0.115 - 0.080 * 0.080)).epsilon(2e-3).scale(0));
   const HydraulicParameters& h = p;
   double highest = 0, lowest = 1e9;
   for (int k = 0; k < 3000; ++k) {
@@ -146,13 +146,13 @@ TEST_CASE("plant/hydraulics: a port relief caps a chamber driven from outside at
     lowest = std::min(lowest, c.pressure_b()[3]);
   }
   const double expected = h.port_relief_pressure + A * -v * h.relief_override / h.pump_flow;
-  CHECK(c.pressure_a()[3] == doctest::Approx(expected).epsilon(1e-9));
+  CHECK(c.pressure_a()[3] == doctest::Approx(expected).epsilon(1e-9).scale(0));
   CHECK(highest <= expected * (1 + 1e-9));  // backward Euler: no overshoot on the way up
   const double below_tank = Ab * -v * std::sqrt(p.laminar_pressure) * std::sqrt(h.makeup_pressure_drop) / h.pump_flow;
-  CHECK(p.tank_pressure - c.pressure_b()[3] == doctest::Approx(below_tank).epsilon(1e-6));
+  CHECK(p.tank_pressure - c.pressure_b()[3] == doctest::Approx(below_tank).epsilon(1e-6).scale(0));
   CHECK(lowest >= h.vapour_pressure);
-  CHECK(c.report().relief_flow[3] == doctest::Approx(A * -v).epsilon(1e-9));
-  CHECK(c.report().makeup_flow[3] == doctest::Approx(Ab * -v).epsilon(1e-6));
+  CHECK(c.report().relief_flow[3] == doctest::Approx(A * -v).epsilon(1e-9).scale(0));
+  CHECK(c.report().makeup_flow[3] == doctest::Approx(Ab * -v).epsilon(1e-6).scale(0));
   CHECK(c.report().cavitation_substeps == 0);
   CHECK(c.report().relief_substeps > 0);
 }
@@ -181,11 +181,11 @@ TEST_CASE("plant/hydraulics: a stall against the end stop holds the bore side at
   MESSAGE("bucket stalled at " << s.q_a[3] << " m: bore side " << s.pressure_a[3] * 1e-6 << " MPa (highest "
                                << highest * 1e-6 << "), rod side " << s.pressure_b[3] * 1e-6 << " MPa; impact "
                                << s.end_stop_loss << " J, balance moved " << drift << " J over the 2 s stall");
-  CHECK(s.q_a[3] == doctest::Approx(m.bucket.max_length));
+  CHECK(s.q_a[3] == doctest::Approx(m.bucket.max_length).scale(0));
   CHECK(highest <= relief);
-  CHECK(s.pressure_a[3] == doctest::Approx(relief).epsilon(1e-3));
-  CHECK(s.pressure_b[3] == doctest::Approx(p.scene().machine.hydraulics.tank_pressure).epsilon(1e-2));
-  CHECK(s.hydraulics.pump_pressure[0] == doctest::Approx(relief));
+  CHECK(s.pressure_a[3] == doctest::Approx(relief).epsilon(1e-3).scale(0));
+  CHECK(s.pressure_b[3] == doctest::Approx(p.scene().machine.hydraulics.tank_pressure).epsilon(1e-2).scale(0));
+  CHECK(s.hydraulics.pump_pressure[0] == doctest::Approx(relief).scale(0));
   CHECK(s.end_stop_loss > 0);
   CHECK(drift < 30.0);
 }
@@ -216,7 +216,7 @@ TEST_CASE("plant/hydraulics: a blocked cylinder's oil column rings at omega_n = 
   REQUIRE(t.size() > 10);
   const double period = (t.back() - t.front()) / static_cast<double>(t.size() - 1);
   MESSAGE("boom oil column with 20 t: " << 2 * M_PI / period / (2 * M_PI) << " Hz, closed form " << omega / (2 * M_PI) << " Hz");
-  CHECK(2 * M_PI / period == doctest::Approx(omega).epsilon(1e-3));
+  CHECK(2 * M_PI / period == doctest::Approx(omega).epsilon(1e-3).scale(0));
   CHECK(c.report().makeup_flow[1] == 0);  // the ringing stayed inside the chambers' pressures
 }
 
@@ -248,7 +248,7 @@ TEST_CASE("plant/hydraulics: the swing motor's oil column in the plant rings at 
   const double period = (tc.back() - tc.front()) / static_cast<double>(tc.size() - 1);
   MESSAGE("swing oil column: " << 1 / period << " Hz, closed form " << omega / (2 * M_PI) << " Hz (I = " << M(0, 0)
                                << " kg m^2)");
-  CHECK(2 * M_PI / period == doctest::Approx(omega).epsilon(5e-3));
+  CHECK(2 * M_PI / period == doctest::Approx(omega).epsilon(5e-3).scale(0));
 }
 
 TEST_CASE("plant/hydraulics: flow sharing: functions demanding more than the pumps all slow by pump flow / demand, the total is the pumps' flow") {
@@ -267,30 +267,30 @@ TEST_CASE("plant/hydraulics: flow sharing: functions demanding more than the pum
     return c.report();
   };
   const HydraulicReport b = flows(Vec4(0, 1, 0, 0)), a = flows(Vec4(0, 0, 1, 0)), s = flows(Vec4(1, 0, 0, 0));
-  CHECK(b.meter_in_flow[1] == doctest::Approx(boom).epsilon(2e-3));  // areas from the rounded machine limits
-  CHECK(a.meter_in_flow[2] == doctest::Approx(arm).epsilon(2e-3));
-  CHECK(s.meter_in_flow[0] == doctest::Approx(swing).epsilon(1e-9));
+  CHECK(b.meter_in_flow[1] == doctest::Approx(boom).epsilon(2e-3).scale(0));  // areas from the rounded machine limits
+  CHECK(a.meter_in_flow[2] == doctest::Approx(arm).epsilon(2e-3).scale(0));
+  CHECK(s.meter_in_flow[0] == doctest::Approx(swing).epsilon(1e-9).scale(0));
   CHECK(b.flow_scale[0] == 1);
   // Together: 2 x ~434 L/min asked of 439 L/min.
   const HydraulicReport ba = flows(Vec4(0, 1, 1, 0));
   const double ratio = pump / (b.meter_in_flow[1] + a.meter_in_flow[2]);
   MESSAGE("boom + arm ask " << (b.meter_in_flow[1] + a.meter_in_flow[2]) * 60000 << " L/min of " << pump * 60000
                              << ": each gets " << ratio * 100 << " %");
-  CHECK(ba.meter_in_flow[1] == doctest::Approx(ratio * b.meter_in_flow[1]).epsilon(1e-9));
-  CHECK(ba.meter_in_flow[2] == doctest::Approx(ratio * a.meter_in_flow[2]).epsilon(1e-9));
-  CHECK(ba.meter_in_flow[1] + ba.meter_in_flow[2] == doctest::Approx(pump).epsilon(1e-9));
-  CHECK(ba.pump_flow.sum() == doctest::Approx(pump).epsilon(1e-9));
-  CHECK(ba.pump_flow[0] == doctest::Approx(ba.pump_flow[1]));  // merged: each pump half
-  CHECK(ba.flow_scale[0] == doctest::Approx(ratio));
+  CHECK(ba.meter_in_flow[1] == doctest::Approx(ratio * b.meter_in_flow[1]).epsilon(1e-9).scale(0));
+  CHECK(ba.meter_in_flow[2] == doctest::Approx(ratio * a.meter_in_flow[2]).epsilon(1e-9).scale(0));
+  CHECK(ba.meter_in_flow[1] + ba.meter_in_flow[2] == doctest::Approx(pump).epsilon(1e-9).scale(0));
+  CHECK(ba.pump_flow.sum() == doctest::Approx(pump).epsilon(1e-9).scale(0));
+  CHECK(ba.pump_flow[0] == doctest::Approx(ba.pump_flow[1]).scale(0));  // merged: each pump half
+  CHECK(ba.flow_scale[0] == doctest::Approx(ratio).scale(0));
   // Three functions at part opening: the same factor for every one of them.
   const HydraulicReport three = flows(Vec4(0.8, 0.6, -0.5, 0));
   const HydraulicReport s8 = flows(Vec4(0.8, 0, 0, 0)), b6 = flows(Vec4(0, 0.6, 0, 0)), a5 = flows(Vec4(0, 0, -0.5, 0));
   const double demand = s8.meter_in_flow[0] + b6.meter_in_flow[1] + a5.meter_in_flow[2];
   REQUIRE(demand > pump);
-  CHECK(three.meter_in_flow[0] / s8.meter_in_flow[0] == doctest::Approx(pump / demand));
-  CHECK(three.meter_in_flow[1] / b6.meter_in_flow[1] == doctest::Approx(pump / demand));
-  CHECK(three.meter_in_flow[2] / a5.meter_in_flow[2] == doctest::Approx(pump / demand));
-  CHECK(three.meter_in_flow.sum() == doctest::Approx(pump));
+  CHECK(three.meter_in_flow[0] / s8.meter_in_flow[0] == doctest::Approx(pump / demand).scale(0));
+  CHECK(three.meter_in_flow[1] / b6.meter_in_flow[1] == doctest::Approx(pump / demand).scale(0));
+  CHECK(three.meter_in_flow[2] / a5.meter_in_flow[2] == doctest::Approx(pump / demand).scale(0));
+  CHECK(three.meter_in_flow.sum() == doctest::Approx(pump).scale(0));
   // Split pumps: boom and bucket share pump 0's half, the arm has pump 1's half to itself.
   Machine split = m;
   split.hydraulics.pumps_merged = false;
@@ -300,11 +300,11 @@ TEST_CASE("plant/hydraulics: flow sharing: functions demanding more than the pum
   c.command_opening(Vec4(0, 1, 1, 1));
   c.advance(1e-6, kMid, Vec4::Zero());
   const HydraulicReport& r = c.report();
-  CHECK(r.meter_in_flow[1] + r.meter_in_flow[3] == doctest::Approx(pump / 2));
-  CHECK(r.meter_in_flow[2] == doctest::Approx(pump / 2));
-  CHECK(r.pump_flow[0] == doctest::Approx(pump / 2));
-  CHECK(r.pump_flow[1] == doctest::Approx(pump / 2));
-  CHECK(r.meter_in_flow[1] / r.meter_in_flow[3] == doctest::Approx(b.meter_in_flow[1] / flows(Vec4(0, 0, 0, 1)).meter_in_flow[3]));
+  CHECK(r.meter_in_flow[1] + r.meter_in_flow[3] == doctest::Approx(pump / 2).scale(0));
+  CHECK(r.meter_in_flow[2] == doctest::Approx(pump / 2).scale(0));
+  CHECK(r.pump_flow[0] == doctest::Approx(pump / 2).scale(0));
+  CHECK(r.pump_flow[1] == doctest::Approx(pump / 2).scale(0));
+  CHECK(r.meter_in_flow[1] / r.meter_in_flow[3] == doctest::Approx(b.meter_in_flow[1] / flows(Vec4(0, 0, 0, 1)).meter_in_flow[3]).scale(0));
 }
 
 TEST_CASE("plant/hydraulics: the flow-sharing rule's two functions") {
@@ -312,7 +312,7 @@ TEST_CASE("plant/hydraulics: the flow-sharing rule's two functions") {
   CHECK(flow_share_scale(4.0, 1.0) == 0.25);
   CHECK(load_sensing_pressure(true, 10e6, 0.3e6, 2e6, 34.3e6) == 12e6);
   CHECK(load_sensing_pressure(true, 33e6, 0.3e6, 2e6, 34.3e6) == 34.3e6);
-  CHECK(load_sensing_pressure(false, 33e6, 0.3e6, 2e6, 34.3e6) == doctest::Approx(2.3e6));
+  CHECK(load_sensing_pressure(false, 33e6, 0.3e6, 2e6, 34.3e6) == doctest::Approx(2.3e6).scale(0));
 }
 
 TEST_CASE("plant/hydraulics: in the plant, boom and arm together both slow by pump flow / demand") {
@@ -336,7 +336,7 @@ TEST_CASE("plant/hydraulics: in the plant, boom and arm together both slow by pu
     if (k == 400) q0 = plant.state().q_a;
     if (k > 400) {
       always_saturated = always_saturated && plant.state().hydraulics.flow_scale[0] < 1;
-      CHECK(plant.state().hydraulics.meter_in_flow.sum() == doctest::Approx(pump).epsilon(1e-9));
+      CHECK(plant.state().hydraulics.meter_in_flow.sum() == doctest::Approx(pump).epsilon(1e-9).scale(0));
     }
   }
   const Vec4 mean = plant.state().q_a - q0;  // over 1 s
@@ -348,8 +348,8 @@ TEST_CASE("plant/hydraulics: in the plant, boom and arm together both slow by pu
   CHECK(r.pump_pressure == plant.state().hydraulics.pump_pressure);
   CHECK(r.pump_pressure[0] > plant.state().pressure_a[1]);  // the highest load + the margin
   CHECK(r.swing_pressure == Vec2(plant.state().pressure_a[0], plant.state().pressure_b[0]));
-  CHECK(mean[1] == doctest::Approx(s * m.boom.max_speed).epsilon(0.03));
-  CHECK(mean[2] == doctest::Approx(s * m.arm.max_speed).epsilon(0.03));
+  CHECK(mean[1] == doctest::Approx(s * m.boom.max_speed).epsilon(0.03).scale(0));
+  CHECK(mean[2] == doctest::Approx(s * m.arm.max_speed).epsilon(0.03).scale(0));
 }
 
 TEST_CASE("plant/hydraulics: pumps that lose flow (the fault campaign's pump_loss) deliver their share: the boom alone slows to it, and speeds up again when the flow is back") {
@@ -370,12 +370,12 @@ TEST_CASE("plant/hydraulics: pumps that lose flow (the fault campaign's pump_los
     if (k == 400) q0 = plant.state().q_a;
     if (k > 400) {
       CHECK(plant.state().hydraulics.flow_scale[0] < 1);
-      CHECK(plant.state().hydraulics.meter_in_flow.sum() == doctest::Approx(0.3 * pump).epsilon(1e-9));
+      CHECK(plant.state().hydraulics.meter_in_flow.sum() == doctest::Approx(0.3 * pump).epsilon(1e-9).scale(0));
     }
   }
   const double slow = plant.state().q_a[1] - q0[1];  // m over 1 s
   MESSAGE("boom at 30 % of the pumps' flow: " << slow << " m/s (flow / bore area " << 0.3 * pump / bore << ")");
-  CHECK(slow == doctest::Approx(0.3 * pump / bore).epsilon(0.03));
+  CHECK(slow == doctest::Approx(0.3 * pump / bore).epsilon(0.03).scale(0));
   plant.set_pump_flow_scale(1);
   for (int k = 1; k <= 400; ++k) REQUIRE(plant.step(valve(Vec4(0, 1, 0, 0))).ok());
   CHECK(plant.state().hydraulics.flow_scale[0] == 1);
@@ -412,7 +412,7 @@ TEST_CASE("plant/hydraulics: a fast boom-down (overrunning load) refills the rod
   // The speed is the meter-out's: A v = K_out sqrt(p_A - p_tank), K_out = A v_max / sqrt(5 MPa).
   const PlantState& s = plant.state();
   const double p_tank = plant.scene().machine.hydraulics.tank_pressure, drop = plant.scene().machine.hydraulics.valve_pressure_drop;
-  CHECK(-s.qd_a[1] == doctest::Approx(m.boom.max_speed * std::sqrt((s.pressure_a[1] - p_tank) / drop)).epsilon(0.02));
+  CHECK(-s.qd_a[1] == doctest::Approx(m.boom.max_speed * std::sqrt((s.pressure_a[1] - p_tank) / drop)).epsilon(0.02).scale(0));
   CHECK(refilled > 0.1 * metered);  // overrunning: the make-up valves carried a real part of it
   CHECK(lowest >= floor);
   CHECK(plant.state().hydraulics.cavitation_substeps == 0);
