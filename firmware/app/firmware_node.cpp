@@ -54,6 +54,7 @@ void check_controller_interface(control::ControllerKind kind, const control::Con
 FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
                            hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry)
     : model_(model),
+      friction_(actuator_friction(model.machine)),
       task_(task),
       config_(config),
       port_(port),
@@ -359,8 +360,8 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   control_timing_.record_ns(hal::monotonic_now_ns() - start_ns);
 }
 
-Vec4 FirmwareNode::seal_friction() const {
-  return model_.machine.hydraulics.viscous_friction.cwiseProduct(estimator_.velocity());
+Vec4 FirmwareNode::seal_friction(const Vec4& v, const Vec4& p_a, const Vec4& p_b) const {
+  return smooth_friction(friction_, v, p_a, p_b);
 }
 
 control::AppliedEffort FirmwareNode::applied_effort() const {
@@ -370,7 +371,7 @@ control::AppliedEffort FirmwareNode::applied_effort() const {
     const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
     // What the cylinders push minus what their seals take (the nominal machine's friction): the
     // effort the mechanism receives, as the model's M_a qdd + h_a + J_t^T F_soil describes it.
-    a.effort = valves_.measured_force(p_a, p_b) - seal_friction();
+    a.effort = valves_.measured_force(p_a, p_b) - seal_friction(estimator_.velocity(), p_a, p_b);
     a.valid = a.measured = true;
     const control::ValveCommand& v = valves_.last();
     a.suspect = static_cast<std::uint8_t>(v.limited | valves_.off_map(p_a, p_b) | (v.pump_limited ? 0x0F : 0));
@@ -408,8 +409,9 @@ void FirmwareNode::command_valves(const Vec4& q) {
     last_sent_ = tau;
     const Vec4 v_ff = qd_d_ - valves_.settings().position_gain.cwiseProduct(out_.e);
     // The cylinders push what the mechanism needs plus what their seals take (the nominal machine's
-    // friction; applied_effort() takes it back out of the measured force).
-    v = &valves_.from_force(tau + seal_friction(), v_ff, q, p_a, p_b);
+    // friction, signed by the velocity the valves are asked for, which does not chatter with the
+    // sensors' noise; applied_effort() takes it back out of the measured force).
+    v = &valves_.from_force(tau + seal_friction(v_ff, p_a, p_b), v_ff, q, p_a, p_b);
   }
   if (v->pump_limited) ++pump_limited_cycles_;
   update_pump_warning(v->pump_limited, v->demanded_flow);

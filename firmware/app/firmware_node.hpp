@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "model/actuator_friction.hpp"
 #include "control/actuator_lag_compensator.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
@@ -145,7 +146,8 @@ class FirmwareNode {
   // (valve interface, from the pressures) or the delivered-effort model of the last command.
   control::AppliedEffort applied_effort() const;
   // The effort the hydraulic machine's seals take at the estimated velocity (nominal friction).
-  Vec4 seal_friction() const;
+  // The nominal machine's friction at velocity v and these chamber pressures (actuator_friction.hpp).
+  Vec4 seal_friction(const Vec4& v, const Vec4& p_a, const Vec4& p_b) const;
   // The valve interface: the law's effort through the force loop (or a flow law's velocity) to the
   // spools' pilot pressures.
   void command_valves(const Vec4& q);
@@ -157,6 +159,7 @@ class FirmwareNode {
   void raise(FirmwareFault fault);
 
   const Model& model_;
+  ActuatorFriction friction_;  // the nominal machine's (start-up)
   const control::Task& task_;
   FirmwareNodeConfig config_;
   hal::FirmwareCanPort& port_;

@@ -5,6 +5,7 @@
 
 #include "app/firmware_node.hpp"
 #include "control/effort_feasibility.hpp"
+#include "model/actuator_friction.hpp"
 #include "model/model.hpp"
 #include "model/scene_common.hpp"
 
@@ -20,6 +21,12 @@ void check_task_efforts(FirmwareSettings& s) {
   control::FeasibilityOptions o;
   o.soil_margin = task.efforts.soil_margin;
   o.terrain = s.terrain;
+  if (s.controller.command_interface == control::CommandInterface::valve) {
+    // A hydraulic machine: its seals and the swing motor's breakaway take part of each limit.
+    const HydraulicParameters& h = s.machine.hydraulics;
+    const double pump = h.main_relief_pressure;
+    o.friction = coulomb_level(actuator_friction(s.machine), Vec4::Constant(pump), Vec4::Zero());
+  }
   const Model model = build_model(s.machine);
   const control::FeasibilityReport r = control::check_effort_feasibility(model, task.trajectory, o);
   if (r.ok) return;

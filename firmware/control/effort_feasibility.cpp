@@ -51,7 +51,7 @@ FeasibilityReport check_effort_feasibility(const Model& model, const JointTrajec
     const double keep = in_soil ? 1 - options.soil_margin : 1;
     r.samples += 1;
     for (int j = 0; j < 4; ++j) {
-      const double h = hi[j] * keep, l = lo[j] * keep;
+      const double h = hi[j] * keep - options.friction[j], l = lo[j] * keep + options.friction[j];
       const double s = least_scale(g[j], tau[j] - g[j], l, h);
       const double limit = tau[j] >= 0 ? h : l;
       const double ratio = tau[j] / limit;

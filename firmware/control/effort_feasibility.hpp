@@ -23,6 +23,9 @@ struct FeasibilityOptions {
   double sample_period = 1e-3;  // s: every control cycle
   double soil_margin = 0.3;     // fraction of each limit kept free for the soil where the tip is below ground
   Terrain terrain;              // the ground (flat or a profile)
+  // What the actuators' dry friction takes of each limit while they move (N m, N; the nominal
+  // machine's Coulomb level at the pumps' pressure on a hydraulic machine, 0 on force actuators).
+  Vec4 friction = Vec4::Zero();
 };
 
 struct FeasibilityReport {

@@ -34,4 +34,11 @@ double friction_force(const ActuatorFriction& f, int function, double v, double 
   return std::copysign(dry_friction(f, function, fc, v), v) + f.viscous[function] * v;
 }
 
+Vec4 smooth_friction(const ActuatorFriction& f, const Vec4& v, const Vec4& p_a, const Vec4& p_b) {
+  const Vec4 fc = coulomb_level(f, p_a, p_b);
+  Vec4 out;
+  for (int j = 0; j < 4; ++j) out[j] = fc[j] * std::tanh(v[j] / f.stribeck_velocity[j]) + f.viscous[j] * v[j];
+  return out;
+}
+
 }  // namespace exc

@@ -34,4 +34,10 @@ double dry_friction(const ActuatorFriction& f, int function, double fc, double v
 // friction holds whatever is below it): dry_friction sign(v) + b v.
 double friction_force(const ActuatorFriction& f, int function, double v, double p_a, double p_b);
 
+// The friction a controller can predict: the Coulomb level through a smooth sign, tanh(v / v_s),
+// plus the viscous term; v_s the Stribeck velocity. The Stribeck peak and the stick at rest are left
+// out: near zero speed the sign of a filtered velocity is noise, and a discontinuous estimate would
+// chatter into the command and the residual.
+Vec4 smooth_friction(const ActuatorFriction& f, const Vec4& v, const Vec4& p_a, const Vec4& p_b);
+
 }  // namespace exc

@@ -10,6 +10,7 @@
 #include "app/firmware_settings.hpp"
 #include "control/effort_feasibility.hpp"
 #include "control/task.hpp"
+#include "model/actuator_friction.hpp"
 #include "model/closed_chain.hpp"
 #include "model/workspace.hpp"
 #include "scenes.hpp"
@@ -101,4 +102,22 @@ TEST_CASE("firmware/feasibility says no timing fits where gravity alone exceeds 
   CHECK(std::isinf(r.time_scale));
   CHECK(r.joint == 1);
   CHECK(r.message(task.waypoint_times, "task.waypoints").find("no timing fits") != std::string::npos);
+}
+
+TEST_CASE("firmware/feasibility counts the actuators' dry friction against their limits: the swing's time scale grows as the limit less the friction") {
+  const Model model = build_model(reference_machine());
+  const Task task = parse_task(YAML::Load(sim::kFastSwingTask)["task"], "scene.yaml", model.machine);
+  const double s0 = check_effort_feasibility(model, task.trajectory).time_scale;
+  FeasibilityOptions o;
+  const double limit = model.machine.effort_max()[0];
+  o.friction[0] = 0.2 * limit;
+  const FeasibilityReport r = check_effort_feasibility(model, task.trajectory, o);
+  // No gravity on the swing: what the path needs scales with 1/s^2, so (s / s0)^2 = limit / (limit - F).
+  CHECK(r.time_scale * r.time_scale == doctest::Approx(s0 * s0 / 0.8).epsilon(1e-3));
+  CHECK(r.limit == doctest::Approx(std::copysign(0.8 * limit, r.limit)).epsilon(1e-9));
+  // The hydraulic machine's own: the swing motor's breakaway takes a twelfth of its torque or more.
+  const Vec4 f = coulomb_level(actuator_friction(model.machine), Vec4::Constant(model.machine.hydraulics.main_relief_pressure),
+                               Vec4::Zero());
+  CHECK(f[0] > limit / 12);
+  CHECK(f[0] < limit / 4);
 }
