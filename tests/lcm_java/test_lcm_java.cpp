@@ -11,7 +11,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -22,6 +24,7 @@
 #include <thread>
 #include <vector>
 
+#include "log_channels.hpp"
 #include "sim_runs.hpp"
 #include "telemetry/telemetry_channels.hpp"
 
@@ -29,6 +32,7 @@ extern char** environ;
 
 namespace fs = std::filesystem;
 using exc::test::kDig;
+using exc::test::kPerCycleChannels;
 using exc::test::read_text_file;
 using exc::test::Run;
 using exc::test::run_sim;
@@ -217,7 +221,7 @@ TEST_CASE("telemetry/java: LCM's Java log reader with the exlcm jar decodes ever
       CHECK(j.last_seq == j.events - 1);
       java_types.insert(j.type);
       const std::string base = channel.substr(0, channel.find('/'));
-      if (base == "EXC_STATE" || base == "EXC_COMMAND" || base == "EXC_CONTROLLER") {
+      if (std::find(std::begin(kPerCycleChannels), std::end(kPerCycleChannels), base) != std::end(kPerCycleChannels)) {
         CHECK(j.events == cycles);  // one per cycle, stamped with its cycle's end
         CHECK(j.first_utime == 1000);
         CHECK(j.last_utime == cycles * 1000);

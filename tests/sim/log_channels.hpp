@@ -11,6 +11,11 @@
 
 namespace exc::test {
 
+// The channels the firmware and the plant publish (firmware/telemetry/telemetry_channels.hpp): the
+// first three every control cycle, the others periodically or on events.
+inline const char* const kPerCycleChannels[] = {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"};
+inline const char* const kOtherChannels[] = {"EXC_TIMING", "EXC_CAN_STATS", "EXC_FAULT", "EXC_TELEMETRY_STATS"};
+
 // Per channel of an LCM log: messages, their sequence numbers and time stamps. Every exlcm type
 // begins with the 8-byte fingerprint, int64 utime and int64 seq (big-endian, LCM's wire format), so
 // both are read from the bytes as the .lcm files define them, without the generated code.

@@ -32,6 +32,8 @@ namespace fs = std::filesystem;
 
 extern char** environ;
 
+using exc::test::kOtherChannels;
+using exc::test::kPerCycleChannels;
 using exc::test::LogChannel;
 using exc::test::read_log_channels;
 using exc::test::edited_dig;
@@ -60,10 +62,6 @@ void write_sweep_spec(const std::string& shipped, int cases, const std::string& 
   std::ofstream(to) << spec << extra;
 }
 
-// The channels the firmware and the plant publish (firmware/telemetry/telemetry_channels.hpp): the
-// first three every control cycle, the others periodically or on events.
-const char* const kPerCycleChannels[] = {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"};
-const char* const kOtherChannels[] = {"EXC_TIMING", "EXC_CAN_STATS", "EXC_FAULT", "EXC_TELEMETRY_STATS"};
 
 // A log of `controllers` each run for `cycles` cycles of 1 ms: on every per-cycle channel of every
 // controller, one message per cycle, counted by the channel's own sequence numbers (0 .. cycles-1,

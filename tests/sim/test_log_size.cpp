@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -19,6 +20,7 @@
 namespace fs = std::filesystem;
 using exc::test::csv_data_rows;
 using exc::test::kDig;
+using exc::test::kPerCycleChannels;
 using exc::test::LogChannel;
 using exc::test::read_log_channels;
 using exc::test::read_text_file;
@@ -26,8 +28,6 @@ using exc::test::Run;
 using exc::test::run_sim;
 
 namespace {
-
-const char* const kPerCycleChannels[] = {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"};
 
 // The expected size stated on stderr for the log at `log` ("excavator-sim: log PATH: about 4.6 MB
 // (4612345 bytes: ...)"), -1 if there is no such line.
@@ -136,15 +136,16 @@ TEST_CASE("tools/excavator-sim refuses a run whose log the disk cannot hold befo
                                "or in a user namespace): neither is allowed here");
   // Inside the namespace: mount, run, and record what the disk holds after (the tmpfs vanishes with it).
   const auto run_small = [&](const std::string& args, const std::string& tag) {
-    const std::string script = "mount -t tmpfs -o size=1m exc-small small && " + std::string(EXC_SIM_TOOL) + " run " + kDig +
-                               " --duration 1 --out small/out " + args + " > " + tag + ".out 2> " + tag + ".err; echo \\$? > " +
+    const std::string script = "mount -t tmpfs -o size=1m exc-small small && " + std::string(EXC_SIM_TOOL) + " " + args +
+                               " > " + tag + ".out 2> " + tag + ".err; echo \\$? > " +
                                tag + ".status; stat -c %s small/out/run.lcm > " + tag + ".size 2>/dev/null; ls small/out > " +
                                tag + ".files 2>/dev/null; true";
     const std::string cmd = "cd '" + dir.string() + "' && " + ns + " sh -c \"" + script + "\"";
     REQUIRE(std::system(cmd.c_str()) == 0);
   };
-  // The hydraulic dig's three controllers for 1 s: about 4.6 MB.
-  run_small("", "whole");
+  // The hydraulic dig's three controllers for 1 s: about 3 MB.
+  const std::string dig_run = "run " + kDig + " --duration 1 --out small/out";
+  run_small(dig_run, "whole");
   const std::string err = read_text_file(dir / "whole.err");
   INFO(err);
   CHECK(std::atoi(read_text_file(dir / "whole.status").c_str()) == 2);
@@ -158,7 +159,7 @@ TEST_CASE("tools/excavator-sim refuses a run whose log the disk cannot hold befo
   CHECK(err.find(" with pid") == std::string::npos);  // no run started
   CHECK(read_text_file(dir / "whole.files").find("run.lcm") == std::string::npos);
   // The same run recording the per-cycle channels every 50th cycle fits, and its statement holds.
-  run_small("--log-every 50 --no-report --quiet", "thinned");
+  run_small(dig_run + " --log-every 50 --no-report --quiet", "thinned");
   const std::string thinned_err = read_text_file(dir / "thinned.err");
   INFO(thinned_err);
   CHECK(std::atoi(read_text_file(dir / "thinned.status").c_str()) == 0);
@@ -167,4 +168,23 @@ TEST_CASE("tools/excavator-sim refuses a run whose log the disk cannot hold befo
   CHECK(written > 0);
   CHECK(written < (1 << 20));
   CHECK(std::abs(thinned_stated - written) <= written / 100);
+  // paper's three scenes for 0.3 s: each log would fit alone (0.6 to 0.9 MB), the three together do
+  // not; all are sized before the first runs.
+  const std::string scenes = std::string(EXC_SOURCE_DIR) + "/scenes/";
+  run_small("paper --duration 0.3 --out small/paper --free-motion " + scenes + "paper_free_motion.yaml --dig " + scenes +
+                "paper_dig.yaml --hydraulic-dig " + kDig,
+            "paper");
+  const std::string paper_err = read_text_file(dir / "paper.err");
+  INFO(paper_err);
+  CHECK(std::atoi(read_text_file(dir / "paper.status").c_str()) == 2);
+  long long each_max = 0;
+  for (const char* scene : {"free_motion", "dig", "hydraulic_dig"}) {
+    const long long bytes = stated_log_bytes(paper_err, dir / "small" / "paper" / scene / "run.lcm");
+    CHECK(bytes > 0);
+    each_max = std::max(each_max, bytes);
+  }
+  CHECK(each_max < (1 << 20));
+  CHECK(std::regex_search(paper_err, std::regex("the logs [^ ]*free_motion/run\\.lcm, [^ ]*dig/run\\.lcm, "
+                                                "[^ ]*hydraulic_dig/run\\.lcm need about [0-9.]+ MB")));
+  CHECK(paper_err.find(" with ") == std::string::npos);  // no scene ran
 }

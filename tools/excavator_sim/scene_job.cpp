@@ -100,8 +100,9 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
   for (const std::string& name : options.controllers) {
     const LogVolume v = lockstep_log_volume(plan.cycles, "/" + name, job.log_every);
     plan.log_bytes += v.bytes;
-    plan.per_cycle_bytes = v.per_cycle_bytes;
+    plan.per_cycle_bytes += v.per_cycle_bytes;
   }
+  if (!options.controllers.empty()) plan.per_cycle_bytes /= options.controllers.size();  // the mean: names differ in length
   return plan;
 }
 
@@ -141,7 +142,8 @@ void check_log_room(const std::vector<const SceneJobPlan*>& plans) {
     for (const fs::path& log : room.logs) logs += (logs.empty() ? "" : ", ") + log.string();
     throw std::runtime_error(
         (room.logs.size() == 1 ? "the log " + logs + " needs" : "the logs " + logs + " need") + " about " +
-        human_bytes(static_cast<double>(room.needed)) + " (" + std::to_string(room.needed) + " bytes) but its file system (" +
+        human_bytes(static_cast<double>(room.needed)) + " (" + std::to_string(room.needed) + " bytes) but " +
+        (room.logs.size() == 1 ? "its" : "their") + " file system (" +
         room.probed.string() + ") has " + human_bytes(static_cast<double>(room.free + room.reclaimed)) +
         " free: shorten the run (--duration), record the per-cycle channels less often (--log-every N) or write the "
         "log to another disk (--out DIR, or --lcm file://PATH?mode=w)");

@@ -34,7 +34,7 @@ struct SceneJobPlan {
   std::filesystem::path log;      // the log file the telemetry writes; empty for a provider with no file (udpm://)
   std::int64_t cycles = 0;        // per controller
   std::uint64_t log_bytes = 0;    // expected size of the log (harness/log_volume.hpp), every controller
-  std::uint64_t per_cycle_bytes = 0;  // of one controller's recorded cycle
+  std::uint64_t per_cycle_bytes = 0;  // of one controller's recorded cycle (the controllers' mean)
 };
 
 struct SceneJobResult {
