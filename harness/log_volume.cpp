@@ -16,16 +16,15 @@ namespace {
 // LCM's log event: sync word (4), event number (8), timestamp (8), channel length (4), data length (4).
 constexpr std::uint64_t kEventHeaderBytes = 28;
 
+// Bytes of one Msg on `channel` + `suffix` in an LCM log file: the event header, the channel's name,
+// the message as lcm-gen encodes it (fixed-size types: the same for every message of the type).
 template <class Msg>
 std::uint64_t event_bytes(telemetry::Channel channel, const std::string& suffix) {
-  return log_event_bytes(telemetry::channel_base_name(channel) + suffix, static_cast<std::uint64_t>(Msg{}.getEncodedSize()));
+  const std::string name = telemetry::channel_base_name(channel) + suffix;
+  return kEventHeaderBytes + name.size() + static_cast<std::uint64_t>(Msg{}.getEncodedSize());
 }
 
 }  // namespace
-
-std::uint64_t log_event_bytes(const std::string& channel, std::uint64_t payload_bytes) {
-  return kEventHeaderBytes + channel.size() + payload_bytes;
-}
 
 LogVolume lockstep_log_volume(std::int64_t cycles, const std::string& channel_suffix, std::uint32_t per_cycle_every) {
   using telemetry::Channel;

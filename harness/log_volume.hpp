@@ -8,9 +8,6 @@
 
 namespace exc::sim {
 
-// Bytes of one event of `payload_bytes` on `channel` in an LCM log file.
-std::uint64_t log_event_bytes(const std::string& channel, std::uint64_t payload_bytes);
-
 struct LogVolume {
   std::uint64_t bytes = 0;               // the whole run's log
   std::uint64_t per_cycle_messages = 0;  // recorded per channel: EXC_STATE, EXC_COMMAND, EXC_CONTROLLER each
