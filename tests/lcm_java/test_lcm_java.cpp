@@ -288,6 +288,8 @@ TEST_CASE("telemetry/lcm-spy under Xvfb, started as the README says with the exl
   const Run live = run_sim("run " + kDig + " --controller adaptive --duration 2 --quiet --no-report --lcm '" + url + "'");
   INFO(live.err);
   REQUIRE(live.status == 0);
+  // No log file here: the run says what a logger of it would write.
+  CHECK(live.err.find("excavator-sim: telemetry to " + url + " (no log file here); logged, it takes about ") != std::string::npos);
   // Every channel the run sent, shown with its type: waited for generously (lcm-spy counts as it
   // receives; a loaded machine only makes that later).
   const auto complete = [&] {
