@@ -146,6 +146,10 @@ std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
          plant::to_string(scene.actuators.fidelity);
 }
 
+std::int64_t lockstep_cycles(const plant::Scene& scene, double duration) {
+  return static_cast<std::int64_t>(std::llround((duration > 0 ? duration : scene.duration) / scene.cycle));
+}
+
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
   RunRecord result;
   result.controller = control::to_string(options.controller);
@@ -175,6 +179,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     tc.shared_output = options.telemetry;
     tc.channel_suffix = "/" + result.controller;
     tc.overflow = telemetry::OverflowPolicy::block;  // no deadline here: every message is recorded
+    tc.per_cycle_every = options.log_every;
+    result.telemetry_per_cycle_every = options.log_every;
     publisher = std::make_unique<telemetry::TelemetryPublisher>(tc);
     std::string error;
     if (!publisher->start(&error)) throw std::runtime_error("telemetry: " + error);
@@ -191,7 +197,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   app::PlantNode plant_node(plant, plant_port, publisher.get());
 
   const double duration = options.duration > 0 ? options.duration : scene.duration;
-  const auto cycles = static_cast<std::int64_t>(std::llround(duration / scene.cycle));
+  const std::int64_t cycles = lockstep_cycles(scene, options.duration);
   const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
   TrackingMetrics metrics;
   const auto wall_start = std::chrono::steady_clock::now();

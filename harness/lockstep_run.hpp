@@ -97,6 +97,7 @@ struct RunRecord {
   // refused because the ring was full (never with the blocking publisher the harness uses).
   std::uint64_t telemetry_enqueued = 0, telemetry_published = 0, telemetry_dropped = 0;
   std::size_t telemetry_ring_high_water = 0;
+  std::uint32_t telemetry_per_cycle_every = 1;  // the per-cycle channels recorded every Nth cycle (LockstepOptions::log_every)
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
   double first_fault_detected_time = -1;  // s its fault was detected (FirmwareNode::fault_detected_time)
@@ -148,6 +149,9 @@ struct LockstepOptions {
   double duration = 0;  // s; 0: the scene's
   // Telemetry into this provider (null: none), channels suffixed "/<controller>".
   std::shared_ptr<telemetry::LcmOutput> telemetry;
+  // Record the per-cycle channels (EXC_STATE, EXC_COMMAND, EXC_CONTROLLER) every Nth cycle only, from
+  // the first (TelemetryConfig::per_cycle_every): a long run's log at a fraction of the size.
+  std::uint32_t log_every = 1;
   bool progress = false;            // one line per tenth of the run on stderr
   bool stop_at_safe_state = false;  // end the run at the firmware's first safe stop (maps, sweeps)
   FaultSchedule fault;
@@ -159,6 +163,9 @@ struct LockstepOptions {
   // loop's; ieee only to measure what it saves (docs/floating-point.md).
   app::FloatMode float_mode = app::FloatMode::flush_subnormals;
 };
+
+// The cycles a run of `scene` lasts: `duration` s, or the scene's own duration when it is 0.
+std::int64_t lockstep_cycles(const plant::Scene& scene, double duration);
 
 // Runs the plant's scene against the firmware's settings (which may differ on purpose: a wrong
 // model, other gains). The plant starts from the scene's initial state.

@@ -23,7 +23,6 @@ namespace exc::app {
 namespace {
 
 constexpr int kHeartbeatPeriod = hal::kHeartbeatPeriodCycles;
-constexpr int kCounterPeriod = 100;    // cycles between timing / CAN counter messages
 
 Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]); }
 
@@ -470,7 +469,7 @@ void FirmwareNode::publish_counters() {
   // trajectory, law), 3 write, 6 telemetry encode; 5 the wake-up interval of a real-time loop, whose
   // overruns field carries the deadlines missed (the plant publishes 4, its step).
   exlcm::timing_t m{};
-  const std::pair<const control::PerfCounter*, std::int8_t> stages[] = {
+  const std::pair<const control::PerfCounter*, std::int8_t> stages[kTimingStages] = {
       {&cycle_timing_, 0}, {&read_timing_, 1}, {&control_timing_, 2}, {&write_timing_, 3}, {&telemetry_timing_, 6}};
   for (const auto& [counter, stage] : stages) {
     fill_timing(*counter, stage, utime, m);

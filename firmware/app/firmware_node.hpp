@@ -58,6 +58,11 @@ enum class FirmwareFault : std::uint16_t {
   pump_limited = 5,
 };
 inline constexpr int kPumpWarningCycles = 20;
+// Cycles between the node's counter messages (EXC_TIMING per stage, EXC_CAN_STATS).
+inline constexpr int kCounterPeriod = 100;
+// The stages the node publishes on EXC_TIMING each time (publish_counters): whole cycle, read, update,
+// write, telemetry encode; a real-time loop adds its wake-up interval.
+inline constexpr int kTimingStages = 5;
 const char* to_string(FirmwareFault fault);
 
 class FirmwareNode {

@@ -17,6 +17,14 @@ enum class Channel : std::uint16_t {
 };
 inline constexpr std::size_t channel_count = 7;
 
+// The channels published every control cycle: the bulk of a log, and what a long run may record at a
+// lower rate (TelemetryConfig::per_cycle_every).
+constexpr bool per_cycle(Channel channel) {
+  return channel == Channel::state || channel == Channel::command || channel == Channel::controller;
+}
+// The largest per_cycle_every a program accepts: every 10 s at 1 kHz.
+inline constexpr long kMaxPerCycleEvery = 10000;
+
 // The base LCM channel name (without suffix).
 constexpr const char* channel_base_name(Channel channel) {
   switch (channel) {

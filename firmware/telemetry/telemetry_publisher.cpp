@@ -37,6 +37,7 @@ TelemetryPublisher::TelemetryPublisher(TelemetryConfig config)
   for (std::size_t i = 0; i < channel_count; ++i) {
     channel_names_[i] =
         std::string(channel_base_name(static_cast<Channel>(i))) + config_.channel_suffix;
+    every_[i] = per_cycle(static_cast<Channel>(i)) ? std::max<std::uint32_t>(1, config_.per_cycle_every) : 1;
   }
 }
 

@@ -39,6 +39,11 @@ struct TelemetryConfig {
   // How often the telemetry thread publishes telemetry_stats_t.
   std::chrono::milliseconds stats_period{1000};
   OverflowPolicy overflow = OverflowPolicy::block;
+  // Record the per-cycle channels (per_cycle(): EXC_STATE, EXC_COMMAND, EXC_CONTROLLER) every Nth
+  // message only, from the first (for a long run's log: 10 gives a tenth of their volume). The others
+  // are recorded whole. A message left out is not sent and not counted as sent or dropped; seq counts
+  // the recorded ones, so a gap in seq still means a lost message, and utime says which cycle it is.
+  std::uint32_t per_cycle_every = 1;
   // The telemetry thread wakes this often and drains the ring. To a file:// provider it hands
   // everything (no receiver to outrun). To a udpm:// provider at most `udpm_burst` messages per wake:
   // an LCM subscriber (lcm-logger, lcm-spy) queues at most 30 messages per subscription by default
@@ -87,6 +92,7 @@ class TelemetryPublisher {
   bool publish(Channel channel, Msg msg) {
     const auto index = static_cast<std::size_t>(channel);
     if (index >= channel_count) return false;
+    if (every_[index] > 1 && offered_[index]++ % every_[index] != 0) return true;  // left out on purpose
     msg.seq = static_cast<std::int64_t>(next_sequence_[index]++);
     const int size = msg.encode(encode_buffer_.data(), 0, static_cast<int>(Ring::slot_bytes));
     if (size < 0) {
@@ -121,6 +127,8 @@ class TelemetryPublisher {
   Ring& ring_;
   // Loop-side state (producer thread only).
   std::array<std::uint64_t, channel_count> next_sequence_{};
+  std::array<std::uint64_t, channel_count> offered_{};  // messages offered per channel (per_cycle_every)
+  std::array<std::uint32_t, channel_count> every_{};    // record every Nth (1: all)
   alignas(8) std::array<std::uint8_t, Ring::slot_bytes> encode_buffer_{};
   // Telemetry-thread state.
   std::shared_ptr<LcmOutput> output_;

@@ -25,12 +25,17 @@
 #include "harness/lockstep_run.hpp"
 #include "matplotlib_probe.hpp"
 #include "run_report.hpp"
+#include "log_channels.hpp"
 #include "sim_runs.hpp"
 
 namespace fs = std::filesystem;
 
 extern char** environ;
 
+using exc::test::kOtherChannels;
+using exc::test::kPerCycleChannels;
+using exc::test::LogChannel;
+using exc::test::read_log_channels;
 using exc::test::edited_dig;
 using exc::test::edited_scene;
 using exc::test::kDig;
@@ -57,50 +62,6 @@ void write_sweep_spec(const std::string& shipped, int cases, const std::string& 
   std::ofstream(to) << spec << extra;
 }
 
-// Per channel of an LCM log: messages, their sequence numbers and time stamps. Every exlcm type
-// begins with the 8-byte fingerprint, int64 utime and int64 seq (big-endian, LCM's wire format), so
-// both are read from the bytes as the .lcm files define them, without the generated code.
-struct LogChannel {
-  std::int64_t count = 0, first_seq = -1, last_seq = -1, seq_gaps = 0;
-  std::int64_t out_of_order = 0;     // a sequence number not above the one before (a repeat or a step back)
-  std::int64_t stamp_mismatches = 0;  // utime not (seq + 1) ms: cycle seq's message stamped with another cycle
-  std::int64_t first_utime = -1, last_utime = -1;
-  std::map<std::int64_t, std::int64_t> utime_steps;  // utime difference to the previous message: how often
-};
-std::map<std::string, LogChannel> read_log_channels(const fs::path& path) {
-  std::map<std::string, LogChannel> channels;
-  lcm::LogFile log(path.string(), "r");
-  REQUIRE_MESSAGE(log.good(), "cannot read " << path.string());
-  while (const lcm::LogEvent* e = log.readNextEvent()) {
-    LogChannel& c = channels[e->channel];
-    REQUIRE(e->datalen >= 24);
-    const auto* b = static_cast<const std::uint8_t*>(e->data);
-    const auto field = [b](int at) {
-      std::uint64_t v = 0;
-      for (int i = at; i < at + 8; ++i) v = v << 8 | b[i];
-      return static_cast<std::int64_t>(v);
-    };
-    const std::int64_t utime = field(8), seq = field(16);
-    if (c.count == 0) {
-      c.first_seq = seq;
-      c.first_utime = utime;
-    } else {
-      if (seq != c.last_seq + 1) ++c.seq_gaps;
-      if (seq <= c.last_seq) ++c.out_of_order;
-      ++c.utime_steps[utime - c.last_utime];
-    }
-    if (utime != (seq + 1) * 1000) ++c.stamp_mismatches;
-    c.last_seq = seq;
-    c.last_utime = utime;
-    ++c.count;
-  }
-  return channels;
-}
-
-// The channels the firmware and the plant publish (firmware/telemetry/telemetry_channels.hpp): the
-// first three every control cycle, the others periodically or on events.
-const char* const kPerCycleChannels[] = {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"};
-const char* const kOtherChannels[] = {"EXC_TIMING", "EXC_CAN_STATS", "EXC_FAULT", "EXC_TELEMETRY_STATS"};
 
 // A log of `controllers` each run for `cycles` cycles of 1 ms: on every per-cycle channel of every
 // controller, one message per cycle, counted by the channel's own sequence numbers (0 .. cycles-1,

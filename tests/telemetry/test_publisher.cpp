@@ -446,3 +446,51 @@ TEST_CASE("telemetry/publish allocates nothing over 100000 messages of every typ
   CHECK(counters.published + counters.dropped_overflow == 100000);
   fs::remove(log_path);
 }
+
+TEST_CASE("telemetry/per_cycle_every 7 records every 7th message of the per-cycle channels from the first, seq without gaps, and the other channels whole") {
+  const fs::path log_path = temp_path("every-7.lcm");
+  constexpr std::int64_t cycles = 100, every = 7, recorded = (cycles + every - 1) / every;  // cycles 0, 7, ..., 98
+  {
+    TelemetryConfig config;
+    config.lcm_url = "file://" + log_path.string() + "?mode=w";
+    config.per_cycle_every = every;
+    TelemetryPublisher publisher(config);
+    std::string error;
+    REQUIRE_MESSAGE(publisher.start(&error), error);
+    exlcm::timing_t timing{};
+    for (std::int64_t k = 0; k < cycles; ++k) {
+      CHECK(publisher.publish(Channel::state, state_at(k)));  // left out on purpose is not refused
+      publisher.publish(Channel::command, command_at(k));
+      publisher.publish(Channel::controller, controller_at(k));
+      if (k % 10 == 0) publisher.publish(Channel::timing, timing);
+    }
+    publisher.stop();
+    const exc::telemetry::TelemetryCounters c = publisher.counters();
+    CHECK(c.enqueued == 3 * recorded + cycles / 10);
+    CHECK(c.published == c.enqueued);
+    CHECK(c.dropped_full_total + c.dropped_overflow == 0);
+  }
+  std::map<std::string, std::vector<std::int64_t>> utimes;  // per channel, in log order
+  std::int64_t seq_mismatches = 0;
+  for (const Event& e : read_log_events(log_path)) {
+    if (e.channel == "EXC_TELEMETRY_STATS") continue;
+    // Every exlcm type starts with the fingerprint, utime and seq (big-endian int64).
+    REQUIRE(e.data.size() >= 24);
+    const auto field = [&e](int at) {
+      std::uint64_t v = 0;
+      for (int i = at; i < at + 8; ++i) v = v << 8 | e.data[i];
+      return static_cast<std::int64_t>(v);
+    };
+    std::vector<std::int64_t>& u = utimes[e.channel];
+    if (field(16) != static_cast<std::int64_t>(u.size())) ++seq_mismatches;
+    u.push_back(field(8));
+  }
+  CHECK(seq_mismatches == 0);
+  for (const char* channel : {"EXC_STATE", "EXC_COMMAND", "EXC_CONTROLLER"}) {
+    INFO(channel);
+    REQUIRE(utimes[channel].size() == recorded);
+    for (std::int64_t i = 0; i < recorded; ++i) CHECK(utimes[channel][i] == i * every * 1000);  // cycle i * every
+  }
+  CHECK(utimes["EXC_TIMING"].size() == cycles / 10);
+  fs::remove(log_path);
+}

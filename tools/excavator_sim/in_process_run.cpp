@@ -77,6 +77,7 @@ Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
     lo.controller = kind;
     lo.duration = options.duration_override;
     lo.telemetry = output;
+    lo.log_every = options.log_every;
     lo.progress = options.progress;
     summary.runs.push_back(run_lockstep(bundle.scene, bundle.firmware, lo));
     summary.all_ok = summary.all_ok && summary.runs.back().ok;

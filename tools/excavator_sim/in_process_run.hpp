@@ -1,6 +1,7 @@
 #pragma once
 // The main job's runs: one lockstep run per controller (harness/lockstep_run.hpp), all into one LCM
 // log with a channel suffix per controller.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@ struct RunOptions {
   std::vector<std::string> controllers;  // pid, adaptive, slotine_li
   double duration_override = 0;          // s; 0: the scene's duration
   std::string lcm_url;                   // empty: no telemetry
+  std::uint32_t log_every = 1;           // the per-cycle channels every Nth cycle (LockstepOptions::log_every)
   bool progress = true;
 };
 

@@ -25,6 +25,7 @@
 #include "scene_job.hpp"
 #include "settings/section_reader.hpp"
 #include "sweep.hpp"
+#include "telemetry/telemetry_channels.hpp"
 
 namespace fs = std::filesystem;
 
@@ -63,6 +64,12 @@ int main(int argc, char** argv) {
                   "live: udpm://239.255.76.67:7667?ttl=0)");
   run->add_option("--duration", duration, "simulated seconds (default: the scene's duration)")
       ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
+  std::uint32_t log_every = 1;
+  const std::string log_every_help =
+      "record the per-cycle channels (EXC_STATE, EXC_COMMAND, EXC_CONTROLLER) every Nth cycle only, for a long "
+      "run's log (default 1: every cycle; the other channels are always whole)";
+  run->add_option("--log-every", log_every, log_every_help)
+      ->check(exc::cli::count_in(1, exc::telemetry::kMaxPerCycleEvery));
   run->add_flag("--no-report", no_report, "skip the CSV export, plots and report page");
   run->add_flag("--quiet", quiet, "no progress output");
 
@@ -103,6 +110,9 @@ int main(int argc, char** argv) {
                     "output directory (default: out/paper): report.md, free_motion/, dig/, hydraulic_dig/");
   paper->add_option("--duration", paper_duration, "simulated seconds of each scene (default: each scene's)")
       ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
+  std::uint32_t paper_log_every = 1;
+  paper->add_option("--log-every", paper_log_every, log_every_help)
+      ->check(exc::cli::count_in(1, exc::telemetry::kMaxPerCycleEvery));
   paper->add_flag("--quiet", paper_quiet, "no progress output");
   auto* sweep = app.add_subcommand(
       "sweep", "run a sweep's cases (all, or one shard of them for GNU parallel or a Slurm job array) into a JSON-lines "
@@ -226,10 +236,16 @@ int main(int argc, char** argv) {
       for (exc::sim::SceneJob* job : {&free_job, &dig_job, &hydraulic_job}) {
         job->progress = !paper_quiet;
         job->duration = paper_duration;
+        job->log_every = paper_log_every;
       }
-      const exc::sim::SceneJobResult free_result = exc::sim::run_scene_job(free_job);
-      const exc::sim::SceneJobResult dig_result = exc::sim::run_scene_job(dig_job);
-      const exc::sim::SceneJobResult hydraulic_result = exc::sim::run_scene_job(hydraulic_job);
+      // All three logs are sized before the first run: a disk too small for them refuses the job at once.
+      const exc::sim::SceneJobPlan free_plan = exc::sim::plan_scene_job(free_job);
+      const exc::sim::SceneJobPlan dig_plan = exc::sim::plan_scene_job(dig_job);
+      const exc::sim::SceneJobPlan hydraulic_plan = exc::sim::plan_scene_job(hydraulic_job);
+      exc::sim::check_log_room({&free_plan, &dig_plan, &hydraulic_plan});
+      const exc::sim::SceneJobResult free_result = exc::sim::run_scene_job(free_plan);
+      const exc::sim::SceneJobResult dig_result = exc::sim::run_scene_job(dig_plan);
+      const exc::sim::SceneJobResult hydraulic_result = exc::sim::run_scene_job(hydraulic_plan);
       if (!exc::sim::write_paper_report(out, free_result, dig_result, hydraulic_result)) {
         std::cerr << "excavator-sim: cannot write " << (out / "report.md").string() << "\n";
         return 1;
@@ -250,6 +266,7 @@ int main(int argc, char** argv) {
     job.lcm_url = lcm_url;
     job.json_path = json_path;
     job.duration = duration;
+    job.log_every = log_every;
     job.report = !no_report;
     job.progress = !quiet;
     return exc::sim::run_scene_job(job).exit_code;

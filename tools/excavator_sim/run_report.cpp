@@ -97,6 +97,10 @@ void print_summary(const Summary& summary, std::ostream& out) {
                   static_cast<unsigned long long>(r.heap_allocations_in_loop),
                   static_cast<unsigned long long>(r.telemetry_published), static_cast<unsigned long long>(r.telemetry_dropped),
                   r.simulated_seconds, r.wall_seconds, r.wall_seconds > 0 ? r.simulated_seconds / r.wall_seconds : 0.0);
+    if (r.telemetry_per_cycle_every > 1)
+      out << format("%-10s telemetry: EXC_STATE, EXC_COMMAND and EXC_CONTROLLER logged every %u cycles (--log-every), "
+                    "the figures above from every cycle\n",
+                    "", static_cast<unsigned>(r.telemetry_per_cycle_every));
     if (r.hydraulic)
       out << format("%-10s hydraulics: chamber pressures %.2f .. %.1f MPa; pumps short of flow %.2f s (firmware asked more "
                     "in %llu cycles); reliefs open %.3f s; make-up at the vapour floor %.3f s\n",
@@ -158,7 +162,7 @@ nlohmann::json to_json(const Summary& summary) {
     run["cycles"] = cycles;
     run["telemetry"] = {{"enqueued", r.telemetry_enqueued}, {"published", r.telemetry_published},
                         {"dropped", r.telemetry_dropped}, {"ring_high_water", r.telemetry_ring_high_water},
-                        {"overflow_policy", "block"}};
+                        {"overflow_policy", "block"}, {"per_cycle_every", r.telemetry_per_cycle_every}};
     j[r.controller] = run;
     // Headline figures over all runs: the worst timing, the total allocations.
     worst.median_us = std::max(worst.median_us, r.control_step.median_us);

@@ -1,11 +1,19 @@
 #include "scene_job.hpp"
 
+#include <sys/stat.h>
+#include <sys/statvfs.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <stdexcept>
 #include <string_view>
 
 #include "control/flow_position_control.hpp"
+#include "harness/log_volume.hpp"
 #include "output_file.hpp"
 #include "run_report.hpp"
 #include "settings/section_reader.hpp"
@@ -14,13 +22,59 @@ namespace exc::sim {
 
 namespace fs = std::filesystem;
 
-SceneJobResult run_scene_job(const SceneJob& job) {
-  SceneJobResult result;
-  RunOptions options;
+namespace {
+
+// LCM's file provider: file://PATH?mode=w.
+constexpr std::string_view kFileScheme = "file://";
+
+// "13.2 MB": decimal units, as df -H and file managers count.
+std::string human_bytes(double bytes) {
+  const char* units[] = {"bytes", "kB", "MB", "GB", "TB", "PB"};
+  int u = 0;
+  while (bytes >= 1000 && u < 5) {
+    bytes /= 1000;
+    ++u;
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, u == 0 ? "%.0f %s" : "%.3g %s", bytes, units[u]);
+  return text;
+}
+
+std::string ordinal_cycle(std::uint32_t every) {
+  if (every <= 1) return "every cycle";
+  const std::uint32_t tens = every % 100, ones = every % 10;
+  const char* suffix = tens >= 11 && tens <= 13 ? "th" : ones == 1 ? "st" : ones == 2 ? "nd" : ones == 3 ? "rd" : "th";
+  return "every " + std::to_string(every) + suffix + " cycle";
+}
+
+// The nearest directory of `path` that exists (the log's own may be created by the run).
+fs::path existing_directory(const fs::path& path) {
+  fs::path dir = fs::absolute(path).parent_path();
+  std::error_code ec;
+  while (!dir.empty() && !fs::is_directory(dir, ec) && dir != dir.root_path()) dir = dir.parent_path();
+  return dir;
+}
+
+struct FileSystemRoom {
+  std::uint64_t free = 0;       // bytes this process may still write (f_bavail)
+  std::uint64_t needed = 0;     // the logs' expected bytes
+  std::uint64_t reclaimed = 0;  // bytes of logs that exist and will be overwritten
+  fs::path probed;              // the directory statvfs looked at
+  std::vector<fs::path> logs;
+};
+
+}  // namespace
+
+SceneJobPlan plan_scene_job(const SceneJob& job) {
+  SceneJobPlan plan;
+  plan.job = job;
+  plan.bundle = load_scene_bundle(job.scene_path);
+  const SceneBundle& bundle = plan.bundle;
+  RunOptions& options = plan.options;
   options.scene_path = job.scene_path;
   options.duration_override = job.duration;
   options.progress = job.progress;
-  const SceneBundle bundle = load_scene_bundle(job.scene_path);
+  options.log_every = job.log_every;
   // Which controllers: --controller, else the scene's controller.type, else the paper's comparison
   // (and on a valve-commanded machine the industry's flow-based baseline beside it).
   const control::ControllerConfig& cc = bundle.firmware.controller;
@@ -38,20 +92,83 @@ SceneJobResult run_scene_job(const SceneJob& job) {
     std::cerr << "excavator-sim: " << bundle.name
               << ": flow left out of the default controllers: the task moves the swing, which flow-based control "
                  "cannot accelerate (docs/control.md); --controller flow runs it\n";
-  result.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
+  check_controller_names(options.controllers);
+  plan.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
+  options.lcm_url = job.lcm_url.empty()
+                        ? std::string(kFileScheme) + (fs::absolute(plan.out_dir) / "run.lcm").string() + "?mode=w"
+                        : job.lcm_url;
+  if (options.lcm_url.rfind(kFileScheme, 0) == 0) {
+    // The path between the scheme and the options.
+    const std::string rest = options.lcm_url.substr(kFileScheme.size());
+    plan.log = rest.substr(0, rest.find('?'));
+  }
+  plan.cycles = lockstep_cycles(bundle.scene, job.duration);
+  for (const std::string& name : options.controllers) {
+    const LogVolume v = lockstep_log_volume(plan.cycles, "/" + name, job.log_every);
+    plan.log_bytes += v.bytes;
+    plan.per_cycle_bytes += v.per_cycle_bytes;
+  }
+  if (!options.controllers.empty()) plan.per_cycle_bytes /= options.controllers.size();  // the mean: names differ in length
+  return plan;
+}
+
+void check_log_room(const std::vector<const SceneJobPlan*>& plans) {
+  std::map<dev_t, FileSystemRoom> file_systems;
+  for (const SceneJobPlan* plan : plans) {
+    const std::string what = std::to_string(plan->options.controllers.size()) + " controller" +
+                             (plan->options.controllers.size() == 1 ? "" : "s") + " x " + std::to_string(plan->cycles) +
+                             " cycles, EXC_STATE, EXC_COMMAND and EXC_CONTROLLER " + ordinal_cycle(plan->job.log_every) +
+                             ", " + human_bytes(static_cast<double>(plan->per_cycle_bytes)) + " per recorded cycle and controller";
+    if (plan->log.empty()) {
+      std::fprintf(stderr, "excavator-sim: telemetry to %s (no log file here); logged, it takes about %s (%s)\n",
+                   plan->options.lcm_url.c_str(), human_bytes(static_cast<double>(plan->log_bytes)).c_str(), what.c_str());
+      continue;
+    }
+    const fs::path dir = existing_directory(plan->log);
+    struct stat st {};
+    struct statvfs vfs {};
+    if (::stat(dir.c_str(), &st) != 0 || ::statvfs(dir.c_str(), &vfs) != 0)
+      throw std::runtime_error(dir.string() + ": cannot read its file system's free space (" + std::strerror(errno) + ")");
+    FileSystemRoom& room = file_systems[st.st_dev];
+    room.free = static_cast<std::uint64_t>(vfs.f_bavail) * vfs.f_frsize;
+    room.probed = dir;
+    room.needed += plan->log_bytes;
+    room.logs.push_back(plan->log);
+    std::error_code ec;
+    const auto existing = fs::file_size(plan->log, ec);
+    if (!ec) room.reclaimed += existing;
+    std::fprintf(stderr, "excavator-sim: log %s: about %s (%llu bytes: %s); %s free on its file system\n",
+                 plan->log.c_str(), human_bytes(static_cast<double>(plan->log_bytes)).c_str(),
+                 static_cast<unsigned long long>(plan->log_bytes), what.c_str(),
+                 human_bytes(static_cast<double>(room.free)).c_str());
+  }
+  for (const auto& [device, room] : file_systems) {
+    if (room.needed <= room.free + room.reclaimed) continue;
+    std::string logs;
+    for (const fs::path& log : room.logs) logs += (logs.empty() ? "" : ", ") + log.string();
+    throw std::runtime_error(
+        (room.logs.size() == 1 ? "the log " + logs + " needs" : "the logs " + logs + " need") + " about " +
+        human_bytes(static_cast<double>(room.needed)) + " (" + std::to_string(room.needed) + " bytes) but " +
+        (room.logs.size() == 1 ? "its" : "their") + " file system (" +
+        room.probed.string() + ") has " + human_bytes(static_cast<double>(room.free + room.reclaimed)) +
+        " free: shorten the run (--duration), record the per-cycle channels less often (--log-every N) or write the "
+        "log to another disk (--out DIR, or --lcm file://PATH?mode=w)");
+  }
+}
+
+SceneJobResult run_scene_job(const SceneJobPlan& plan) {
+  const SceneJob& job = plan.job;
+  const SceneBundle& bundle = plan.bundle;
+  SceneJobResult result;
+  result.out_dir = plan.out_dir;
   // The --json file is opened before the run, so a path that cannot be written costs no run time.
   std::ofstream json_file;
   if (!job.json_path.empty()) json_file = output::open_file(job.json_path);
   fs::create_directories(result.out_dir);
   // What the run used, every default filled in: it loads back to the same run.
   output::write_file(result.out_dir / "effective.yaml", settings::emit(bundle.effective));
-  // LCM's file provider: file://PATH?mode=w.
-  constexpr std::string_view kFileScheme = "file://";
-  options.lcm_url = job.lcm_url.empty()
-                        ? std::string(kFileScheme) + (fs::absolute(result.out_dir) / "run.lcm").string() + "?mode=w"
-                        : job.lcm_url;
 
-  result.summary = run_all(bundle, options);
+  result.summary = run_all(bundle, plan.options);
   print_summary(result.summary, std::cout);
   const nlohmann::json j = to_json(result.summary);
   const fs::path summary_path = result.out_dir / "summary.json";
@@ -61,13 +178,10 @@ SceneJobResult run_scene_job(const SceneJob& job) {
     output::finish_file(json_file, job.json_path);
   }
   result.exit_code = result.summary.all_ok ? 0 : 1;
-  if (job.report && options.lcm_url.rfind(kFileScheme, 0) == 0) {
+  if (job.report && !plan.log.empty()) {
     const std::string title = bundle.name + ": " + bundle.scene.description;
-    // The report reads the log the telemetry went to: <out>/run.lcm, or the file --lcm named (the
-    // path between the scheme and the options).
-    const std::string rest = options.lcm_url.substr(kFileScheme.size());
-    const fs::path log = rest.substr(0, rest.find('?'));
-    const int rc = write_report(log, result.out_dir, summary_path, title);
+    // The report reads the log the telemetry went to: <out>/run.lcm, or the file --lcm named.
+    const int rc = write_report(plan.log, result.out_dir, summary_path, title);
     if (rc != 0) {
       std::cerr << "excavator-sim: the report step failed (exit " << rc << "); the log and summary are in "
                 << result.out_dir.string() << "\n";
@@ -76,10 +190,16 @@ SceneJobResult run_scene_job(const SceneJob& job) {
       std::cout << "report: " << (result.out_dir / "report" / "report.md").string() << "\n";
     }
   } else if (job.report) {
-    std::cerr << "excavator-sim: no report: the telemetry went to " << options.lcm_url
+    std::cerr << "excavator-sim: no report: the telemetry went to " << plan.options.lcm_url
               << ", not to a log file (log it with lcm-logger, then excavator-log report LOG)\n";
   }
   return result;
+}
+
+SceneJobResult run_scene_job(const SceneJob& job) {
+  const SceneJobPlan plan = plan_scene_job(job);
+  check_log_room({&plan});
+  return run_scene_job(plan);
 }
 
 }  // namespace exc::sim

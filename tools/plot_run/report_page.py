@@ -53,6 +53,8 @@ def sim_table(runs):
         row("control step %s (us)" % q, lambda r, q=q: "%.1f" % r["control_step_us"][q])
     row("heap allocations in the loop", lambda r: "%d" % r["heap_allocations_in_loop"])
     row("telemetry messages (dropped)", lambda r: "%d (%d)" % (r["telemetry"]["published"], r["telemetry"]["dropped"]))
+    row("per-cycle channels logged", lambda r: "every cycle" if r["telemetry"].get("per_cycle_every", 1) == 1
+        else "every %d cycles" % r["telemetry"]["per_cycle_every"])
     row("simulated (s)", lambda r: "%.3g" % r["simulated_seconds"])
     row("task finished at (s)", lambda r: "%.3f" % r["task_finish_time"] if r["task_finished"] else
         "not finished (run ended at %.3g s)" % r["simulated_seconds"])
@@ -101,6 +103,17 @@ def long_run_note(runs):
     return [note, ""]
 
 
+def thinned_log_note(summary):
+    """What a log recorded at a lower rate (excavator-sim --log-every) holds (nothing for a whole log)."""
+    every = sorted({r.get("telemetry", {}).get("per_cycle_every", 1) for r in sim_runs(summary).values()})
+    if every in ([], [1]):
+        return []
+    rates = " or ".join(str(e) for e in every)
+    return ["The log holds EXC_STATE, EXC_COMMAND and EXC_CONTROLLER of one control cycle in %s only "
+            "(`--log-every %s`): the RMS above, the CSVs and the figures are over those cycles; the summary's "
+            "figures are over every cycle. The other channels are whole." % (rates, rates), ""]
+
+
 def write_report(runs, summary, title, out_dir, written):
     lines = ["# %s" % title, ""]
     if summary is not None:
@@ -123,6 +136,7 @@ def write_report(runs, summary, title, out_dir, written):
         lines.append("| %s (%s) | " % (joint, unit.split("[")[-1].rstrip("]")) + " | ".join(cells)
                      + " |")
     lines.append("")
+    lines += thinned_log_note(summary)
     note = long_run_note(runs)
     lines += note
     lines += cycle_table(summary)
