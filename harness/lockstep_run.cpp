@@ -12,7 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "app/firmware_node.hpp"
 #include "app/tracking_metrics.hpp"
 #include "hal/fault_injecting_bus.hpp"
@@ -181,7 +181,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   {
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
     // allocations (LCM) are on another thread and not counted.
-    test::AllocationCounter counter;
+    app::AllocationCounter counter;
     const FaultSchedule& fault = options.fault;
     bool fault_on = false;
     for (std::int64_t k = 0; k < cycles; ++k) {
