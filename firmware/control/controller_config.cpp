@@ -114,17 +114,12 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   check_cross_fields(r, c);
 }
 
-ControllerConfig parse_controller_config(const YAML::Node& node, const std::string& file) {
+ControllerConfig read_controller_config(const settings::Document& scene) {
+  SectionReader top(scene);
+  SectionReader controller = top.section("controller", "the control law's settings");
   ControllerConfig c;
-  SectionReader r(file, "controller", node);
-  read_controller_config(r, c);
+  read_controller_config(controller, c);
   return c;
-}
-
-void validate(const ControllerConfig& c, const std::string& file) {
-  ControllerConfig copy = c;
-  SectionReader r(file, "controller", YAML::Node());
-  read_controller_config(r, copy);
 }
 
 }  // namespace exc::control

@@ -107,9 +107,8 @@ struct ControllerConfig {
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
 // Hurwitz gains, ...).
 void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
-// The same from a node (which may be null/undefined: defaults). 'file' is named in errors.
-ControllerConfig parse_controller_config(const YAML::Node& controller, const std::string& file);
-// Checks a configuration built in C++ with the same declarations; throws SettingsError.
-void validate(const ControllerConfig& c, const std::string& file);
+// The `controller:` section of a parsed scene file (absent: the defaults), the rest of the file left to
+// its readers: a sweep's case that changes only controller settings reads them again so.
+ControllerConfig read_controller_config(const settings::Document& scene);
 
 }  // namespace exc::control

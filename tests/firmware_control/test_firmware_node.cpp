@@ -47,7 +47,7 @@ struct Loop {
 
   Loop(const Model& m, const char* task_yaml, app::FirmwareNodeConfig cfg)
       : model(m),
-        task(parse_task(YAML::Load(task_yaml)["task"], "test", m.machine)),
+        task(read_task(settings::Document::parse(task_yaml, "test"), m.machine)),
         plant(m, sim::SoilTruth{}),
         node(m, task, cfg, fw_port, nullptr) {
     Vec4 q0, qd0, qdd0;

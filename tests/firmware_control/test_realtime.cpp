@@ -67,7 +67,7 @@ struct Overrun {
 TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, trajectory, model, controller, lag compensation, plant)") {
   REQUIRE(exc::app::allocation_counting_works());
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   struct Variant {
     ControllerKind kind;
     bool integral_action;
@@ -126,7 +126,7 @@ TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, 
 
 TEST_CASE("firmware/timing budget of the adaptive control step after real-time preparation: no page fault in the loop, CPU median < 50 us, p99 < 100 us, p99.9 < 500 us, at most 10 of 100000 steps over the 1 ms cycle, each one's time taken from the thread, not spent by its code") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   const ControllerConfig cfg;
   AdaptiveComputedTorque ctrl(model, cfg, effort_limits_of(model.machine));
   StateEstimator est(cfg.filter);
