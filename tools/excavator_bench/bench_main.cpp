@@ -26,6 +26,7 @@
 #include "mujoco_peer.hpp"
 #endif
 #include "sim_plant/plant.hpp"
+#include "option_checks.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -250,7 +251,7 @@ int main(int argc, char** argv) {
   exp->add_option("--q-a", q_a, "assemble at q_a = swing L_boom L_arm L_bucket (default: the first reference pose)")
       ->expected(4);
   app.require_subcommand(0, 1);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
   o.plots = !no_plots;
   try {
     if (exp->parsed()) return exc::bench::export_command(machine_file, xml_out, q_a);

@@ -13,6 +13,7 @@
 
 #include "log_export.hpp"
 #include "output_file.hpp"
+#include "option_checks.hpp"
 
 namespace {
 
@@ -122,7 +123,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(10, 100000));
   }
 
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   exc::log::LogSummary summary;
   std::string error;

@@ -122,7 +122,7 @@ int main(int argc, char** argv) {
                 "(the machine as an absolute path); it loads back to the same run");
   std::string config_scene;
   config->add_option("scene", config_scene, "scene file (YAML), e.g. scenes/dig.yaml")->required();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   if (config->parsed()) {
     try {

@@ -129,4 +129,11 @@ BENCHMARK(BM_ForwardDynamicsAugmented);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+// Google Benchmark's main, but an argument it does not know exits 2 (bad input), as every program's does.
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_path, "the dig scene (default: scenes/dig.yaml)");
   app.add_option("--repeats", repeats, "runs of the dig scene for the real-time factors (best is reported)")
       ->check(exc::cli::count_in(1, 1000));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   Scene base;
   control::Task task;
