@@ -26,6 +26,7 @@
 #include "mujoco_peer.hpp"
 #endif
 #include "sim_plant/plant.hpp"
+#include "helper_program.hpp"
 #include "option_checks.hpp"
 
 namespace fs = std::filesystem;
@@ -195,9 +196,10 @@ int run_bench(const Options& o) {
     complete = false;
   }
   if (o.plots) {
-    const std::string cmd = std::string("/usr/bin/python3 '") + EXC_BENCH_PLOT_SCRIPT + "' '" + o.out + "'";
-    if (std::system(cmd.c_str()) != 0) {
-      std::fprintf(stderr, "excavator-bench: the plotting script failed (%s); the CSV files are complete\n", cmd.c_str());
+    const std::vector<std::string> cmd = {"/usr/bin/python3", EXC_BENCH_PLOT_SCRIPT, o.out};
+    if (exc::output::run_helper(cmd) != 0) {
+      std::fprintf(stderr, "excavator-bench: the plotting script failed (%s); the CSV files are complete\n",
+                   exc::output::command_text(cmd).c_str());
       complete = false;
     }
   }

@@ -10,6 +10,7 @@
 #include <regex>
 #include <stdexcept>
 
+#include "helper_program.hpp"
 #include "output_file.hpp"
 #include "run_report.hpp"
 #include "fault_campaign.hpp"
@@ -291,10 +292,12 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   }
   const bool stability = spec.records("stability"), spread = spec.records("robustness") && spec.variants.empty();
   if (charts && (stability || spread) && !cases.empty()) {
-    const std::string what = std::string(stability ? " --stability" : "") + (spread ? " --robustness" : "");
-    const std::string cmd = "/usr/bin/python3 '" EXC_SWEEP_PLOT "'" + what + " '" + out_dir.string() + "'";
-    if (std::system(cmd.c_str()) != 0) {
-      std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", cmd.c_str());
+    std::vector<std::string> cmd = {"/usr/bin/python3", EXC_SWEEP_PLOT};
+    if (stability) cmd.push_back("--stability");
+    if (spread) cmd.push_back("--robustness");
+    cmd.push_back(out_dir.string());
+    if (output::run_helper(cmd) != 0) {
+      std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", output::command_text(cmd).c_str());
       outcome.charts_ok = false;
     }
   }
