@@ -162,7 +162,7 @@ std::string named_machine_file(const std::string& scene) {
   try {
     const settings::Document doc = settings::Document::load(scene);
     SectionReader top(doc);
-    return read_scene_common(top, doc).machine_file;
+    return read_scene_machine(top, doc).file;
   } catch (const SettingsError&) {
   }
   return "";
