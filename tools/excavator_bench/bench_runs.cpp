@@ -160,16 +160,10 @@ void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorP
   if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
 }
 
-app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene, double model_mass_error) {
-  // The firmware's model: the full machine, with its masses off by the given error.
-  Machine fw_machine = s.scene.machine;
-  for (BodyInertia& b : fw_machine.bodies) {
-    b.mass *= 1 + model_mass_error;
-    b.inertia *= 1 + model_mass_error;
-  }
+app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene) {
   app::FirmwareSettings fw;
   fw.name = s.name;
-  fw.machine = fw_machine;
+  fw.machine = s.scene.machine;  // the firmware's model: the full machine
   fw.task = s.task;
   fw.terrain_height = scene.terrain.height;
   fw.duration = scene.duration;
@@ -192,24 +186,16 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
       scene.machine.bodies[k].mass *= 1e-3;
       scene.machine.bodies[k].inertia *= 1e-3;
     }
-  scene.sensors.position_noise = Vec4::Constant(v.position_noise);
-  scene.sensors.latency_cycles = v.delay_cycles;
+  // The chart compares models of the machine, not sensors: no position noise, no latency.
+  scene.sensors.position_noise.setZero();
+  scene.sensors.latency_cycles = 0;
   // The dig scene's file leaves the initial state to the task: start where the task starts.
   Vec4 q0, qd0, qdd0;
   s.task.trajectory.evaluate(s.task.start_time(), q0, qd0, qdd0);
   scene.q_a0 = q0;
   scene.qd_a0 = qd0;
 
-  app::FirmwareSettings fw = bench_firmware(s, scene, v.model_mass_error);
-  control::ControllerConfig& cc = fw.controller;
-  const double g = v.gain_scale;
-  cc.gains.kp *= g * g;
-  cc.gains.kv *= g;
-  cc.gains.ki *= g * g * g;
-  cc.sl_lambda *= g;
-  cc.sl_kd *= g;
-  cc.adaptation_rate *= v.adaptation_scale;
-  cc.sl_adaptation_rate *= v.adaptation_scale;
+  const app::FirmwareSettings fw = bench_firmware(s, scene);
 
   ClosedLoopResult r;
   const int per_hold = cycles_per_hold(scene.cycle);

@@ -74,11 +74,6 @@ struct ClosedLoopVariant {
   plant::ActuatorFidelity fidelity = plant::ActuatorFidelity::ideal;
   bool soil = true;                 // false: soil removed from the scene
   bool massless_cylinders = false;  // cylinder bodies at 1e-3 of their mass (earlier works' model)
-  double gain_scale = 1.0;          // omega_n of the error dynamics multiplied (kp x s^2, kv x s, ki x s^3)
-  double adaptation_scale = 1.0;    // adaptation rates multiplied
-  double position_noise = 0;        // sensor noise standard deviation: m on the cylinders, rad on the swing
-  int delay_cycles = 0;             // sensor latency
-  double model_mass_error = 0;      // relative: the controller's model has masses x (1 + error)
   double duration = 0;              // s; 0: the scene's
 };
 
@@ -97,8 +92,8 @@ struct ClosedLoopResult {
 void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators);
 
 // The firmware's settings for a closed-loop run of `scene` (the plant's side of s, changed): the
-// bench scene's task and controller set for the scene's actuators, its model's masses x (1 + error).
-app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene, double model_mass_error = 0);
+// bench scene's task and controller set for the scene's actuators, its model the full machine.
+app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene);
 
 ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v);
 
