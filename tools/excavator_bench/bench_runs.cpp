@@ -13,6 +13,7 @@
 #include "harness/lockstep_run.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
+#include "sweep_knobs.hpp"
 
 namespace exc::bench {
 
@@ -36,9 +37,12 @@ int cycles_per_hold(double cycle) { return static_cast<int>(std::lround(kProfile
 }  // namespace
 
 BenchScene load_bench_scene(const std::string& path, double start, double horizon) {
-  BenchScene b;
   // One reading of the file: the plant's sections and the firmware's (its task and controller).
-  const sim::SceneBundle bundle = sim::load_scene_bundle(path);
+  return bench_scene(sim::load_scene_bundle(path), start, horizon);
+}
+
+BenchScene bench_scene(const sim::SceneBundle& bundle, double start, double horizon) {
+  BenchScene b;
   b.scene = bundle.scene;
   b.task = bundle.firmware.task;
   b.controller = bundle.firmware.controller;
@@ -76,11 +80,9 @@ OpenLoopResult run_open_loop(const BenchScene& s, const EffortProfile& profile, 
   plant::Scene scene = s.scene;
   scene.integrator = settings.integrator;
   const double h = settings.integrator.step;
-  scene.cycle = h > 1e-3 ? h : 1e-3;
+  scene.cycle = sim::open_loop_cycle(h);
   scene.q_a0 = profile.q_a0;
   scene.qd_a0 = profile.qd_a0;
-  scene.soil.stiffness *= settings.soil_stiffness_scale;
-  scene.soil.damping *= std::sqrt(settings.soil_stiffness_scale);  // keeps the soil's damping ratio
   scene.checks.constraint_tolerance = settings.constraint_tolerance;
   if (!settings.plant_energy_check) {
     scene.checks.energy_tolerance = 1e12;

@@ -12,6 +12,7 @@
 #include "app/firmware_settings.hpp"
 #include "control/controller_config.hpp"
 #include "control/task.hpp"
+#include "harness/scene_source.hpp"
 #include "sim_plant/scene.hpp"
 
 namespace exc::bench {
@@ -28,6 +29,8 @@ struct BenchScene {
 };
 
 BenchScene load_bench_scene(const std::string& path, double start, double horizon);
+// The same from a scene already read.
+BenchScene bench_scene(const sim::SceneBundle& scene, double start, double horizon);
 
 // Efforts tau_a held over kProfileHold: the inverse dynamics of the closed chain (eq. 16b) along the
 // task's desired trajectory, no soil. Every step size of the charts divides kProfileHold.
@@ -42,7 +45,6 @@ EffortProfile effort_profile(const BenchScene& s, double speed = 1.0);
 
 struct OpenLoopSettings {
   plant::IntegratorSettings integrator;
-  double soil_stiffness_scale = 1.0;   // K_t and B_t multiplied (stability map)
   double constraint_tolerance = 1e-2;  // m: wide, so the chart shows the residual growing
   // false (work-precision chart): the energy-balance check is widened as well, because the energy
   // drift is one of the chart's measured errors; the stability maps keep the plant's own settings.
