@@ -125,11 +125,6 @@ Scene read_scene(const settings::Document& doc) {
   return read_scene(doc, read_scene_machine(top, doc));
 }
 
-Scene load_scene_from_string(const std::string& yaml, const std::string& file_for_errors,
-                             const std::string& base_directory) {
-  return read_scene(settings::Document::parse(yaml, file_for_errors, base_directory));
-}
-
 Scene load_scene(const std::string& path) { return read_scene(settings::Document::load(path)); }
 
 }  // namespace exc::plant

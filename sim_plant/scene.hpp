@@ -46,8 +46,5 @@ Scene read_scene(const settings::Document& scene);
 Scene read_scene(const settings::Document& scene, const SceneMachine& machine);
 // Reads and validates a scene file (opened and parsed once).
 Scene load_scene(const std::string& path);
-// Same from text; relative machine paths resolve against 'base_directory'.
-Scene load_scene_from_string(const std::string& yaml, const std::string& file_for_errors,
-                             const std::string& base_directory = ".");
 
 }  // namespace exc::plant
