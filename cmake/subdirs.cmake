@@ -27,7 +27,7 @@ endif()
 function(exc_add_doctest target)
   cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;ENV;PROPERTIES" ${ARGN})
   add_executable(${target} ${ARG_SOURCES})
-  target_link_libraries(${target} PRIVATE doctest::doctest exc_test_support ${ARG_LIBS})
+  target_link_libraries(${target} PRIVATE doctest::doctest exc_test_support exc_allocation_counter ${ARG_LIBS})
   target_compile_definitions(${target} PRIVATE
     EXC_SOURCE_DIR="${EXC_SOURCE_DIR}" EXC_MACHINE_FILE="${EXC_MACHINE_FILE}"
     EXC_BINARY_DIR="${CMAKE_BINARY_DIR}")

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "app/firmware_node.hpp"
 #include "app/tracking_metrics.hpp"
 #include "hal/fault_injecting_bus.hpp"
@@ -105,40 +105,7 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
   return p;
 }
 
-// The firmware's commands must be of the kind the machine takes: a hydraulic machine takes pilot
-// pressures (command_interface: valve), force-actuated ones take efforts. A run of the two mismatched
-// could only fail at its first command (or never track), so the file is refused at load, placed as
-// the settings reader places any error (at the key, or at its section when the key is absent).
-void check_command_fits(const settings::Document& scene, const SceneBundle& b) {
-  const bool hydraulic = b.scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
-  const control::CommandInterface wanted = hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort;
-  const control::CommandInterface given = b.firmware.controller.command_interface;
-  if (given == wanted) return;
-  settings::SectionReader top(scene);
-  const settings::SectionReader controller = top.section("controller", "the control law's settings");
-  controller.fail("command_interface",
-                  std::string("is ") + control::kCommandInterfaces.name_of(given) +
-                      (controller.has("command_interface") ? "" : " (not given: the default)") + " but actuators.fidelity is " +
-                      plant::to_string(b.scene.actuators.fidelity) + ", which takes " +
-                      (hydraulic ? "valve (pilot pressure) commands" : "efforts") +
-                      "; set command_interface: " + control::kCommandInterfaces.name_of(wanted));
-}
-
 }  // namespace
-
-SceneBundle load_scene_bundle(const std::string& path) {
-  // The file is opened and parsed once; each side reads its own sections from the same document.
-  const settings::Document scene = settings::Document::load(path);
-  SceneBundle b;
-  b.scene = plant::read_scene(scene);
-  b.firmware = app::read_firmware_settings(scene);
-  check_command_fits(scene, b);
-  b.name = b.scene.name;
-  b.scene.duration = b.firmware.duration;  // longer when task.efforts.fit_timing stretched the path
-  b.effective = YAML::Clone(b.scene.effective);
-  settings::merge_effective(b.effective, b.firmware.effective);
-  return b;
-}
 
 std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
   if (kind != FaultSchedule::Kind::pump_loss || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
@@ -225,7 +192,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   {
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
     // allocations (LCM) are on another thread and not counted.
-    test::AllocationCounter counter;
+    app::AllocationCounter counter;
     const FaultSchedule& fault = options.fault;
     bool fault_on = false;
     for (std::int64_t k = 0; k < cycles; ++k) {

@@ -12,6 +12,7 @@
 
 #include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
+#include "harness/scene_source.hpp"
 #include "control/controller_config.hpp"
 #include "settings/enum_table.hpp"
 #include "sim_plant/scene.hpp"
@@ -28,21 +29,6 @@ class PlantNode;
 }
 
 namespace exc::sim {
-
-// A scene as both sides read it: the plant's sections (true machine, soil, actuators, ...) and the
-// firmware's (nominal machine, controller, task, terrain height, duration).
-struct SceneBundle {
-  std::string name;
-  plant::Scene scene;
-  app::FirmwareSettings firmware;
-  // The scene's effective configuration: both sides' sections, every default filled in, the machine
-  // as an absolute path when the scene names one. Loads back to the same run (settings::emit).
-  YAML::Node effective;
-};
-
-// Loads both sides of one scene file, opened and parsed once (validated; errors name the file, the
-// line and column and the field).
-SceneBundle load_scene_bundle(const std::string& path);
 
 struct Timing {
   double median_us = 0, p99_us = 0, max_us = 0;

@@ -27,8 +27,6 @@ Plant::Plant(const Scene& scene)
   reset();
 }
 
-Plant Plant::load(const std::string& scene_path) { return Plant(load_scene(scene_path)); }
-
 void Plant::reset() {
   status_ = PlantStatus{};
   state_ = PlantState{};

@@ -51,7 +51,6 @@ struct PlantState {
 class Plant {
  public:
   explicit Plant(const Scene& scene);
-  static Plant load(const std::string& scene_path);
   Plant(const Plant&) = delete;
   Plant& operator=(const Plant&) = delete;
 

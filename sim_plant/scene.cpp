@@ -73,11 +73,11 @@ void read_checks(SectionReader& chk, CheckSettings& c) {
 
 }  // namespace
 
-Scene read_scene(const settings::Document& doc) {
+Scene read_scene(const settings::Document& doc, const SceneMachine& machine) {
   SectionReader top(doc);
   Scene s;
   s.file = doc.file();
-  SceneCommon common = read_scene_common(top, doc);
+  SceneCommon common = read_scene_common(top, machine);
   s.name = common.name;
   s.description = common.description;
   s.machine_file = common.machine_file;
@@ -118,9 +118,9 @@ Scene read_scene(const settings::Document& doc) {
   return s;
 }
 
-Scene load_scene_from_string(const std::string& yaml, const std::string& file_for_errors,
-                             const std::string& base_directory) {
-  return read_scene(settings::Document::parse(yaml, file_for_errors, base_directory));
+Scene read_scene(const settings::Document& doc) {
+  SectionReader top(doc);
+  return read_scene(doc, read_scene_machine(top, doc));
 }
 
 Scene load_scene(const std::string& path) { return read_scene(settings::Document::load(path)); }

@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "model/machine.hpp"
+#include "model/scene_common.hpp"
 #include "settings/document.hpp"
 #include "sim_plant/actuators.hpp"
 #include "sim_plant/integrators.hpp"
@@ -39,12 +40,11 @@ struct Scene {
   YAML::Node effective;
 };
 
-// Reads the plant's sections of a parsed scene file.
+// Reads the plant's sections of a parsed scene file (and the machine file it names).
 Scene read_scene(const settings::Document& scene);
+// The same against its machine already read (read_scene_machine: the file loaded once for both sides).
+Scene read_scene(const settings::Document& scene, const SceneMachine& machine);
 // Reads and validates a scene file (opened and parsed once).
 Scene load_scene(const std::string& path);
-// Same from text; relative machine paths resolve against 'base_directory'.
-Scene load_scene_from_string(const std::string& yaml, const std::string& file_for_errors,
-                             const std::string& base_directory = ".");
 
 }  // namespace exc::plant

@@ -54,11 +54,11 @@ void check_task_efforts(FirmwareSettings& s) {
 
 }  // namespace
 
-FirmwareSettings read_firmware_settings(const settings::Document& scene) {
+FirmwareSettings read_firmware_settings(const settings::Document& scene, const SceneMachine& machine) {
   settings::SectionReader top(scene);
   FirmwareSettings s;
   s.file = scene.file();
-  SceneCommon common = read_scene_common(top, scene);
+  SceneCommon common = read_scene_common(top, machine);
   s.name = common.name;
   s.machine_file = common.machine_file;
   s.machine = std::move(common.machine);
@@ -78,6 +78,11 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene) {
   }
   s.effective = top.effective();
   return s;
+}
+
+FirmwareSettings read_firmware_settings(const settings::Document& scene) {
+  settings::SectionReader top(scene);
+  return read_firmware_settings(scene, read_scene_machine(top, scene));
 }
 
 FirmwareSettings load_firmware_settings(const std::string& path) {

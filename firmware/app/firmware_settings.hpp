@@ -13,6 +13,7 @@
 #include "control/task.hpp"
 #include "model/machine.hpp"
 #include "model/terrain.hpp"
+#include "model/scene_common.hpp"
 #include "settings/document.hpp"
 
 namespace exc::app {
@@ -37,5 +38,7 @@ struct FirmwareSettings {
 FirmwareSettings load_firmware_settings(const std::string& path);
 // From an already parsed scene file (the one the plant's reader reads too).
 FirmwareSettings read_firmware_settings(const settings::Document& scene);
+// The same against its machine already read (read_scene_machine: the file loaded once for both sides).
+FirmwareSettings read_firmware_settings(const settings::Document& scene, const SceneMachine& machine);
 
 }  // namespace exc::app

@@ -162,17 +162,12 @@ void set_command_interface(ControllerConfig& c, CommandInterface interface) {
   c.command_interface = interface;
 }
 
-ControllerConfig parse_controller_config(const YAML::Node& node, const std::string& file) {
-  ControllerConfig c;
-  SectionReader r(file, "controller", node);
-  read_controller_config(r, c);
+ControllerConfig read_controller_config(const settings::Document& scene, const Machine& nominal) {
+  SectionReader top(scene);
+  SectionReader controller = top.section("controller", "the control law's settings");
+  ControllerConfig c = controller_defaults(nominal);
+  read_controller_config(controller, c);
   return c;
-}
-
-void validate(const ControllerConfig& c, const std::string& file) {
-  ControllerConfig copy = c;
-  SectionReader r(file, "controller", YAML::Node());
-  read_controller_config(r, copy);
 }
 
 }  // namespace exc::control

@@ -130,14 +130,13 @@ ControllerConfig controller_defaults(const Machine& nominal);
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
 // Hurwitz gains, ...).
 void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
-// The same from a node (which may be null/undefined: defaults). 'file' is named in errors.
-ControllerConfig parse_controller_config(const YAML::Node& controller, const std::string& file);
+// The `controller:` section of a parsed scene file (absent: the defaults), the rest of the file left to
+// its readers: a sweep's case that changes only controller settings reads them again so.
+ControllerConfig read_controller_config(const settings::Document& scene, const Machine& nominal);
 // Through the valves eq. 27's default rates are the force-commanded machine's times this (period / T_f).
 double valve_adaptation_scale(const ControllerConfig& c);
 // Switches the command interface of a configuration (a bench variant on other actuators), carrying
 // the default rates that depend on it with it.
 void set_command_interface(ControllerConfig& c, CommandInterface interface);
-// Checks a configuration built in C++ with the same declarations; throws SettingsError.
-void validate(const ControllerConfig& c, const std::string& file);
 
 }  // namespace exc::control

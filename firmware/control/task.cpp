@@ -156,10 +156,4 @@ Task read_task(const settings::Document& scene, const Machine& machine, const Tr
   return read_task(task, machine, options);
 }
 
-Task parse_task(const YAML::Node& node, const std::string& file, const Machine& machine,
-                const TrajectoryCheckOptions& options) {
-  SectionReader r(file, "task", node);
-  return read_task(r, machine, options);
-}
-
 }  // namespace exc::control

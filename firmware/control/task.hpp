@@ -64,8 +64,5 @@ struct Task {
 Task read_task(settings::SectionReader& task, const Machine& machine, const TrajectoryCheckOptions& options = {});
 // The `task:` section of a parsed scene file (the rest of the file left to its readers).
 Task read_task(const settings::Document& scene, const Machine& machine, const TrajectoryCheckOptions& options = {});
-// The same from a node; 'file' is named in errors.
-Task parse_task(const YAML::Node& task, const std::string& file, const Machine& machine,
-                const TrajectoryCheckOptions& options = {});
 
 }  // namespace exc::control

@@ -190,6 +190,8 @@ void read_reference_pose(SectionReader& p, ReferencePose& rp) {
   pw.finish();
 }
 
+}  // namespace
+
 Machine read_machine(const settings::Document& doc) {
   SectionReader r(doc);
   Machine m;
@@ -229,8 +231,6 @@ Machine read_machine(const settings::Document& doc) {
   }
   return m;
 }
-
-}  // namespace
 
 Vec4 Machine::q_min() const { return Vec4(-kInf, boom.min_length, arm.min_length, bucket.min_length); }
 Vec4 Machine::q_max() const { return Vec4(kInf, boom.max_length, arm.max_length, bucket.max_length); }

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "settings/document.hpp"
 #include "settings/settings_error.hpp"
 #include "types.hpp"
 
@@ -172,6 +173,8 @@ struct Machine {
 
 // Reads and validates a machine file (read and parsed once). Throws SettingsError.
 Machine load_machine(const std::string& path);
+// The same from a parsed machine file (or a tree of it with values set: a sweep's case).
+Machine read_machine(const settings::Document& machine_file);
 // Same, from YAML text; 'file_for_errors' is what errors name as the file.
 Machine load_machine_from_string(const std::string& yaml, const std::string& file_for_errors);
 // The reference machine compiled into the binary (same numbers as machines/reference-20t.yaml).

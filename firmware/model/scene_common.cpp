@@ -4,23 +4,34 @@ namespace exc {
 
 using settings::Need;
 
-SceneCommon read_scene_common(settings::SectionReader& top, const settings::Document& scene) {
+SceneMachine read_scene_machine(settings::SectionReader& top, const settings::Document& scene) {
+  SceneMachine m;
+  if (!top.given("machine")) {
+    m.document = settings::Document::parse(reference_machine_text(), "<embedded>");
+    m.machine = read_machine(m.document);
+    return m;
+  }
+  std::string path;
+  top.text("machine", path, "machine file, relative to the scene file");
+  m.file = scene.resolve(path);
+  try {
+    m.document = settings::Document::load(m.file);
+    m.machine = read_machine(m.document);
+  } catch (const SettingsError& e) {
+    top.fail("machine", std::string("the machine file does not load: ") + e.what());
+  }
+  top.record("machine", m.file);
+  return m;
+}
+
+SceneCommon read_scene_common(settings::SectionReader& top, const SceneMachine& machine) {
   SceneCommon c;
   top.text("name", c.name, "the scene's name", Need::required);
   top.text("description", c.description, "one line for people");
-  if (top.given("machine")) {
-    std::string path;
-    top.text("machine", path, "machine file, relative to the scene file");
-    c.machine_file = scene.resolve(path);
-    try {
-      c.machine = load_machine(c.machine_file);
-    } catch (const SettingsError& e) {
-      top.fail("machine", std::string("the machine file does not load: ") + e.what());
-    }
-    top.record("machine", c.machine_file);
-  } else {
-    c.machine = reference_machine();
-  }
+  // The key read by read_scene_machine, declared and recorded here as well (the file is not read again).
+  if (top.given("machine")) top.record("machine", machine.file);
+  c.machine_file = machine.file;
+  c.machine = machine.machine;
   settings::SectionReader terrain = top.section("terrain", "the ground");
   if (terrain.has("height") && terrain.has("profile"))
     terrain.fail("profile", "give either 'height' or 'profile', not both");

@@ -22,6 +22,17 @@ inline const std::vector<std::string> kPlantSceneSections = {"soil",       "init
 // A run's duration (s): the scene's `duration` and the programs' --duration overrides.
 inline constexpr settings::Bounds kRunDurationBounds{1e-3, 28800};
 
+// The machine a scene names (its `machine` key), opened and parsed once: the file resolved against
+// the scene's directory, or the built-in machine when the scene names none. Both sides read their
+// sections against it, so a scene's machine file is loaded once however many read the scene.
+struct SceneMachine {
+  std::string file;             // absolute path of the machine file, empty for the built-in reference machine
+  settings::Document document;  // the file as parsed (the built-in machine's text for the built-in one)
+  Machine machine;
+};
+// Reads the scene's `machine` key (an error in the machine file is placed at the key).
+SceneMachine read_scene_machine(settings::SectionReader& top, const settings::Document& scene);
+
 struct SceneCommon {
   std::string name, description;
   std::string machine_file;  // absolute path of the machine file, empty for the built-in reference machine
@@ -32,7 +43,7 @@ struct SceneCommon {
 };
 
 // Reads the shared keys from the scene's top level (their values recorded in its effective tree;
-// the machine as an absolute path when the scene names one).
-SceneCommon read_scene_common(settings::SectionReader& top, const settings::Document& scene);
+// the machine as an absolute path when the scene names one), the machine being `machine`.
+SceneCommon read_scene_common(settings::SectionReader& top, const SceneMachine& machine);
 
 }  // namespace exc

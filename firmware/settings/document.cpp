@@ -37,4 +37,21 @@ std::string Document::resolve(const std::string& path) const {
   return (p.is_absolute() ? p : fs::absolute(fs::path(directory_) / p)).lexically_normal().string();
 }
 
+Document Document::with_root(const YAML::Node& root) const {
+  Document d = *this;
+  d.root_.reset(root);  // rebinds the copy's handle (assigning would overwrite this document's tree)
+  d.declarations_ = std::make_shared<std::vector<Declaration>>();
+  return d;
+}
+
+void Document::declare(Declaration d) const {
+  if (declaration(d.field) == nullptr) declarations_->push_back(std::move(d));
+}
+
+const Declaration* Document::declaration(const std::string& field) const {
+  for (const Declaration& d : *declarations_)
+    if (d.field == field) return &d;
+  return nullptr;
+}
+
 }  // namespace exc::settings

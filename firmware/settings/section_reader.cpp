@@ -51,19 +51,33 @@ YAML::Node flow_sequence() {
 SectionReader::SectionReader(const Document& document)
     : SectionReader(document.file(), "", document.root(),
                     document.root().IsDefined() ? document.root().Mark() : YAML::Mark::null_mark(),
-                    YAML::Node(YAML::NodeType::Map)) {
+                    YAML::Node(YAML::NodeType::Map), &document) {
   if (present() && !in_.IsMap()) fail_here("the file must be a YAML mapping");
   if (!present()) fail_here("the file is empty: a YAML mapping is required");
 }
 
 SectionReader::SectionReader(std::string file, std::string path, YAML::Node input)
     : SectionReader(std::move(file), std::move(path), input,
-                    input.IsDefined() ? input.Mark() : YAML::Mark::null_mark(), YAML::Node(YAML::NodeType::Map)) {
+                    input.IsDefined() ? input.Mark() : YAML::Mark::null_mark(), YAML::Node(YAML::NodeType::Map), nullptr) {
   if (present() && !in_.IsMap()) fail_here("must be a mapping");
 }
 
-SectionReader::SectionReader(std::string file, std::string path, YAML::Node input, YAML::Mark mark, YAML::Node out)
-    : file_(std::move(file)), path_(std::move(path)), in_(input), mark_(mark), out_(out) {}
+SectionReader::SectionReader(std::string file, std::string path, YAML::Node input, YAML::Mark mark, YAML::Node out,
+                             const Document* document)
+    : file_(std::move(file)), path_(std::move(path)), in_(input), mark_(mark), out_(out), document_(document) {}
+
+void SectionReader::note(const char* key, Declaration::Type type, int count, const double* lo, const double* hi,
+                         int stride, const char* unit, const char* what) const {
+  if (document_ == nullptr) return;
+  Declaration d;
+  d.field = field(key);
+  d.type = type;
+  d.count = count;
+  for (int i = 0; i < (stride == 0 ? std::min(count, 1) : count); ++i) d.bounds.push_back({lo[i * stride], hi[i * stride]});
+  d.unit = unit;
+  d.what = what;
+  document_->declare(std::move(d));
+}
 
 std::string SectionReader::field(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
 
@@ -182,6 +196,7 @@ double SectionReader::to_number(const YAML::Node& n, const std::string& name, do
 
 void SectionReader::number(const char* key, double& value, Bounds b, const char* unit, const char* what, Need need) {
   declare(key);
+  note(key, Declaration::Type::number, 1, &b.lo, &b.hi, 0, unit, what);
   if (value_given(key)) {
     value = to_number(get(key), field(key), b.lo, b.hi, unit);
   } else if (need == Need::required) {
@@ -196,6 +211,7 @@ void SectionReader::read_whole(const char* key, double& value, double lo, double
                                const char* what, Need need) {
   const std::string allowed = "a whole number in " + range_text(lo, hi, unit);
   declare(key);
+  note(key, Declaration::Type::whole, 1, &lo, &hi, 0, unit, what);
   if (value_given(key)) {
     const YAML::Node n = get(key);
     double v = 0;
@@ -242,6 +258,7 @@ void SectionReader::texts(const char* key, std::vector<std::string>& values, std
 void SectionReader::read_list(const char* key, double* values, int n, const double* lo, const double* hi,
                               int stride, const char* unit, const char* what, Need need) {
   declare(key);
+  note(key, Declaration::Type::numbers, n, lo, hi, stride, unit, what);
   const bool scalar_bounds = stride == 0;
   const std::string shape = "a list of " + std::to_string(n) + " numbers" +
                             (scalar_bounds ? " in " + range_text(lo[0], hi[0], unit) : std::string());
@@ -327,7 +344,7 @@ SectionReader SectionReader::section(const char* key, const char* what, Need nee
   if (!has(key) && need == Need::required) fail(key, std::string("missing: ") + what);
   YAML::Node out(YAML::NodeType::Map);
   out_[key] = out;
-  return SectionReader(file_, field(key), n, n.IsDefined() ? n.Mark() : mark_, out);
+  return SectionReader(file_, field(key), n, n.IsDefined() ? n.Mark() : mark_, out, document_);
 }
 
 std::size_t SectionReader::begin_sections(const char* key, std::size_t min, std::size_t max, const char* what,
@@ -351,7 +368,7 @@ SectionReader SectionReader::section_item(const char* key, std::size_t i) {
   YAML::Node out(YAML::NodeType::Map);
   YAML::Node list = out_[key];
   list.push_back(out);
-  return SectionReader(file_, index_field(field(key), i), n, n.Mark(), out);
+  return SectionReader(file_, index_field(field(key), i), n, n.Mark(), out, document_);
 }
 
 void SectionReader::others(const std::vector<std::string>& keys) {

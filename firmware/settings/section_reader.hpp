@@ -15,7 +15,9 @@
 // the same declarations that parse; reading a struct from an absent section dumps (and validates)
 // it. Errors are SettingsErrors at the offending node's line and column: a bad value at the value,
 // an unknown key at the key, a missing one at its section. Numbers are recorded in the shortest form
-// that reads back to the same double. Start-up code: allocates, throws.
+// that reads back to the same double. Reading a Document, each numeric or enumerated field's
+// declaration (type, count, range, unit, description) is recorded in it (Document::declarations()).
+// Start-up code: allocates, throws.
 #include <algorithm>
 #include <cstddef>
 #include <initializer_list>
@@ -31,10 +33,6 @@
 namespace exc::settings {
 
 enum class Need { optional, required };
-
-struct Bounds {
-  double lo, hi;  // inclusive
-};
 
 // The shortest text that reads back to the same double (std::to_chars), plain unless the exponent
 // form is more than 2 characters shorter: 0.001, 0.0003, 1000000, 34300000, 1e-06, 1e+09.
@@ -115,6 +113,7 @@ class SectionReader {
       value = *table.named(name);
     }
     record(key, name);
+    note(key, Declaration::Type::choice, 0, nullptr, nullptr, 0, "", table.names().c_str());
   }
   // The same without a default: `given` tells whether the file names one; recorded only then.
   template <typename E, std::size_t N>
@@ -172,8 +171,13 @@ class SectionReader {
   void record(const char* key, const std::string& value);
 
  private:
-  SectionReader(std::string file, std::string path, YAML::Node input, YAML::Mark mark, YAML::Node out);
+  SectionReader(std::string file, std::string path, YAML::Node input, YAML::Mark mark, YAML::Node out,
+                const Document* document);
   YAML::Node get(const std::string& key) const;
+  // Records the field's declaration in the document read (nothing without one). Bounds: `count`
+  // elements `stride` apart (stride 0: one for all).
+  void note(const char* key, Declaration::Type type, int count, const double* lo, const double* hi, int stride,
+            const char* unit, const char* what) const;
   YAML::Mark mark_of(const std::string& key) const;
   void declare(const char* key);
   [[noreturn]] void fail_at(const YAML::Mark& mark, const std::string& field, const std::string& reason) const;
@@ -197,6 +201,7 @@ class SectionReader {
   YAML::Mark mark_;  // of the section, or of the nearest enclosing one present in the file
   YAML::Node out_;
   std::vector<std::string> declared_;
+  const Document* document_ = nullptr;  // the document read (null: a node given without one)
 };
 
 // Adds to `into` every key of `from` it does not have (recursively for mappings): the effective

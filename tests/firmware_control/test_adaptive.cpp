@@ -133,7 +133,7 @@ TEST_CASE("firmware/adaptive: the Lyapunov check can fail (a wrong anchor breaks
 TEST_CASE("firmware/adaptive: the projection keeps every soil estimate inside its bounds under noise") {
   const Model model = build_model(reference_machine());
   const Machine& m = model.machine;
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", m);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), m);
   ControllerConfig cfg;
   cfg.adaptation_rate *= 10.0;  // an aggressive rate, so the noise really pushes at the bounds
   AdaptiveComputedTorque ctrl(model, cfg, effort_limits_of(m));

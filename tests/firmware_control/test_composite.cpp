@@ -12,6 +12,7 @@
 #include "control/soil_contact.hpp"
 #include "control/soil_identification.hpp"
 #include "control/task.hpp"
+#include "settings/document.hpp"
 #include "scenes.hpp"
 #include "tracking_run.hpp"
 
@@ -150,7 +151,7 @@ TEST_CASE("firmware/soil contact with a site map: contact below a sloped ground,
 
 TEST_CASE("firmware/adaptive composite update: told the applied efforts, it identifies the soil's spring and damper on a dig pass (exact model, eq. 27 off)") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   ControllerConfig cfg;
   cfg.adaptation_rate.setZero();  // the composite term alone
   sim::SoilTruth loam;            // theta (200, 5e3, 7e4) on both axes

@@ -39,7 +39,7 @@ double worst_load(const Model& model, const JointTrajectory& tr, int joint) {
 
 TEST_CASE("firmware/feasibility refuses a 2 rad swing in 2.5 s, naming the swing, its torque and the timing that fits") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kFastSwingTask)["task"], "scene.yaml", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kFastSwingTask, "scene.yaml"), model.machine);
   const FeasibilityReport r = check_effort_feasibility(model, task.trajectory);
   CHECK_FALSE(r.ok);
   CHECK(r.joint == 0);
@@ -60,7 +60,7 @@ TEST_CASE("firmware/feasibility refuses a 2 rad swing in 2.5 s, naming the swing
 
 TEST_CASE("firmware/feasibility's time scale is exact: the rescaled path touches the limit and stays within it") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kFastSwingTask)["task"], "scene.yaml", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kFastSwingTask, "scene.yaml"), model.machine);
   const double s = check_effort_feasibility(model, task.trajectory).time_scale;
   const JointTrajectory fit = scale_timing(task.trajectory, s * 1.001);
   const JointTrajectory tight = scale_timing(task.trajectory, s * 0.97);
@@ -86,7 +86,7 @@ TEST_CASE("firmware/feasibility passes the shipped scenes' tasks and the test ta
     CHECK(r.samples >= st.task.end_time() / 1e-3);
   }
   for (const char* yaml : {sim::kDigTask, sim::kFreeMotionTask}) {
-    const Task task = parse_task(YAML::Load(yaml)["task"], "test", model.machine);
+    const Task task = read_task(settings::Document::parse(yaml, "test"), model.machine);
     CHECK(check_effort_feasibility(model, task.trajectory).ok);
   }
 }
@@ -96,7 +96,7 @@ TEST_CASE("firmware/feasibility says no timing fits where gravity alone exceeds 
   weak.boom.max_force *= 0.02;  // far below the boom's static load
   weak.boom.min_force *= 0.02;
   const Model model = build_model(weak);
-  const Task task = parse_task(YAML::Load(sim::kFreeMotionTask)["task"], "test", weak);
+  const Task task = read_task(settings::Document::parse(sim::kFreeMotionTask, "test"), weak);
   const FeasibilityReport r = check_effort_feasibility(model, task.trajectory);
   CHECK_FALSE(r.ok);
   CHECK(std::isinf(r.time_scale));
@@ -106,7 +106,7 @@ TEST_CASE("firmware/feasibility says no timing fits where gravity alone exceeds 
 
 TEST_CASE("firmware/feasibility counts the actuators' dry friction against their limits: the swing's time scale grows as the limit less the friction") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kFastSwingTask)["task"], "scene.yaml", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kFastSwingTask, "scene.yaml"), model.machine);
   const double s0 = check_effort_feasibility(model, task.trajectory).time_scale;
   FeasibilityOptions o;
   const double limit = model.machine.effort_max()[0];

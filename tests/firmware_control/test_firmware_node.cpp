@@ -9,7 +9,7 @@
 #include <map>
 #include <vector>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "app/firmware_node.hpp"
 #include "closed_loop.hpp"
 #include "dbc_reader.hpp"
@@ -47,7 +47,7 @@ struct Loop {
 
   Loop(const Model& m, const char* task_yaml, app::FirmwareNodeConfig cfg)
       : model(m),
-        task(parse_task(YAML::Load(task_yaml)["task"], "test", m.machine)),
+        task(read_task(settings::Document::parse(task_yaml, "test"), m.machine)),
         plant(m, sim::SoilTruth{}),
         node(m, task, cfg, fw_port, nullptr) {
     Vec4 q0, qd0, qdd0;
@@ -193,7 +193,7 @@ TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fau
 }
 
 TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over 20000 cycles of the dig task") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   const Model model = build_model(reference_machine());
   for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {
     app::FirmwareNodeConfig cfg;
@@ -203,8 +203,8 @@ TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over
     loop.cycle();  // start-up cycle outside the count (first touch)
     std::size_t allocations = 0;
     {
-      exc::test::AllocationCounter counter;
-      exc::test::EigenNoMallocScope no_eigen_malloc;
+      exc::app::AllocationCounter counter;
+      exc::app::EigenNoMallocScope no_eigen_malloc;
       for (int k = 0; k < 20000; ++k) loop.cycle();
       allocations = counter.count();
     }

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "app/realtime_setup.hpp"
 #include "control/actuator_lag_compensator.hpp"
 #include "control/perf_counter.hpp"
@@ -65,9 +65,9 @@ struct Overrun {
 }  // namespace
 
 TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, trajectory, model, controller, lag compensation, plant)") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   struct Variant {
     ControllerKind kind;
     bool integral_action;
@@ -91,8 +91,8 @@ TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, 
     const int steps = kind == ControllerKind::adaptive && !variant.integral_action ? 100000 : 20000;
     std::size_t allocations = 0;
     {
-      exc::test::AllocationCounter counter;
-      exc::test::EigenNoMallocScope no_eigen_malloc;
+      exc::app::AllocationCounter counter;
+      exc::app::EigenNoMallocScope no_eigen_malloc;
       Vec4 last = Vec4::Zero();
       for (int k = 0; k < steps; ++k) {
         // Loop the 10 s dig pass so the run spends time in and out of the soil.
@@ -126,7 +126,7 @@ TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, 
 
 TEST_CASE("firmware/timing budget of the adaptive control step after real-time preparation: no page fault in the loop, CPU median < 50 us, p99 < 100 us, p99.9 < 500 us, at most 10 of 100000 steps over the 1 ms cycle, each one's time taken from the thread, not spent by its code") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   const ControllerConfig cfg;
   AdaptiveComputedTorque ctrl(model, cfg, effort_limits_of(model.machine));
   StateEstimator est(cfg.filter);

@@ -14,7 +14,7 @@ using namespace exc::control;
 namespace {
 
 Task parse(const std::string& yaml) {
-  return parse_task(YAML::Load(yaml)["task"], "scene.yaml", reference_machine());
+  return read_task(settings::Document::parse(yaml, "scene.yaml"), reference_machine());
 }
 
 // A bad task's error: scene.yaml, the field, the place where `at` begins in the yaml, the reason part.
@@ -123,14 +123,14 @@ TEST_CASE("firmware/task schema errors name the field, its line and column and t
               "is 2; allowed range [0, 0.9]");
   check_error(std::string(sim::kDigTask) + "  efforts: {check: maybe}\n", "task.efforts.check", "maybe",
               "is 'maybe'; allowed values: true, false");
-  // No task at all: named without a place (there is no node to point at).
+  // No task at all: placed at its section, the file's top, as the reader places every missing key.
   try {
     parse("other: 1");
     FAIL("no error");
   } catch (const SettingsError& e) {
     CHECK(e.file() == "scene.yaml");
     CHECK(e.field() == "task");
-    CHECK(e.line() == 0);
+    CHECK(e.line() == 1);
     CHECK(e.reason() == "missing: the firmware needs a task (type: joint_waypoints, dig, truck_loading)");
   }
 }

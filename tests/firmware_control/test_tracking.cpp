@@ -22,7 +22,7 @@ std::string mm(const Vec4& v) {
 
 TEST_CASE("firmware/dig scene: adaptive RMS error of arm and bucket at least 5x smaller than PID") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kDigTask)["task"], "dig", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   const ControllerConfig cfg;
   const sim::SoilTruth loam;  // loam, re-anchoring at S_dist, terrain at z = 0
   const auto pid = sim::run_tracking(model, task, ControllerKind::pid, cfg, loam);
@@ -47,7 +47,7 @@ TEST_CASE("firmware/dig scene: adaptive RMS error of arm and bucket at least 5x 
 
 TEST_CASE("firmware/free motion: every cylinder tracks to under 1 mm under PID and adaptive (Slotine-Li 2.5 mm)") {
   const Model model = build_model(reference_machine());
-  const Task task = parse_task(YAML::Load(sim::kFreeMotionTask)["task"], "free", model.machine);
+  const Task task = read_task(settings::Document::parse(sim::kFreeMotionTask, "free"), model.machine);
   const ControllerConfig cfg;
   sim::SoilTruth no_soil;
   no_soil.terrain_height = -100;  // never touches

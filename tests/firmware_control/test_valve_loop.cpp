@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "control/flow_position_control.hpp"
 #include "control/valve_inner_loop.hpp"
 
@@ -272,9 +272,9 @@ TEST_CASE("firmware/valve stage allocates nothing over 100000 cycles") {
   ValveLoopSettings s;
   ValveInnerLoop loop(simple_model(), s, kPeriod);
   double sink = 0;
-  exc::test::AllocationCounter counter;
+  exc::app::AllocationCounter counter;
   {
-    exc::test::EigenNoMallocScope no_malloc;
+    exc::app::EigenNoMallocScope no_malloc;
     for (int k = 0; k < 100000; ++k) {
       const double w = 1e-3 * k;
       const Vec4 pa = Vec4::Constant(5e6 + 1e6 * std::sin(w)), pb = Vec4::Constant(2e6);

@@ -38,8 +38,8 @@ Vec3 jumps(const JointTrajectory& tr, double t) {
 
 TEST_CASE("firmware/work cycles: repeat N gives N cycles joined by return moves continuous in position, velocity and acceleration") {
   const Machine m = reference_machine();
-  const Task once = parse_task(YAML::Load(sim::kFreeMotionTask)["task"], "test", m);
-  const Task three = parse_task(YAML::Load(repeated(sim::kFreeMotionTask, "  repeat: 3\n  return_time: 4\n"))["task"], "test", m);
+  const Task once = read_task(settings::Document::parse(sim::kFreeMotionTask, "test"), m);
+  const Task three = read_task(settings::Document::parse(repeated(sim::kFreeMotionTask, "  repeat: 3\n  return_time: 4\n"), "test"), m);
   REQUIRE(once.cycles() == 1);
   REQUIRE(three.cycles() == 3);
   const double length = once.end_time() - once.start_time();
@@ -85,7 +85,7 @@ task:
   times: {to_dump: 5, dump: 2, back: 5}
   repeat: 2
 )";
-  const Task t = parse_task(YAML::Load(yaml)["task"], "test", m);
+  const Task t = read_task(settings::Document::parse(yaml, "test"), m);
   REQUIRE(t.type == TaskType::truck_loading);
   REQUIRE(t.cycles() == 2);
   CHECK(t.cycle_starts[1] == doctest::Approx(10 + 5 + 2 + 5));

@@ -7,10 +7,11 @@
 
 #include "hal/can_codec.hpp"
 #include "hal/can_ports.hpp"
-#include "hal/candump_log.hpp"
+#include "candump_log.hpp"
 #include "hal/memory_bus.hpp"
 
 using namespace exc::hal;
+using namespace exc::test;
 
 TEST_CASE("hal/candump log lines parse into frames") {
   CandumpLine line;

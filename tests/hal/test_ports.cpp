@@ -6,7 +6,7 @@
 #include <cmath>
 #include <string>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "port_fixtures.hpp"
 #include "hal/can_ports.hpp"
 #include "hal/clock.hpp"
@@ -266,7 +266,7 @@ TEST_CASE("hal/ports loop survives delayed (reordered) frames") {
 }
 
 TEST_CASE("hal/ports allocate nothing over 100000 cycles of every frame on the memory bus") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   FaultInjection faults;
   faults.drop_fraction = 0.01;
   faults.corrupt_fraction = 0.01;
@@ -275,8 +275,8 @@ TEST_CASE("hal/ports allocate nothing over 100000 cycles of every frame on the m
   LoopResult r;
   std::size_t allocations = 0;
   {
-    exc::test::AllocationCounter counter;
-    exc::test::EigenNoMallocScope no_eigen_malloc;
+    exc::app::AllocationCounter counter;
+    exc::app::EigenNoMallocScope no_eigen_malloc;
     // SENS_MACHINE with all pressures, the three command sets in turn, heartbeats, faults both ways.
     r = bench.run(100000, rotating_mode, true);
     allocations = counter.count();

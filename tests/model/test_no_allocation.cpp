@@ -2,13 +2,13 @@
 // dynamics (both forms), mass matrix and bias forces, over thousands of steps.
 #include <doctest/doctest.h>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "model_fixture.hpp"
 
 using namespace exc;
 
 TEST_CASE("model/zero heap allocations in id and fd after loading") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   const Model model = build_model(reference_machine());  // start-up: may allocate
   Workspace ws(model);
   test::RandomStates rs(31);
@@ -21,8 +21,8 @@ TEST_CASE("model/zero heap allocations in id and fd after loading") {
   double checksum = 0;
   std::size_t allocations = 0;
   {
-    test::AllocationCounter counter;
-    test::EigenNoMallocScope no_eigen_malloc;
+    app::AllocationCounter counter;
+    app::EigenNoMallocScope no_eigen_malloc;
     for (int k = 0; k < 5000; ++k) {
       const auto& s = states[k % states.size()];
       Vec4 tau_a, qdd_a, h_a;

@@ -40,7 +40,7 @@ struct SceneText {
            "sensors: {" + sensors + "}\n"
            "checks: {" + checks + "}\n";
   }
-  Scene scene() const { return load_scene_from_string(yaml(), "<test>"); }
+  Scene scene() const { return read_scene(settings::Document::parse(yaml(), "<test>")); }
 };
 
 inline const char* kMethods[] = {"semi_implicit_euler", "rk4", "implicit_midpoint"};

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "model/closed_chain.hpp"
 #include "plant_scenes.hpp"
 #include "sim_plant/flow_sharing.hpp"
@@ -677,7 +677,7 @@ TEST_CASE("plant/hydraulics: parameters outside their ranges are refused naming 
 }
 
 TEST_CASE("plant/hydraulics: the hydraulic step allocates nothing (valve and pilot commands, saturation, relief, make-up)") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   plant::test::SceneText t;
   t.actuators = "fidelity: hydraulic";
   t.terrain = "height: 1.9";
@@ -688,8 +688,8 @@ TEST_CASE("plant/hydraulics: the hydraulic step allocates nothing (valve and pil
   std::size_t allocations = 0;
   int steps = 0;
   {
-    exc::test::AllocationCounter counter;
-    exc::test::EigenNoMallocScope no_eigen_malloc;
+    exc::app::AllocationCounter counter;
+    exc::app::EigenNoMallocScope no_eigen_malloc;
     for (int k = 0; k < 4000; ++k) {
       if (k % 1000 == 500) {
         c.mode = ActuatorCommand::pilot;

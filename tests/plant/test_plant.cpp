@@ -17,7 +17,7 @@
 #include <filesystem>
 #include <iterator>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "scratch_files.hpp"
 #include "plant_scenes.hpp"
 
@@ -25,7 +25,7 @@ using namespace exc;
 using namespace exc::plant;
 
 TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, formulation, fidelity, pressure method)") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   struct Config {
     const char *method, *formulation, *actuators, *integrator = "";
   };
@@ -58,8 +58,8 @@ TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, form
     std::size_t allocations = 0;
     int steps = 0;
     {
-      exc::test::AllocationCounter counter;
-      exc::test::EigenNoMallocScope no_eigen_malloc;
+      exc::app::AllocationCounter counter;
+      exc::app::EigenNoMallocScope no_eigen_malloc;
       for (int i = 0; i < 10000; ++i) {
         if (!p.step(cmd).ok()) break;
         ++steps;
@@ -79,7 +79,7 @@ TEST_CASE("plant/a failure report allocates nothing either") {
   std::size_t allocations = 0;
   PlantStatus st;
   {
-    exc::test::AllocationCounter counter;
+    exc::app::AllocationCounter counter;
     for (int i = 0; i < 3000 && st.ok(); ++i) st = p.step(cmd);
     allocations = counter.count();
   }

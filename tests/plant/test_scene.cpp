@@ -17,7 +17,7 @@ const std::string kBase = "name: t\nduration: 1\ninitial_state: {q_a: [0, 2.4626
 }  // namespace
 
 TEST_CASE("plant/scene minimal file loads with the documented defaults") {
-  const Scene s = load_scene_from_string(kBase, "ok.yaml");
+  const Scene s = read_scene(settings::Document::parse(kBase, "ok.yaml"));
   CHECK(s.name == "t");
   CHECK(s.actuators.fidelity == ActuatorFidelity::ideal);
   CHECK(s.integrator.method == IntegrationMethod::semi_implicit_euler);
@@ -84,7 +84,7 @@ TEST_CASE("plant/scene errors name the file, the line and column, the field and 
   for (const Case& c : cases) {
     CAPTURE(c.yaml);
     try {
-      load_scene_from_string(c.yaml, "bad.yaml");
+      read_scene(settings::Document::parse(c.yaml, "bad.yaml"));
       FAIL("no error");
     } catch (const SettingsError& e) {
       exc::test::check_settings_error(e, "bad.yaml", c.yaml, c.field, c.at, c.reason);
@@ -94,7 +94,7 @@ TEST_CASE("plant/scene errors name the file, the line and column, the field and 
 
 TEST_CASE("plant/scene: a file that is not YAML is named with the line where the parser stopped") {
   try {
-    load_scene_from_string(kBase + "integrator: {method: rk4\n", "bad.yaml");
+    read_scene(settings::Document::parse(kBase + "integrator: {method: rk4\n", "bad.yaml"));
     FAIL("no error");
   } catch (const SettingsError& e) {
     CHECK(e.file() == "bad.yaml");
@@ -105,7 +105,7 @@ TEST_CASE("plant/scene: a file that is not YAML is named with the line where the
 }
 
 TEST_CASE("plant/scene leaves the firmware's controller and task sections to the firmware") {
-  const Scene s = load_scene_from_string(kBase + "controller: {anything: [1, 2]}\ntask: {type: whatever, x: 1}\n", "ok.yaml");
+  const Scene s = read_scene(settings::Document::parse(kBase + "controller: {anything: [1, 2]}\ntask: {type: whatever, x: 1}\n", "ok.yaml"));
   CHECK(s.has_controller);
   CHECK(s.has_task);
   CHECK_FALSE(s.effective["controller"].IsDefined());
@@ -131,10 +131,10 @@ TEST_CASE("plant/scene shipped scenes load and their initial states assemble") {
 
 TEST_CASE("plant/scene accepts a run of a working shift (duration 28800 s) and refuses one second more, naming the field and the range") {
   const std::string task = "initial_state: {q_a: [0, 2.4626, 2.3231, 2.1447]}\n";
-  CHECK(load_scene_from_string("name: t\nduration: 28800\n" + task, "ok.yaml").duration == 28800);
+  CHECK(read_scene(settings::Document::parse("name: t\nduration: 28800\n" + task, "ok.yaml")).duration == 28800);
   const std::string yaml = "name: t\nduration: 28801\n" + task;
   try {
-    load_scene_from_string(yaml, "bad.yaml");
+    read_scene(settings::Document::parse(yaml, "bad.yaml"));
     FAIL("no error");
   } catch (const SettingsError& e) {
     exc::test::check_settings_error(e, "bad.yaml", yaml, "duration", "28801", "is 28801 s; allowed range [0.001, 28800] s");

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "matplotlib_probe.hpp"
 #include "png_size.hpp"
@@ -182,4 +183,35 @@ print("view_zero_in_envelope=%d" % (np.count_nonzero(lo == 0) + np.count_nonzero
   CHECK(v.at("view_first_bucket_nan") == 1);
   CHECK(v.at("view_nan_buckets") == 1);
   CHECK(v.at("view_zero_in_envelope") == 0);
+}
+
+TEST_CASE("tools/excavator-sim: a helper's output (plot-run's line) follows the table it ran after, never inside it, with stdout a file") {
+  // stdout to a file is block-buffered: plot-run, started while part of the table was still in
+  // excavator-sim's buffer, printed its line above or inside the table.
+  const std::string scenes = std::string(EXC_SOURCE_DIR) + "/scenes/";
+  const std::string paper = "paper --free-motion " + scenes + "paper_free_motion.yaml --dig " + scenes + "paper_dig.yaml --hydraulic-dig " +
+                            exc::test::kDig + " --duration 0.2 --out paper";
+  for (const std::string& job : {"run " + exc::test::kDig + " --duration 0.2 --out run", paper}) {
+    CAPTURE(job);
+    const Run r = run_sim(job + " --quiet");
+    REQUIRE_MESSAGE(r.status == 0, r.err);
+    std::istringstream out(r.out);
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(out, line);) lines.push_back(line);
+    int helpers = 0, tables = 0;
+    for (std::size_t i = 0; i < lines.size(); ++i) {
+      if (lines[i].rfind("scene ", 0) == 0) ++tables;
+      if (lines[i].rfind("plot-run: ", 0) != 0) continue;
+      ++helpers;
+      INFO(r.out);
+      // After every line of its scene's table (the runs' lines, then the hydraulics'), before "report: ".
+      REQUIRE(i > 0);
+      REQUIRE(i + 1 < lines.size());
+      CHECK(lines[i + 1].rfind("report: ", 0) == 0);
+      CHECK((lines[i - 1].find("heap allocations in loop") != std::string::npos ||
+             lines[i - 1].find("hydraulics: chamber pressures") != std::string::npos));
+    }
+    CHECK(helpers == tables);  // one report per scene
+    CHECK(tables >= 1);
+  }
 }

@@ -24,7 +24,7 @@
 #include <string>
 #include <thread>
 
-#include "allocation_counter.hpp"
+#include "app/allocation_counter.hpp"
 #include "exlcm/can_stats_t.hpp"
 #include "exlcm/command_t.hpp"
 #include "exlcm/controller_state_t.hpp"
@@ -410,7 +410,7 @@ TEST_CASE("telemetry/udpm with lcm-logger records 10 s of 1 kHz telemetry, all i
 }
 
 TEST_CASE("telemetry/publish allocates nothing over 100000 messages of every type") {
-  REQUIRE(exc::test::allocation_counting_works());
+  REQUIRE(exc::app::allocation_counting_works());
   const fs::path log_path = temp_path("no-alloc.lcm");
   TelemetryConfig config;
   config.lcm_url = "file://" + log_path.string() + "?mode=w";
@@ -423,8 +423,8 @@ TEST_CASE("telemetry/publish allocates nothing over 100000 messages of every typ
   fault.text[0] = 'x';
   std::size_t allocations = 0;
   {
-    exc::test::EigenNoMallocScope no_eigen_malloc;
-    exc::test::AllocationCounter counter;
+    exc::app::EigenNoMallocScope no_eigen_malloc;
+    exc::app::AllocationCounter counter;
     for (std::int64_t k = 0; k < 100000; ++k) {
       switch (k % 6) {
         case 0: publisher.publish(Channel::state, state_at(k)); break;

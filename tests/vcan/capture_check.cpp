@@ -4,7 +4,7 @@
 
 #include "hal/can_codec.hpp"
 #include "hal/can_protocol.hpp"
-#include "hal/candump_log.hpp"
+#include "candump_log.hpp"
 
 namespace exc::vcan {
 
@@ -38,6 +38,8 @@ struct Accepted {
 
 CaptureReport check_capture(std::istream& in, const std::string& interface_name) {
   using namespace exc::hal;
+  using exc::test::CandumpLine;
+  using exc::test::parse_candump_line;
   CaptureReport report;
   bool have_sync = false;
   std::uint8_t sync_counter = 0;

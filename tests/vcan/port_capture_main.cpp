@@ -16,10 +16,11 @@
 #include <vector>
 
 #include "hal/can_ports.hpp"
-#include "hal/candump_log.hpp"
+#include "candump_log.hpp"
 #include "hal/memory_bus.hpp"
 
 using namespace exc::hal;
+using namespace exc::test;
 
 namespace {
 

@@ -10,10 +10,11 @@
 
 #include "capture_check.hpp"
 #include "hal/can_ports.hpp"
-#include "hal/candump_log.hpp"
+#include "candump_log.hpp"
 #include "hal/memory_bus.hpp"
 
 using namespace exc::hal;
+using namespace exc::test;
 
 namespace {
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "hal/candump_log.hpp"
+#include "candump_log.hpp"
 #include "text_file.hpp"
 
 namespace fs = std::filesystem;
@@ -154,9 +154,9 @@ TEST_CASE("vcan/vcan-vm passes output and status and directory and environment a
   std::int64_t last_ns = 0;
   for (std::size_t i = 0; i < sent.size(); ++i) {
     CAPTURE(captured[i]);
-    exc::hal::CandumpLine line;
+    exc::test::CandumpLine line;
     std::string error;
-    REQUIRE_MESSAGE(exc::hal::parse_candump_line(captured[i], line, error), error);
+    REQUIRE_MESSAGE(exc::test::parse_candump_line(captured[i], line, error), error);
     CHECK(line.interface_name == "vcan0");
     CHECK(line.frame.timestamp_ns >= last_ns);
     last_ns = line.frame.timestamp_ns;

@@ -27,6 +27,8 @@
 #include "mujoco_peer.hpp"
 #endif
 #include "sim_plant/plant.hpp"
+#include "helper_program.hpp"
+#include "option_checks.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -229,9 +231,10 @@ int run_bench(const Options& o) {
     complete = false;
   }
   if (o.plots) {
-    const std::string cmd = std::string("/usr/bin/python3 '") + EXC_BENCH_PLOT_SCRIPT + "' '" + o.out + "'";
-    if (std::system(cmd.c_str()) != 0) {
-      std::fprintf(stderr, "excavator-bench: the plotting script failed (%s); the CSV files are complete\n", cmd.c_str());
+    const std::vector<std::string> cmd = {"/usr/bin/python3", EXC_BENCH_PLOT_SCRIPT, o.out};
+    if (exc::output::run_helper(cmd) != 0) {
+      std::fprintf(stderr, "excavator-bench: the plotting script failed (%s); the CSV files are complete\n",
+                   exc::output::command_text(cmd).c_str());
       complete = false;
     }
   }
@@ -299,7 +302,7 @@ int main(int argc, char** argv) {
   exp->add_option("--q-a", q_a, "assemble at q_a = swing L_boom L_arm L_bucket (default: the first reference pose)")
       ->expected(4);
   app.require_subcommand(0, 1);
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
   o.plots = !no_plots;
   try {
     if (exp->parsed()) return exc::bench::export_command(machine_file, xml_out, q_a);

@@ -13,6 +13,7 @@
 #include "harness/lockstep_run.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
+#include "sweep_knobs.hpp"
 
 namespace exc::bench {
 
@@ -36,9 +37,12 @@ int cycles_per_hold(double cycle) { return static_cast<int>(std::lround(kProfile
 }  // namespace
 
 BenchScene load_bench_scene(const std::string& path, double start, double horizon) {
-  BenchScene b;
   // One reading of the file: the plant's sections and the firmware's (its task and controller).
-  const sim::SceneBundle bundle = sim::load_scene_bundle(path);
+  return bench_scene(sim::load_scene_bundle(path), start, horizon);
+}
+
+BenchScene bench_scene(const sim::SceneBundle& bundle, double start, double horizon) {
+  BenchScene b;
   b.scene = bundle.scene;
   b.task = bundle.firmware.task;
   b.controller = bundle.firmware.controller;
@@ -76,11 +80,9 @@ OpenLoopResult run_open_loop(const BenchScene& s, const EffortProfile& profile, 
   plant::Scene scene = s.scene;
   scene.integrator = settings.integrator;
   const double h = settings.integrator.step;
-  scene.cycle = h > 1e-3 ? h : 1e-3;
+  scene.cycle = sim::open_loop_cycle(h);
   scene.q_a0 = profile.q_a0;
   scene.qd_a0 = profile.qd_a0;
-  scene.soil.stiffness *= settings.soil_stiffness_scale;
-  scene.soil.damping *= std::sqrt(settings.soil_stiffness_scale);  // keeps the soil's damping ratio
   scene.checks.constraint_tolerance = settings.constraint_tolerance;
   if (!settings.plant_energy_check) {
     scene.checks.energy_tolerance = 1e12;
@@ -160,16 +162,10 @@ void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorP
   if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
 }
 
-app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene, double model_mass_error) {
-  // The firmware's model: the full machine, with its masses off by the given error.
-  Machine fw_machine = s.scene.machine;
-  for (BodyInertia& b : fw_machine.bodies) {
-    b.mass *= 1 + model_mass_error;
-    b.inertia *= 1 + model_mass_error;
-  }
+app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene) {
   app::FirmwareSettings fw;
   fw.name = s.name;
-  fw.machine = fw_machine;
+  fw.machine = s.scene.machine;  // the firmware's model: the full machine
   fw.task = s.task;
   fw.terrain = scene.terrain;
   fw.duration = scene.duration;
@@ -193,24 +189,16 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
       scene.machine.bodies[k].mass *= 1e-3;
       scene.machine.bodies[k].inertia *= 1e-3;
     }
-  scene.sensors.position_noise = Vec4::Constant(v.position_noise);
-  scene.sensors.latency_cycles = v.delay_cycles;
+  // The chart compares models of the machine, not sensors: no position noise, no latency.
+  scene.sensors.position_noise.setZero();
+  scene.sensors.latency_cycles = 0;
   // The dig scene's file leaves the initial state to the task: start where the task starts.
   Vec4 q0, qd0, qdd0;
   s.task.trajectory.evaluate(s.task.start_time(), q0, qd0, qdd0);
   scene.q_a0 = q0;
   scene.qd_a0 = qd0;
 
-  app::FirmwareSettings fw = bench_firmware(s, scene, v.model_mass_error);
-  control::ControllerConfig& cc = fw.controller;
-  const double g = v.gain_scale;
-  cc.gains.kp *= g * g;
-  cc.gains.kv *= g;
-  cc.gains.ki *= g * g * g;
-  cc.sl_lambda *= g;
-  cc.sl_kd *= g;
-  cc.adaptation_rate *= v.adaptation_scale;
-  cc.sl_adaptation_rate *= v.adaptation_scale;
+  const app::FirmwareSettings fw = bench_firmware(s, scene);
 
   ClosedLoopResult r;
   const int per_hold = cycles_per_hold(scene.cycle);

@@ -12,6 +12,7 @@
 #include "app/firmware_settings.hpp"
 #include "control/controller_config.hpp"
 #include "control/task.hpp"
+#include "harness/scene_source.hpp"
 #include "sim_plant/scene.hpp"
 
 namespace exc::bench {
@@ -28,6 +29,8 @@ struct BenchScene {
 };
 
 BenchScene load_bench_scene(const std::string& path, double start, double horizon);
+// The same from a scene already read.
+BenchScene bench_scene(const sim::SceneBundle& scene, double start, double horizon);
 
 // Efforts tau_a held over kProfileHold: the inverse dynamics of the closed chain (eq. 16b) along the
 // task's desired trajectory, no soil. Every step size of the charts divides kProfileHold.
@@ -42,7 +45,6 @@ EffortProfile effort_profile(const BenchScene& s, double speed = 1.0);
 
 struct OpenLoopSettings {
   plant::IntegratorSettings integrator;
-  double soil_stiffness_scale = 1.0;   // K_t and B_t multiplied (stability map)
   double constraint_tolerance = 1e-2;  // m: wide, so the chart shows the residual growing
   // false (work-precision chart): the energy-balance check is widened as well, because the energy
   // drift is one of the chart's measured errors; the stability maps keep the plant's own settings.
@@ -75,11 +77,6 @@ struct ClosedLoopVariant {
   bool soil = true;                 // false: soil removed from the scene
   bool dry_friction_and_leakage = true;  // false: the hydraulic machine with viscous friction only (the old plant)
   bool massless_cylinders = false;  // cylinder bodies at 1e-3 of their mass (earlier works' model)
-  double gain_scale = 1.0;          // omega_n of the error dynamics multiplied (kp x s^2, kv x s, ki x s^3)
-  double adaptation_scale = 1.0;    // adaptation rates multiplied
-  double position_noise = 0;        // sensor noise standard deviation: m on the cylinders, rad on the swing
-  int delay_cycles = 0;             // sensor latency
-  double model_mass_error = 0;      // relative: the controller's model has masses x (1 + error)
   double duration = 0;              // s; 0: the scene's
 };
 
@@ -98,8 +95,8 @@ struct ClosedLoopResult {
 void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators);
 
 // The firmware's settings for a closed-loop run of `scene` (the plant's side of s, changed): the
-// bench scene's task and controller set for the scene's actuators, its model's masses x (1 + error).
-app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene, double model_mass_error = 0);
+// bench scene's task and controller set for the scene's actuators, its model the full machine.
+app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene);
 
 ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v);
 

@@ -211,9 +211,12 @@ def peer(out):
 
 
 def main():
-    if len(sys.argv) != 2 or sys.argv[1] in ("-h", "--help"):
+    if sys.argv[1:] in (["-h"], ["--help"]):
         print(__doc__.strip())
-        return 0 if len(sys.argv) == 2 else 2
+        return 0
+    if len(sys.argv) != 2 or sys.argv[1].startswith("-"):
+        print(__doc__.strip(), file=sys.stderr)
+        return 2
     out = sys.argv[1]
     for chart in (work_precision, pressure_integration, fidelity, stability, peer):
         chart(out)

@@ -20,38 +20,35 @@ using sim::SweepCase;
 using sim::SweepSpec;
 using sim::SweepValue;
 
-// The open loop as a sweep's run: the case's integrator, soil and task speed; with a search over the
-// step, the first step (largest first) at which the plant's own checks pass.
+// The open loop as a sweep's run: the case's scene (its integrator, soil, ... as its knobs set them,
+// read by the scene's readers) under the task's effort profile at the case's speed; with a search over
+// the step, the first step (largest first) at which the plant's own checks pass.
 json run_open_loop_case(const SweepSpec& spec, const SweepCase& c) {
-  static std::map<std::string, BenchScene> scenes;
-  static std::map<std::pair<std::string, double>, EffortProfile> profiles;
-  const std::string& path = spec.scenes[static_cast<std::size_t>(c.scene)];
-  auto it = scenes.find(path);
-  if (it == scenes.end()) it = scenes.emplace(path, load_bench_scene(path, spec.window_start, spec.window_horizon)).first;
-  const BenchScene& s = it->second;
+  // A profile per scene, window and speed (computed once: the inverse dynamics along the task).
+  static std::map<std::tuple<std::string, double, double, double>, EffortProfile> profiles;
+  const std::size_t scene = static_cast<std::size_t>(c.scene);
+  const BenchScene nominal = bench_scene(spec.sources[scene]->nominal, spec.window_start, spec.window_horizon);
   const double speed = c.value("profile.speed") ? c.value("profile.speed")->number : 1.0;
-  auto p = profiles.find({path, speed});
-  if (p == profiles.end()) p = profiles.emplace(std::make_pair(path, speed), effort_profile(s, speed)).first;
-  OpenLoopSettings st;
-  const std::string name = c.value("integrator") ? c.value("integrator")->name : method_name(s.scene.integrator.method, s.scene.integrator.formulation);
-  st.integrator = s.scene.integrator;
-  st.integrator.method = *plant::kIntegrationMethods.named(name.substr(0, name.find('/')));
-  st.integrator.formulation = *plant::kFormulations.named(name.substr(name.find('/') + 1));
-  const double base_k = s.scene.soil.stiffness.x() > 0 ? s.scene.soil.stiffness.x() : 7e4;
-  if (c.value("soil.stiffness")) st.soil_stiffness_scale = c.value("soil.stiffness")->number / base_k;
-  st.constraint_tolerance = 1e-4;  // the plant's default check
-  std::vector<SweepValue> steps = spec.search.values;
-  if (spec.search.knob.empty()) steps = {c.value("integrator.step") ? *c.value("integrator.step") : SweepValue{}};
-  if (spec.search.knob.empty() && !c.value("integrator.step")) steps.front().number = s.scene.integrator.step;
+  const auto key = std::make_tuple(spec.scenes[scene], spec.window_start, spec.window_horizon, speed);
+  auto p = profiles.find(key);
+  if (p == profiles.end()) p = profiles.emplace(key, effort_profile(nominal, speed)).first;
+  const auto run_with = [&](const sim::SweepSetting* searched) {
+    const BenchScene s = bench_scene(sim::case_bundle(spec, c, searched), spec.window_start, spec.window_horizon);
+    OpenLoopSettings st;
+    st.integrator = s.scene.integrator;
+    st.constraint_tolerance = 1e-4;  // the plant's default check
+    return std::make_pair(run_open_loop(s, p->second, st), s.scene.integrator.step);
+  };
   json run = {{"ok", false}, {"search_value", nullptr}};
-  for (const SweepValue& h : steps) {
-    st.integrator.step = h.number;
-    const OpenLoopResult r = run_open_loop(s, p->second, st);
+  const std::size_t tries = spec.search.knob.empty() ? 1 : spec.search.values.size();
+  for (std::size_t i = 0; i < tries; ++i) {
+    const sim::SweepSetting searched{spec.search.knob, spec.search.knob.empty() ? SweepValue{} : spec.search.values[i]};
+    const auto [r, step] = run_with(spec.search.knob.empty() ? nullptr : &searched);
     if (r.ok) {
       if (run.contains("failure")) run["failure_before"] = run["failure"];
       run.erase("failure");
       run["ok"] = true;
-      run["search_value"] = h.number;
+      run["search_value"] = step;
       break;
     }
     run["failure"] = r.failure;
@@ -79,9 +76,10 @@ std::vector<json> run_spec(const SweepSpec& spec, const std::string& out, const 
 
 // A spec of sweeps_dir with its scenes taken from scenes_dir (same file names).
 SweepSpec load_spec(const std::string& sweeps_dir, const std::string& name, const std::string& scenes_dir) {
-  SweepSpec spec = sim::load_sweep_spec(sweeps_dir + "/" + name);
-  for (std::string& s : spec.scenes) s = (fs::path(scenes_dir) / fs::path(s).filename()).string();
-  return spec;
+  return sim::load_sweep_spec(sweeps_dir + "/" + name, [&scenes_dir](std::vector<std::string> scenes) {
+    for (std::string& s : scenes) s = (fs::path(scenes_dir) / fs::path(s).filename()).string();
+    return scenes;
+  });
 }
 
 // The CI cut: each axis named here keeps only these values.

@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
       ->check(exc::cli::number_in({0, 1}, ""));
   app.add_flag("--print-config", print_config,
                "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
   if (!print_config && iface.empty()) {
     std::cerr << "excavator-firmware: --can is required\n";
     return 2;

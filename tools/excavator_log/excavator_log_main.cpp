@@ -13,6 +13,8 @@
 
 #include "log_export.hpp"
 #include "output_file.hpp"
+#include "helper_program.hpp"
+#include "option_checks.hpp"
 
 namespace {
 
@@ -59,19 +61,6 @@ std::string plot_run_program() {
   if (std::filesystem::exists(EXC_PLOT_RUN)) return EXC_PLOT_RUN;
 #endif
   return "plot-run";
-}
-
-// Single quotes for the shell, so that paths with spaces survive.
-std::string shell_quoted(const std::string& text) {
-  std::string quoted = "'";
-  for (const char c : text) {
-    if (c == '\'') {
-      quoted += "'\\''";
-    } else {
-      quoted += c;
-    }
-  }
-  return quoted + "'";
 }
 
 }  // namespace
@@ -122,7 +111,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(10, 100000));
   }
 
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   exc::log::LogSummary summary;
   std::string error;
@@ -142,12 +131,10 @@ int main(int argc, char** argv) {
       return 1;
     }
     warn_unread(report_log, summary);
-    std::string command = shell_quoted(plot_run_program()) + " " + shell_quoted(csv) + " --out " +
-                          shell_quoted(report_dir) + " --title " + shell_quoted(title);
-    if (!summary_json.empty()) command += " --summary " + shell_quoted(summary_json);
-    const int status = std::system(command.c_str());
-    if (status != 0) {
-      std::fprintf(stderr, "excavator-log: plot-run failed (%s)\n", command.c_str());
+    std::vector<std::string> command = {plot_run_program(), csv, "--out", report_dir, "--title", title};
+    if (!summary_json.empty()) command.insert(command.end(), {"--summary", summary_json});
+    if (exc::output::run_helper(command) != 0) {
+      std::fprintf(stderr, "excavator-log: plot-run failed (%s)\n", exc::output::command_text(command).c_str());
       return 1;
     }
     return 0;

@@ -17,6 +17,7 @@
 #include "model/closed_chain.hpp"
 #include "model/forward_dynamics.hpp"
 #include "output_file.hpp"
+#include "option_checks.hpp"
 
 namespace {
 
@@ -83,12 +84,7 @@ int main(int argc, char** argv) {
   app.add_subcommand("fk", "q_a (4 numbers) -> tip x y z in the world (m), boom, arm, bucket angles (deg)");
   app.add_subcommand("id", "q_a qd_a qdd_a (12 numbers) -> tau_a (4): inverse dynamics");
   app.add_subcommand("fd", "q_a qd_a tau_a (12 numbers) -> qdd_a (4): forward dynamics");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int rc = app.exit(e);
-    return rc == 0 ? 0 : kBadInput;
-  }
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
   const std::string mode = app.get_subcommands().front()->get_name();
 
   exc::Machine machine;

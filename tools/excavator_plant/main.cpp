@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
   app.add_flag("--realtime", realtime,
                "the firmware runs --realtime: a full telemetry ring drops and counts messages instead of "
                "delaying the answer to SYNC past the firmware's deadline (default: wait, lose nothing)");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   try {
     exc::plant::Plant plant(exc::plant::load_scene(scene_path));

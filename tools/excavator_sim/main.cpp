@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
                 "(the machine as an absolute path); it loads back to the same run");
   std::string config_scene;
   config->add_option("scene", config_scene, "scene file (YAML), e.g. scenes/dig.yaml")->required();
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   if (config->parsed()) {
     try {
@@ -181,13 +181,14 @@ int main(int argc, char** argv) {
 
   if (robust->parsed()) {
     try {
-      exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(robust_spec);
-      if (!robust_scene.empty()) spec.scenes = {robust_scene};
+      exc::sim::SweepSpec spec = exc::sim::load_sweep_spec(robust_spec, [&](const std::vector<std::string>& listed) {
+        return robust_scene.empty() ? listed : std::vector<std::string>{robust_scene};
+      });
       exc::sim::RunOptions options;
       options.controllers = robust_controllers.empty() ? spec.controllers : robust_controllers;
       options.duration_override = robust_duration;
       options.progress = !robust_quiet;
-      const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(spec.scenes.front());
+      const exc::sim::SceneBundle& bundle = spec.sources.front()->nominal;
       // Both output files are opened before the variants run: a path that cannot be written costs no run time.
       if (robust_out.empty()) robust_out = (fs::path("out") / (bundle.name + "-robustness")).string();
       fs::create_directories(robust_out);

@@ -32,14 +32,12 @@ bool pid_over_adaptive(const Summary& s, double& arm, double& bucket) {
 std::vector<RobustnessRow> run_robustness(const SweepSpec& spec, const RunOptions& options) {
   check_controller_names(options.controllers);
   std::vector<RobustnessRow> rows;
-  std::vector<SceneBundle> scenes;
-  for (const std::string& path : spec.scenes) scenes.push_back(load_scene_bundle(path));
   SweepSpec s = spec;
   s.duration = options.duration_override;
   const int total = s.total_cases();
   for (int id = 0; id < total; ++id) {
     const SweepCase c = sweep_case(s, id);
-    const SceneBundle& bundle = scenes[static_cast<std::size_t>(c.scene)];
+    const SceneBundle& bundle = s.sources[static_cast<std::size_t>(c.scene)]->nominal;
     RobustnessRow row;
     row.variant = std::to_string(id);
     if (c.variant >= 0) {
@@ -55,7 +53,7 @@ std::vector<RobustnessRow> run_robustness(const SweepSpec& spec, const RunOption
       if (!control::kControllerKinds.named(name))
         throw std::invalid_argument("--controller: unknown controller '" + name + "' (allowed: " +
                                     control::kControllerKinds.names() + ")");
-      row.summary.runs.push_back(run_sweep_case(bundle, s, c, name));
+      row.summary.runs.push_back(run_sweep_case(s, c, name));
       row.summary.all_ok = row.summary.all_ok && row.summary.runs.back().ok;
     }
     rows.push_back(row);

@@ -1,12 +1,11 @@
 #include "run_report.hpp"
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <cstdarg>
 #include <cstdio>
 #include <string>
 #include <vector>
+
+#include "helper_program.hpp"
 
 namespace exc::sim {
 namespace {
@@ -178,35 +177,14 @@ nlohmann::json to_json(const Summary& summary) {
   return j;
 }
 
-namespace {
-
-// fork + exec + wait: the program's exit status, 127 if it could not run, 128 if it was killed.
-int run_program(const std::vector<std::string>& argv) {
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  const pid_t pid = fork();
-  if (pid < 0) return 127;
-  if (pid == 0) {
-    execv(args[0], args.data());
-    std::fprintf(stderr, "excavator-sim: cannot run %s\n", args[0]);
-    _exit(127);
-  }
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return 127;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128;
-}
-
-}  // namespace
-
 int write_report(const std::filesystem::path& log, const std::filesystem::path& out_dir,
                  const std::filesystem::path& summary_json, const std::string& title) {
-  return run_program({EXC_LOG_TOOL, "report", log.string(), "--out", (out_dir / "report").string(),
-                      "--summary", summary_json.string(), "--title", title});
+  return output::run_helper({EXC_LOG_TOOL, "report", log.string(), "--out", (out_dir / "report").string(), "--summary",
+                             summary_json.string(), "--title", title});
 }
 
 int plot_robustness(const std::filesystem::path& json, const std::filesystem::path& out_dir) {
-  return run_program({EXC_PLOT_RUN, "--robustness", json.string(), "--out", out_dir.string()});
+  return output::run_helper({EXC_PLOT_RUN, "--robustness", json.string(), "--out", out_dir.string()});
 }
 
 }  // namespace exc::sim

@@ -6,100 +6,161 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <fstream>
 #include <random>
+#include <set>
 #include <stdexcept>
 
 #include "settings/section_reader.hpp"
 #include "control/controller_kinds.hpp"
-#include "model/machine.hpp"
-#include "model/scene_common.hpp"
 #include "fault_campaign.hpp"
+#include "sweep_knobs.hpp"
 #include "sweep_tables.hpp"
 
 namespace exc::sim {
 namespace {
 
+using settings::Declaration;
+using settings::format_number;
 using settings::Need;
 using settings::SectionReader;
 
-void read_range(SectionReader& p, const char* key, SweepRange& r, settings::Bounds bounds, const char* what) {
-  if (!p.given(key)) return;
-  std::array<double, 2> v{};
-  p.numbers(key, v, bounds, "", what);
-  if (v[1] < v[0]) p.fail(key, "max " + settings::format_number(v[1]) + " is below min " + settings::format_number(v[0]));
-  r = SweepRange{true, v[0], v[1]};
+[[noreturn]] void fail_at(const SectionReader& r, const std::string& key, long index, const std::string& why) {
+  if (index >= 0) r.fail(key, static_cast<std::size_t>(index), why);
+  r.fail(key, why);
 }
 
-double draw(std::mt19937_64& rng, const SweepRange& r, double fallback) {
-  if (!r.given) return fallback;
-  return r.min + (r.max - r.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+// "a whole number in [0, 63]", "a number in [0, 0.1]" (element's bounds), with the unit.
+std::string allowed(const Declaration& d, int element) {
+  const settings::Bounds& b = d.bounds_of(element);
+  return std::string(d.type == Declaration::Type::whole ? "a whole number" : "a number") + " in [" + format_number(b.lo) +
+         ", " + format_number(b.hi) + "]" + (d.unit.empty() ? "" : " " + d.unit);
 }
 
-// One value of a knob from its node: a number, four numbers where the knob takes one per joint, or a
-// name where it takes names; range-checked. Errors at the key (index >= 0: at the list's element).
-SweepValue read_value(const SectionReader& r, const std::string& key, long index, const YAML::Node& n, const KnobInfo& k) {
-  auto fail = [&](const std::string& why) {
-    if (index >= 0) r.fail(key, static_cast<std::size_t>(index), why);
-    r.fail(key, why);
-  };
-  const std::string range = "in " + settings::format_number(k.lo) + ".." + settings::format_number(k.hi);
-  auto checked = [&](double x) {
-    if (x < k.lo || x > k.hi) fail("is " + settings::format_number(x) + "; must be " + range + " (" + k.what + ")");
-    return x;
-  };
+// One value of a knob from its node, as its declaration takes it: a name for an enumeration (its
+// readers check it), a number (a whole one where the setting is whole), for a setting that takes a
+// list of numbers either that many or one for every element; each number within its range. Errors at
+// the key (index >= 0: at the list's element), naming the range and the setting.
+SweepValue read_value(const SectionReader& r, const std::string& key, long index, const YAML::Node& n, const Declaration& d) {
+  const std::string about = " (" + d.field + (d.what.empty() ? "" : ": " + d.what) + ")";
   SweepValue v;
-  if (n.IsSequence() && k.joints) {
-    if (n.size() != 4) fail("must be one number or four (swing, boom, arm, bucket)");
-    v.type = SweepValue::Type::joints;
-    for (std::size_t j = 0; j < 4; ++j) {
-      double x = 0;
-      if (!settings::finite_number(n[j], x)) fail("must be four numbers " + range);
-      v.joints[j] = checked(x);
-    }
-    return v;
-  }
-  if (!n.IsScalar()) fail(std::string("must be ") + (k.names ? "a name" : "a number " + range) + " (" + k.what + ")");
-  if (k.names) {
-    if (!k.names(n.Scalar())) fail("is '" + n.Scalar() + "'; " + k.what);
+  if (d.type == Declaration::Type::choice) {
+    if (!n.IsScalar()) fail_at(r, key, index, "must be a name" + about);
     v.type = SweepValue::Type::name;
     v.name = n.Scalar();
     return v;
   }
-  if (!settings::finite_number(n, v.number)) fail("is '" + n.Scalar() + "'; must be a number " + range + " (" + k.what + ")");
-  checked(v.number);
+  const auto number = [&](const YAML::Node& x, int first, int last) {
+    double value = 0;
+    if (!settings::finite_number(x, value))
+      fail_at(r, key, index, "is '" + (x.IsScalar() ? x.Scalar() : std::string("not a scalar")) + "'; must be " +
+                                 allowed(d, first) + about);
+    for (int e = first; e <= last; ++e) {
+      const settings::Bounds& b = d.bounds_of(e);
+      if (value < b.lo || value > b.hi || (d.type == Declaration::Type::whole && value != std::floor(value)))
+        fail_at(r, key, index, "is " + format_number(value) + "; allowed: " + allowed(d, e) + about);
+    }
+    return value;
+  };
+  const bool list = d.type == Declaration::Type::numbers;
+  if (n.IsSequence() && list) {
+    if (static_cast<int>(n.size()) != d.count)
+      fail_at(r, key, index, "must be one number or " + std::to_string(d.count) + " of them" + about);
+    v.type = SweepValue::Type::list;
+    for (int e = 0; e < d.count; ++e) v.list.push_back(number(n[static_cast<std::size_t>(e)], e, e));
+    return v;
+  }
+  if (!n.IsScalar())
+    fail_at(r, key, index, "must be " + (list ? "one number or " + std::to_string(d.count) : std::string("a number")) + about);
+  v.number = number(n, 0, list ? d.count - 1 : 0);
   return v;
 }
 
-// The knobs given in a mapping (a grid, the search): each a list of values.
-std::vector<SweepAxis> read_axes(SectionReader& r, const YAML::Node& node, SweepRun run) {
-  std::vector<SweepAxis> axes;
-  for (const KnobInfo& k : knob_table(run)) {
-    if (!r.given(k.name)) continue;
-    const YAML::Node list = node[k.name];
-    if (!list.IsSequence() || list.size() == 0) r.fail(k.name, "must be a list of values (" + std::string(k.what) + ")");
-    SweepAxis a{k.name, {}};
-    for (std::size_t i = 0; i < list.size(); ++i) a.values.push_back(read_value(r, k.name, static_cast<long>(i), list[i], k));
-    axes.push_back(a);
+// Reads a spec's knobs and values, each value read by the scenes' readers once.
+class KnobReader {
+ public:
+  explicit KnobReader(const SweepSpec& spec) : spec_(spec) {}
+
+  // What the knob at `key` takes, the same in every scene (an error at the key otherwise).
+  Declaration values(SectionReader& r, const std::string& key) {
+    r.given(key.c_str());  // declared (and refused when it has no value)
+    Declaration first;
+    for (std::size_t i = 0; i < spec_.sources.size(); ++i) {
+      try {
+        const Declaration d = knob_values(spec_.run, key, *spec_.sources[i]);
+        if (i == 0) first = d;
+      } catch (const std::invalid_argument& e) {
+        r.fail(key, e.what());
+      }
+    }
+    return first;
   }
-  r.finish();
-  return axes;
-}
+
+  // A value, read as the scenes' readers read it with the value set.
+  SweepValue value(const SectionReader& r, const std::string& key, long index, const YAML::Node& n, const Declaration& d) {
+    const SweepValue v = read_value(r, key, index, n, d);
+    if (!checked_.insert(key + "=" + v.text()).second) return v;
+    for (const std::shared_ptr<const SceneSource>& scene : spec_.sources) {
+      try {
+        SceneChanges changes(*scene);
+        set_knob(spec_.run, key, v, changes);
+        (void)changes.read();
+      } catch (const std::exception& e) {
+        fail_at(r, key, index, "is " + v.text() + ", refused by the scene: " + e.what());
+      }
+    }
+    return v;
+  }
+
+  // The knobs given in a mapping (a grid, the search), each a list of values, in the mapping's order.
+  std::vector<SweepAxis> axes(SectionReader& r, const YAML::Node& node) {
+    std::vector<SweepAxis> axes;
+    for (const auto& kv : node) {
+      const std::string knob = kv.first.Scalar();
+      const Declaration d = values(r, knob);
+      const YAML::Node list = kv.second;
+      if (!list.IsSequence() || list.size() == 0) r.fail(knob, "must be a list of values (" + d.field + ")");
+      SweepAxis a{knob, {}};
+      for (std::size_t i = 0; i < list.size(); ++i) a.values.push_back(value(r, knob, static_cast<long>(i), list[i], d));
+      axes.push_back(a);
+    }
+    r.finish();
+    return axes;
+  }
+
+  // Perturbations: each knob drawn in [min, max].
+  void draws(SectionReader& p, const YAML::Node& node, std::vector<SweepDraw>& out) {
+    for (const auto& kv : node) {
+      const std::string knob = kv.first.Scalar();
+      const Declaration d = values(p, knob);
+      if (d.type == Declaration::Type::choice) p.fail(knob, "takes a name: it cannot be drawn");
+      const YAML::Node range = kv.second;
+      if (!range.IsSequence() || range.size() != 2 || !range[0].IsScalar() || !range[1].IsScalar())
+        p.fail(knob, "must be [min, max], each " + allowed(d, 0) + " (" + d.field + ")");
+      const double min = value(p, knob, 0, range[0], d).number, max = value(p, knob, 1, range[1], d).number;
+      if (max < min) p.fail(knob, "max " + format_number(max) + " is below min " + format_number(min));
+      out.push_back(SweepDraw{knob, min, max, d.type == Declaration::Type::whole});
+    }
+  }
+
+ private:
+  const SweepSpec& spec_;
+  std::set<std::string> checked_;  // knob=value pairs already read by the scenes
+};
 
 }  // namespace
 
 std::string SweepValue::text() const {
   if (type == Type::name) return name;
-  if (type == Type::number) return settings::format_number(number);
+  if (type == Type::number) return format_number(number);
   std::string s;
-  for (double x : joints) s += (s.empty() ? "" : " ") + settings::format_number(x);
+  for (double x : list) s += (s.empty() ? "" : " ") + format_number(x);
   return s;
 }
 
 nlohmann::json SweepValue::to_json() const {
   if (type == Type::name) return name;
   if (type == Type::number) return number;
-  return joints;
+  return list;
 }
 
 namespace {
@@ -122,6 +183,10 @@ int SweepSpec::total_cases() const {
 }
 
 bool SweepSpec::records(const std::string& what) const { return std::find(record.begin(), record.end(), what) != record.end(); }
+
+bool SweepSpec::draws(const std::string& knob) const {
+  return std::any_of(perturbations.begin(), perturbations.end(), [&knob](const SweepDraw& d) { return d.knob == knob; });
+}
 
 std::vector<std::string> SweepSpec::set_knobs() const {
   std::vector<std::string> knobs;
@@ -155,41 +220,19 @@ bool parse_shard(const std::string& text, int& shard, int& shards) {
 }
 
 namespace {
-// The machine file a scene names (absolute, as the scene's reader resolves it), "" when it names none
-// (the built-in machine) or its shared keys do not load: the scene's own load, when a case runs, says
-// what is wrong with it.
-std::string named_machine_file(const std::string& scene) {
-  try {
-    const settings::Document doc = settings::Document::load(scene);
-    SectionReader top(doc);
-    return read_scene_common(top, doc).machine_file;
-  } catch (const SettingsError&) {
-  }
-  return "";
-}
-
-// FNV-1a (64 bit) of the spec's text (as read once by its Document), then each scene's bytes and its
-// machine's (the file it names, or the built-in machine's text), as 16 hex digits: what a shard line
-// carries so that the merge can tell a line of this spec from one of another or an edited one.
-std::string content_digest(const std::string& spec_text, const std::vector<std::string>& scenes) {
+// FNV-1a (64 bit) of the spec's text, then each scene's text and its machine's (the file it names, or
+// the built-in machine's text), each as read once, as 16 hex digits: what a shard line carries so that
+// the merge can tell a line of this spec from one of another or an edited one.
+std::string content_digest(const std::string& spec_text, const std::vector<std::shared_ptr<const SceneSource>>& scenes) {
   std::uint64_t h = 0xcbf29ce484222325ULL;
-  const auto add = [&h](char c) { h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL; };
-  const auto end_of_file = [&h] { h = (h ^ 0xFF) * 0x100000001b3ULL; };  // so that bytes moved between files count
-  const auto add_file = [&](const std::string& path) {
-    std::ifstream in(path, std::ios::binary);
-    for (char c; in.get(c);) add(c);
-    end_of_file();
+  const auto add = [&h](const std::string& text) {
+    for (const char c : text) h = (h ^ static_cast<unsigned char>(c)) * 0x100000001b3ULL;
+    h = (h ^ 0xFF) * 0x100000001b3ULL;  // the end of a file: so that bytes moved between files count
   };
-  for (const char c : spec_text) add(c);
-  end_of_file();
-  for (const std::string& scene : scenes) {
-    add_file(scene);
-    if (const std::string machine = named_machine_file(scene); !machine.empty()) {
-      add_file(machine);
-    } else {
-      for (const char* c = reference_machine_text(); *c != 0; ++c) add(*c);
-      end_of_file();
-    }
+  add(spec_text);
+  for (const std::shared_ptr<const SceneSource>& scene : scenes) {
+    add(scene->scene.text());
+    add(scene->machine.document.text());
   }
   char text[17];
   std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
@@ -197,7 +240,7 @@ std::string content_digest(const std::string& spec_text, const std::vector<std::
 }
 }  // namespace
 
-SweepSpec load_sweep_spec(const std::string& path) {
+SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
   const settings::Document doc = settings::Document::load(path);
   // The reader first: it refuses a file that is no mapping naming it (indexing a scalar root would
   // throw yaml-cpp's own error, which names no file).
@@ -229,6 +272,10 @@ SweepSpec load_sweep_spec(const std::string& path) {
     }
   }
   if (s.given("scene") == s.given("scenes")) s.fail_here("name the scenes: scene: FILE or scenes: [FILE, ...] (one of them)");
+  if (scenes) spec.scenes = scenes(spec.scenes);
+  // Each scene and its machine file read once, here: the knobs' values are read by their readers.
+  for (const std::string& scene_path : spec.scenes)
+    spec.sources.push_back(std::make_shared<const SceneSource>(load_scene_source(scene_path)));
   s.choice("run", spec.run, kSweepRuns, "what one run of a case is");
   s.choices("controllers", spec.controllers, control::kControllerKinds, 1, "the controllers each case runs");
   s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws per grid point and variant, case i from (seed, i)");
@@ -239,46 +286,47 @@ SweepSpec load_sweep_spec(const std::string& path) {
   w.number("start", spec.window_start, {0, 3600}, "s", "of the task where the window starts");
   w.number("horizon", spec.window_horizon, {0.01, 3600}, "s", "simulated");
   w.finish();
-  SectionReader p = s.section("perturbations", "each drawn uniformly in [min, max] per case");
-  read_range(p, "model_mass", spec.model_mass, {-0.9, 9}, "the firmware's link masses x (1 + value)");
-  read_range(p, "soil_stiffness", spec.soil_stiffness, {0.01, 100}, "the plant's soil K x value");
-  read_range(p, "position_noise", spec.position_noise, {0, 0.1}, "m (rad on the swing), 1 sigma");
-  read_range(p, "delay_cycles", spec.delay_cycles, {0, 100}, "whole cycles, drawn as integers");
+  KnobReader knobs(spec);
+  SectionReader p = s.section("perturbations", "each knob drawn uniformly in [min, max] per case");
+  if (p.present()) knobs.draws(p, raw["perturbations"], spec.perturbations);
   p.finish();
   s.choices("faults", spec.faults, kFaultKinds, 0, "one fault per case, its kind drawn from the list");
   if (s.given("grid")) {
     if (raw["grid"].IsSequence()) {
       s.sections("grid", 1, 1000, "grids run one after the other", [&](SectionReader& g, std::size_t i) {
-        spec.grids.push_back(read_axes(g, raw["grid"][i], spec.run));
+        spec.grids.push_back(knobs.axes(g, raw["grid"][i]));
       });
     } else {
       SectionReader g = s.section("grid", "lists of values, crossed");
-      spec.grids.push_back(read_axes(g, raw["grid"], spec.run));
+      spec.grids.push_back(knobs.axes(g, raw["grid"]));
     }
     for (const SweepGrid& g : spec.grids)
-      if (g.empty()) s.fail("grid", "a grid names no knob; allowed: " + knob_names(spec.run));
+      if (g.empty()) s.fail("grid", "a grid names no knob");
   }
   s.sections("variants", 0, 10000, "named cases", [&](SectionReader& v, std::size_t i) {
     SweepVariant variant;
     v.text("name", variant.name, "the variant's short name", Need::required);
     v.text("description", variant.description, "what is changed, in words");
-    for (const KnobInfo& k : knob_table(spec.run))
-      if (v.given(k.name)) variant.values.push_back({k.name, read_value(v, k.name, -1, raw["variants"][i][k.name], k)});
+    for (const auto& kv : raw["variants"][i]) {
+      const std::string knob = kv.first.Scalar();
+      if (knob == "name" || knob == "description") continue;
+      variant.values.push_back({knob, knobs.value(v, knob, -1, kv.second, knobs.values(v, knob))});
+    }
     spec.variants.push_back(variant);
   });
   if (s.given("search")) {
     SectionReader q = s.section("search", "one knob: per case, the first of its values whose run passes");
-    const std::vector<SweepAxis> axes = read_axes(q, raw["search"], spec.run);
-    if (axes.size() != 1) s.fail("search", "must name exactly one knob; allowed: " + knob_names(spec.run));
+    const std::vector<SweepAxis> axes = knobs.axes(q, raw["search"]);
+    if (axes.size() != 1) s.fail("search", "must name exactly one knob");
     spec.search = axes.front();
   }
   s.choices("record", spec.record, kSweepRecords, 1, "what the merge writes");
   // A knob is either drawn or set, and set by one of grid, variants and search.
   const std::vector<std::string> set = spec.set_knobs();
+  if (!spec.search.knob.empty() && spec.draws(spec.search.knob))
+    s.fail("perturbations", "'" + spec.search.knob + "' is drawn here and searched: choose one");
   for (const std::string& k : set) {
-    const bool drawn = (k == "model_mass" && spec.model_mass.given) || (k == "soil_stiffness" && spec.soil_stiffness.given) ||
-                       (k == "position_noise" && spec.position_noise.given) || (k == "delay_cycles" && spec.delay_cycles.given);
-    if (drawn) s.fail("perturbations", "'" + k + "' is drawn here and set by the grid or a variant: choose one");
+    if (spec.draws(k)) s.fail("perturbations", "'" + k + "' is drawn here and set by the grid or a variant: choose one");
     if (k == spec.search.knob) s.fail("search", "'" + k + "' is searched and set by the grid or a variant: choose one");
     if (!spec.grids.empty() && !spec.variants.empty())
       for (const SweepVariant& v : spec.variants)
@@ -290,7 +338,7 @@ SweepSpec load_sweep_spec(const std::string& path) {
   if (spec.total_cases() > 10'000'000) s.fail_here("more than 10 million cases");
   s.finish();
   top.finish();
-  spec.digest = content_digest(doc.text(), spec.scenes);
+  spec.digest = content_digest(doc.text(), spec.sources);
   return spec;
 }
 
@@ -323,12 +371,21 @@ SweepCase sweep_case(const SweepSpec& spec, int id) {
   }
   if (c.variant >= 0)
     for (const SweepSetting& v : spec.variants[static_cast<std::size_t>(c.variant)].values) c.set.push_back(v);
-  c.model_mass = draw(rng, spec.model_mass, 0);
-  c.soil_stiffness = draw(rng, spec.soil_stiffness, 1);
-  c.position_noise = draw(rng, spec.position_noise, 0);
-  c.delay_cycles = static_cast<int>(std::floor(draw(rng, spec.delay_cycles, 0) + (spec.delay_cycles.given ? 0.5 : 0)));
+  for (const SweepDraw& d : spec.perturbations) {
+    double x = d.min + (d.max - d.min) * std::uniform_real_distribution<double>(0.0, 1.0)(rng);
+    if (d.whole) x = std::floor(x + 0.5);
+    c.drawn.push_back({d.knob, SweepValue{SweepValue::Type::number, x, {}, ""}});
+  }
   if (!spec.faults.empty()) draw_fault(rng, spec.faults, c);
   return c;
+}
+
+SceneBundle case_bundle(const SweepSpec& spec, const SweepCase& c, const SweepSetting* searched) {
+  SceneChanges changes(*spec.sources[static_cast<std::size_t>(c.scene)]);
+  for (const std::vector<SweepSetting>* values : {&c.drawn, &c.set})
+    for (const SweepSetting& v : *values) set_knob(spec.run, v.first, v.second, changes);
+  if (searched != nullptr) set_knob(spec.run, searched->first, searched->second, changes);
+  return changes.read();
 }
 
 }  // namespace exc::sim

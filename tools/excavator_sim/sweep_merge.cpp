@@ -10,11 +10,11 @@
 #include <regex>
 #include <stdexcept>
 
+#include "helper_program.hpp"
 #include "output_file.hpp"
 #include "run_report.hpp"
 #include "fault_campaign.hpp"
 #include "sweep.hpp"
-#include "sweep_tables.hpp"
 
 namespace exc::sim {
 namespace {
@@ -55,14 +55,6 @@ std::string draw_region(const json& j) {
          : j["delay_cycles"].get<int>() >= 2 ? "delay >= 2 cycles" : "elsewhere";
 }
 
-// The Monte-Carlo draws by their name in a shard line and in the table.
-std::array<std::pair<const char*, const SweepRange*>, 4> drawn_ranges(const SweepSpec& spec) {
-  return {{{"model_mass", &spec.model_mass},
-           {"soil_stiffness", &spec.soil_stiffness},
-           {"position_noise", &spec.position_noise},
-           {"delay_cycles", &spec.delay_cycles}}};
-}
-
 std::vector<std::string> run_columns(const SweepSpec& spec) {
   return spec.run == SweepRun::open_loop ? std::vector<std::string>{"plant"} : spec.controllers;
 }
@@ -83,10 +75,8 @@ std::string record_problem(const SweepSpec& spec, const json& j) {
   const auto is = [&](const json& o, const char* key, bool (json::*type)() const noexcept) {
     return !o.contains(key) || (o[key].*type)();
   };
-  const auto draws = drawn_ranges(spec);
-  for (const auto& [draw, range] : draws)
-    if (!is(j, draw, &json::is_number) || (range->given && !j.contains(draw)))
-      return std::string("its ") + draw + " is not a number";
+  for (const SweepDraw& d : spec.perturbations)
+    if (!j.contains(d.knob) || !j[d.knob].is_number()) return "its " + d.knob + " is not a number";
   if (!is(j, "scene", &json::is_string) || (spec.scenes.size() > 1 && !j.contains("scene"))) return "no scene name";
   if (!is(j, "variant", &json::is_string)) return "its variant is not a name";
   if (j.contains("fault")) {
@@ -200,13 +190,11 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   const json absent_files = read_shards(spec, shard_files, cases, ignored, conflicts);
   fs::create_directories(out_dir);
   const std::vector<std::string> runs = run_columns(spec), knobs = spec.set_knobs();
-  const auto draws = drawn_ranges(spec);
   std::ofstream csv = output::open_file(out_dir / "sweep.csv");
   csv << "case";
   if (spec.scenes.size() > 1) csv << ",scene";
   if (!spec.variants.empty()) csv << ",variant";
-  for (const auto& [name, range] : draws)
-    if (range->given) csv << ',' << name;
+  for (const SweepDraw& d : spec.perturbations) csv << ',' << d.knob;
   if (!spec.faults.empty()) csv << ",fault,fault_joint,fault_start,fault_duration,fault_magnitude";
   for (const std::string& k : knobs) csv << ',' << k;
   for (const std::string& c : runs) {
@@ -220,7 +208,8 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   std::map<std::string, std::map<std::string, int>> failures, kinds;  // controller -> region / kind -> count
   json by_value = json::object();                                      // controller -> knob -> value -> counts
   json campaign = json::object();                                      // controller -> fault kind -> outcomes
-  const bool all_draws = spec.model_mass.given && spec.soil_stiffness.given && spec.delay_cycles.given;
+  // The Monte-Carlo regions need the three draws they are made of.
+  const bool all_draws = spec.draws("model_mass") && spec.draws("soil_stiffness") && spec.draws("delay_cycles");
   for (int id = 0; id < spec.total_cases(); ++id) {
     const auto it = cases.find(id);
     if (it == cases.end()) {
@@ -231,8 +220,7 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
     csv << id;
     if (spec.scenes.size() > 1) csv << ',' << j.value("scene", "");
     if (!spec.variants.empty()) csv << ',' << j.value("variant", "");
-    for (const auto& [name, range] : draws)
-      if (range->given) csv << ',' << cell(j[name]);
+    for (const SweepDraw& d : spec.perturbations) csv << ',' << cell(j[d.knob]);
     if (!spec.faults.empty()) {
       const json& f = j.contains("fault") ? j["fault"] : json::object();
       csv << ',' << f.value("kind", "none") << ',' << cell(f.value("joint", json())) << ',' << cell(f.value("start", json()))
@@ -291,10 +279,12 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   }
   const bool stability = spec.records("stability"), spread = spec.records("robustness") && spec.variants.empty();
   if (charts && (stability || spread) && !cases.empty()) {
-    const std::string what = std::string(stability ? " --stability" : "") + (spread ? " --robustness" : "");
-    const std::string cmd = "/usr/bin/python3 '" EXC_SWEEP_PLOT "'" + what + " '" + out_dir.string() + "'";
-    if (std::system(cmd.c_str()) != 0) {
-      std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", cmd.c_str());
+    std::vector<std::string> cmd = {"/usr/bin/python3", EXC_SWEEP_PLOT};
+    if (stability) cmd.push_back("--stability");
+    if (spread) cmd.push_back("--robustness");
+    cmd.push_back(out_dir.string());
+    if (output::run_helper(cmd) != 0) {
+      std::fprintf(stderr, "sweep merge: the charts failed (%s)\n", output::command_text(cmd).c_str());
       outcome.charts_ok = false;
     }
   }

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <map>
 #include <stdexcept>
 
 #include "control/controller_kinds.hpp"
@@ -17,61 +16,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-Vec4 joints_of(const SweepValue& v) {
-  return v.type == SweepValue::Type::joints ? Vec4(v.joints[0], v.joints[1], v.joints[2], v.joints[3])
-                                            : Vec4::Constant(v.number);
-}
-
-void scale_model_masses(SceneBundle& b, double scale) {
-  for (BodyInertia& body : b.firmware.machine.bodies) {
-    body.mass *= scale;
-    body.inertia *= scale;
-  }
-}
-
-// One knob's value into the scene (the plant's sections) or the firmware's settings.
-void apply_knob(SceneBundle& b, const std::string& knob, const SweepValue& v) {
-  control::ControllerConfig& cc = b.firmware.controller;
-  const double x = v.number;
-  if (knob == "model_mass") scale_model_masses(b, 1 + x);
-  else if (knob == "soil_stiffness") b.scene.soil.stiffness *= x;
-  else if (knob == "position_noise") b.scene.sensors.position_noise = joints_of(v);
-  else if (knob == "velocity_noise") b.scene.sensors.velocity_noise = joints_of(v);
-  else if (knob == "delay_cycles") b.scene.sensors.latency_cycles = static_cast<int>(std::lround(x));
-  else if (knob == "gain_scale") {
-    // omega_n of the error dynamics x value (excavator-bench's gain axis).
-    cc.gains.kp *= x * x;
-    cc.gains.kv *= x;
-    cc.gains.ki *= x * x * x;
-    cc.sl_lambda *= x;
-    cc.sl_kd *= x;
-  } else if (knob == "adaptation_scale") {
-    cc.adaptation_rate *= x;
-    cc.sl_adaptation_rate *= x;
-  } else if (knob == "controller.valves.force_time_constant") cc.valves.force_time_constant = x;
-  else if (knob == "controller.valves.position_gain") cc.valves.position_gain = joints_of(v);
-  else if (knob == "machine.hydraulics.valve_time_constant") b.scene.machine.hydraulics.valve_time_constant = x;
-  else if (knob == "machine.hydraulics.bulk_modulus") b.scene.machine.hydraulics.bulk_modulus = x;
-  else throw std::invalid_argument("sweep: the closed loop takes no knob '" + knob + "'");
-}
-
-const SceneBundle& cached_scene(const std::string& path) {
-  static std::map<std::string, SceneBundle> scenes;  // one reading per scene file and process
-  auto it = scenes.find(path);
-  if (it == scenes.end()) it = scenes.emplace(path, load_scene_bundle(path)).first;
-  return it->second;
-}
-
-RunRecord run_one(const SceneBundle& nominal, const SweepSpec& spec, const SweepCase& c, const std::string& controller,
-                  const SweepSetting* searched) {
-  SceneBundle b = nominal;
-  // The draws the spec perturbs (an absent range leaves the scene's value).
-  if (spec.model_mass.given) scale_model_masses(b, 1 + c.model_mass);
-  if (spec.soil_stiffness.given) b.scene.soil.stiffness *= c.soil_stiffness;
-  if (spec.position_noise.given) b.scene.sensors.position_noise = Vec4::Constant(c.position_noise);
-  if (spec.delay_cycles.given) b.scene.sensors.latency_cycles = c.delay_cycles;
-  for (const SweepSetting& s : c.set) apply_knob(b, s.first, s.second);
-  if (searched) apply_knob(b, searched->first, searched->second);
+RunRecord run_bundle(const SceneBundle& b, const SweepSpec& spec, const SweepCase& c, const std::string& controller) {
   LockstepOptions o;
   o.controller = *control::kControllerKinds.named(controller);
   o.duration = spec.duration;
@@ -82,9 +27,8 @@ RunRecord run_one(const SceneBundle& nominal, const SweepSpec& spec, const Sweep
 
 }  // namespace
 
-RunRecord run_sweep_case(const SceneBundle& nominal, const SweepSpec& spec, const SweepCase& c,
-                         const std::string& controller) {
-  return run_one(nominal, spec, c, controller, nullptr);
+RunRecord run_sweep_case(const SweepSpec& spec, const SweepCase& c, const std::string& controller) {
+  return run_bundle(case_bundle(spec, c), spec, c, controller);
 }
 
 nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firmware) {
@@ -99,13 +43,12 @@ nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firm
 }
 
 nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c) {
-  const SceneBundle& nominal = cached_scene(spec.scenes[static_cast<std::size_t>(c.scene)]);
-  nlohmann::json line = {{"case", c.id},
-                         {"model_mass", c.model_mass},
-                         {"soil_stiffness", c.soil_stiffness},
-                         {"position_noise", c.position_noise},
-                         {"delay_cycles", c.delay_cycles}};
-  if (spec.scenes.size() > 1) line["scene"] = nominal.name;
+  nlohmann::json line = {{"case", c.id}};
+  for (std::size_t i = 0; i < c.drawn.size(); ++i) {
+    const double x = c.drawn[i].second.number;
+    line[c.drawn[i].first] = spec.perturbations[i].whole ? nlohmann::json(std::llround(x)) : nlohmann::json(x);
+  }
+  if (spec.scenes.size() > 1) line["scene"] = spec.sources[static_cast<std::size_t>(c.scene)]->nominal.name;
   if (c.variant >= 0) line["variant"] = spec.variants[static_cast<std::size_t>(c.variant)].name;
   if (!c.set.empty()) {
     line["set"] = nlohmann::json::object();
@@ -114,19 +57,22 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c) {
   if (c.fault != "none")
     line["fault"] = {{"kind", c.fault}, {"start", c.fault_start}, {"duration", c.fault_duration},
                      {"joint", c.fault_joint}, {"magnitude", c.fault_magnitude}};
+  // The case's scene read once (once per searched value) for all its controllers.
+  const SceneBundle bundle = spec.search.knob.empty() ? case_bundle(spec, c) : SceneBundle{};
   for (const std::string& name : spec.controllers) {
     if (spec.search.knob.empty()) {
-      line[name] = record_json(run_one(nominal, spec, c, name, nullptr), nominal.firmware);
+      line[name] = record_json(run_bundle(bundle, spec, c, name), bundle.firmware);
       continue;
     }
     // The search: the first value (in the spec's order) whose run passes; the failure of the one before.
     nlohmann::json run = {{"ok", false}, {"search_value", nullptr}};
     for (const SweepValue& v : spec.search.values) {
       const SweepSetting s{spec.search.knob, v};
-      const RunRecord r = run_one(nominal, spec, c, name, &s);
+      const SceneBundle searched = case_bundle(spec, c, &s);
+      const RunRecord r = run_bundle(searched, spec, c, name);
       if (r.ok) {
         const std::string before = run.value("failure", "");
-        run = record_json(r, nominal.firmware);
+        run = record_json(r, searched.firmware);
         run["search_value"] = v.to_json();
         if (!before.empty()) run["failure_before"] = before;
         break;
@@ -144,7 +90,7 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
   std::ofstream file = output::open_file(out);
   // A fault the scenes cannot take (pump_loss without the hydraulic machine) before any run.
   if (!spec.faults.empty())
-    for (const std::string& scene : spec.scenes) check_faults_fit(spec.faults, cached_scene(scene));
+    for (const std::shared_ptr<const SceneSource>& scene : spec.sources) check_faults_fit(spec.faults, scene->nominal);
   int done = 0;
   const int total = spec.total_cases();
   for (int id = shard; id < total; id += shards) {

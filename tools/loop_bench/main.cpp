@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
       ->check(exc::cli::number_in({0, 28800}, "s"));
   app.add_flag("!--no-pin", pin, "do not pin the process (loop and telemetry thread) to one core");
   app.add_flag("--child", child, "one run with telemetry and nothing printed (what --split profiles)")->group("");
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   const auto kind = control::kControllerKinds.named(controller);
   if (!kind) {

@@ -132,10 +132,11 @@ BENCHMARK(BM_ForwardDynamicsAugmented);
 }  // namespace
 
 // The model as the loop evaluates it: in the loop's floating-point mode (docs/floating-point.md).
+// Google Benchmark's main, but an argument it does not know exits 2 (bad input), as every program's does.
 int main(int argc, char** argv) {
   exc::app::set_loop_float_mode();
   benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

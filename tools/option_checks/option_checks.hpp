@@ -1,11 +1,13 @@
 #pragma once
-// Checks of the programs' numeric options, with the settings files' wording ("is -1 s; allowed range
-// [0.001, 28800] s"). CLI11's own Range and PositiveNumber let "nan" through (every comparison with
-// NaN is false), and a NaN duration then reads as "not given": a silent default. These refuse it.
+// The programs' command lines: the parse with their exit convention, and checks of numeric options
+// with the settings files' wording ("is -1 s; allowed range [0.001, 28800] s"). CLI11's own Range and
+// PositiveNumber let "nan" through (every comparison with NaN is false), and a NaN duration then
+// reads as "not given": a silent default. These refuse it.
 #include <cerrno>
 #include <climits>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -13,6 +15,19 @@
 #include "settings/section_reader.hpp"
 
 namespace exc::cli {
+
+// Parses the command line. --help prints and gives 0; an error CLI11 finds (an unknown option, a value
+// out of range or not a number, a missing argument) prints its message and gives 2, the status of
+// every refused input (CLI11's own codes are 100-114). Nothing: the program goes on.
+//   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
+inline std::optional<int> parse_command_line(CLI::App& app, int argc, const char* const* argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  return std::nullopt;
+}
 
 // A finite number in [bounds.lo, bounds.hi] (inclusive), in `unit`.
 inline CLI::Validator number_in(settings::Bounds bounds, const std::string& unit) {

@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
                  "the steps did: the run to count under valgrind --tool=callgrind "
                  "--toggle-collect='exc::plant::Plant::step(*)' (docs/plant.md)")
       ->check(exc::cli::count_in(1, 100000000));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   Scene base;
   control::Task task;

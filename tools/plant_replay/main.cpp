@@ -120,7 +120,7 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_path, "output CSV (default: standard output)");
   app.add_option("--duration", duration, "simulated seconds (default: the scene's duration)")
       ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
-  CLI11_PARSE(app, argc, argv);
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   std::vector<Row> rows;
   exc::plant::Scene scene;

@@ -150,9 +150,12 @@ def robustness(out, rows, chart):
 def main(argv):
     flags = [a for a in argv if a.startswith("--")]
     dirs = [a for a in argv if not a.startswith("--")]
-    if len(dirs) != 1 or not flags or "--help" in flags or any(f not in ("--stability", "--robustness") for f in flags):
+    if "--help" in flags:
         print(__doc__.strip())
-        return 0 if "--help" in flags else 2
+        return 0
+    if len(dirs) != 1 or not flags or any(f not in ("--stability", "--robustness") for f in flags):
+        print(__doc__.strip(), file=sys.stderr)
+        return 2
     out = dirs[0]
     with open(os.path.join(out, "sweep.json")) as f:
         chart = json.load(f)["chart"]

@@ -1,10 +1,14 @@
-#include "hal/candump_log.hpp"
+#include "candump_log.hpp"
 
 #include <cctype>
 #include <cstdio>
 
-namespace exc::hal {
+namespace exc::test {
 namespace {
+
+using hal::kCanFdMaxLength;
+using hal::kCanMaxLength;
+using hal::valid_length;
 
 int hex_value(char c) {
   if (c >= '0' && c <= '9') return c - '0';
@@ -112,7 +116,7 @@ bool parse_candump_line(const std::string& line, CandumpLine& out, std::string& 
   return true;
 }
 
-std::string candump_line(const CanFrame& frame, const std::string& interface_name, std::int64_t timestamp_ns) {
+std::string candump_line(const hal::CanFrame& frame, const std::string& interface_name, std::int64_t timestamp_ns) {
   char text[64];
   std::snprintf(text, sizeof text, "(%lld.%06lld) ", static_cast<long long>(timestamp_ns / 1'000'000'000),
                 static_cast<long long>((timestamp_ns % 1'000'000'000) / 1000));
@@ -131,4 +135,4 @@ std::string candump_line(const CanFrame& frame, const std::string& interface_nam
   return line;
 }
 
-}  // namespace exc::hal
+}  // namespace exc::test

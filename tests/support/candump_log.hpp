@@ -3,16 +3,16 @@
 // classical frame, "(...) vcan0 180##1<hex>" for a CAN FD frame (after "##" one hex digit of FD flags:
 // 1 bit-rate switch, 2 error state indicator; then the payload). So a capture of the bus can be
 // checked frame by frame against the protocol (IDs, FD flag, length, counters, checksums) and decoded
-// by other tools. Test and tool code: these allocate.
+// by other tools. Test code (the vcan tests' captures): these allocate.
 #include <cstdint>
 #include <string>
 
 #include "hal/can_frame.hpp"
 
-namespace exc::hal {
+namespace exc::test {
 
 struct CandumpLine {
-  CanFrame frame;                // timestamp_ns: the log's time stamp (CLOCK_REALTIME as candump writes it)
+  hal::CanFrame frame;           // timestamp_ns: the log's time stamp (CLOCK_REALTIME as candump writes it)
   std::string interface_name;
   bool extended = false;         // 29-bit identifier (never part of this protocol)
   bool remote = false;           // remote request ("R")
@@ -26,6 +26,6 @@ bool parse_candump_line(const std::string& line, CandumpLine& out, std::string& 
 // The line candump -L writes for `frame` received on `interface_name` at `timestamp_ns` (ns since the
 // epoch; candump shows microseconds). FD flags: BRS only (a kernel from 6.0 on also marks every FD
 // frame it delivers with CANFD_FDF, 4, so candump there writes 5 where this writes 1).
-std::string candump_line(const CanFrame& frame, const std::string& interface_name, std::int64_t timestamp_ns);
+std::string candump_line(const hal::CanFrame& frame, const std::string& interface_name, std::int64_t timestamp_ns);
 
-}  // namespace exc::hal
+}  // namespace exc::test

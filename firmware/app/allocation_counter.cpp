@@ -28,7 +28,7 @@ const int g_hooks_installed = __sanitizer_install_malloc_and_free_hooks(on_alloc
 }  // namespace
 #else
 // glibc exports its allocator under __libc_* names; defining malloc & co. here interposes them for
-// the whole test process while still using glibc's allocator underneath.
+// the whole process while still using glibc's allocator underneath.
 extern "C" {
 void* __libc_malloc(size_t);
 void* __libc_calloc(size_t, size_t);
@@ -67,7 +67,7 @@ int posix_memalign(void** out, size_t align, size_t n) {
 }
 #endif
 
-namespace exc::test {
+namespace exc::app {
 
 AllocationCounter::AllocationCounter() : start_(allocations_so_far()) {}
 AllocationCounter::~AllocationCounter() = default;
@@ -80,4 +80,4 @@ bool allocation_counting_works() {
   return c.count() == 1;
 }
 
-}  // namespace exc::test
+}  // namespace exc::app

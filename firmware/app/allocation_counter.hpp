@@ -1,14 +1,17 @@
 #pragma once
-// Counts heap allocations made by the calling thread while a counter is alive. malloc, calloc,
-// realloc, aligned_alloc, posix_memalign and memalign are interposed in allocation_counter.cpp, so
-// operator new, Eigen's aligned allocator and any C library call that allocates are all seen.
+// Counts heap allocations made by the calling thread while a counter is alive: what a run reports as
+// its heap allocations in the loop (harness/lockstep_run.cpp) and what the tests hold the real-time
+// path to (zero). malloc, calloc, realloc, aligned_alloc, posix_memalign and memalign are interposed
+// in allocation_counter.cpp, so operator new, Eigen's aligned allocator and any C library call that
+// allocates are all seen. Link the object library exc_allocation_counter into the executable (an
+// interposed malloc must be in it, not in a shared library).
 #include <cstddef>
 
 #ifdef EIGEN_RUNTIME_NO_MALLOC
 #include <Eigen/Core>
 #endif
 
-namespace exc::test {
+namespace exc::app {
 
 class AllocationCounter {
  public:
@@ -39,8 +42,8 @@ class EigenNoMallocScope {
   EigenNoMallocScope& operator=(const EigenNoMallocScope&) = delete;
 };
 
-// Whether the malloc interposition is active in this executable (a sanity check for the tests that
-// rely on it: an allocation must be seen).
+// Whether the malloc interposition is active in this executable (a sanity check for the figures and
+// tests that rely on it: an allocation must be seen).
 bool allocation_counting_works();
 
-}  // namespace exc::test
+}  // namespace exc::app

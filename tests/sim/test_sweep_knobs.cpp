@@ -1,0 +1,239 @@
+// A sweep's knobs name settings: their type and range are the setting's one declaration (recorded by
+// the settings reader), a case's values are read by the scene's own readers, a value they refuse is
+// refused when the spec loads, and each file is loaded once per process.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "harness/scene_source.hpp"
+#include "settings_error_check.hpp"
+#include "sim_runs.hpp"
+#include "sweep_knobs.hpp"
+
+namespace fs = std::filesystem;
+using exc::settings::Declaration;
+using exc::sim::SceneBundle;
+using exc::sim::SceneChanges;
+using exc::sim::SweepRun;
+using exc::sim::SweepValue;
+using exc::test::kDig;
+using exc::test::read_text_file;
+using exc::test::run_sim;
+
+namespace {
+
+const exc::sim::SceneSource& dig() {
+  static const exc::sim::SceneSource source = exc::sim::load_scene_source(kDig);
+  return source;
+}
+
+SweepValue number(double x) { return SweepValue{SweepValue::Type::number, x, {}, ""}; }
+
+// The case's scene with one knob set.
+SceneBundle with(const std::string& knob, const SweepValue& value, SweepRun run = SweepRun::closed_loop) {
+  SceneChanges changes(dig());
+  exc::sim::set_knob(run, knob, value, changes);
+  return changes.read();
+}
+
+// The settings error a read of the scene with `path` set to `value` raises.
+exc::settings::SettingsError refusal(const std::string& path, const YAML::Node& value) {
+  SceneChanges changes(dig());
+  changes.set(path, value);
+  try {
+    (void)changes.read();
+  } catch (const exc::settings::SettingsError& e) {
+    return e;
+  }
+  FAIL("the readers took " << path);
+  throw;
+}
+
+}  // namespace
+
+TEST_CASE("tools/settings: the reader records each field's declaration in the document read: type, count, range, unit") {
+  const Declaration* latency = dig().declaration("sensors.latency_cycles");
+  REQUIRE(latency != nullptr);
+  CHECK(latency->type == Declaration::Type::whole);
+  CHECK(latency->bounds_of(0).lo == 0);
+  CHECK(latency->bounds_of(0).hi == exc::plant::SensorParameters::kMaxLatency);  // the sensors' ring holds this many
+  const Declaration* noise = dig().declaration("sensors.position_noise");
+  REQUIRE(noise != nullptr);
+  CHECK(noise->type == Declaration::Type::numbers);
+  CHECK(noise->count == 4);
+  CHECK(noise->bounds_of(3).hi == 0.1);
+  const Declaration* t_f = dig().declaration("controller.valves.force_time_constant");  // the firmware's side
+  REQUIRE(t_f != nullptr);
+  CHECK(t_f->unit == "s");
+  CHECK(t_f->bounds_of(0).lo == 1e-3);
+  const Declaration* oil = dig().declaration("machine.hydraulics.bulk_modulus");  // the machine file's (machine.hpp: [1e7, 5e9])
+  REQUIRE(oil != nullptr);
+  CHECK(oil->unit == "Pa");
+  CHECK(oil->bounds_of(0).lo == 1e7);
+  CHECK(oil->bounds_of(0).hi == 5e9);
+  const Declaration* method = dig().declaration("integrator.method");
+  REQUIRE(method != nullptr);
+  CHECK(method->type == Declaration::Type::choice);
+  CHECK(method->what == exc::plant::kIntegrationMethods.names());
+  CHECK(dig().declaration("sensors.no_such_field") == nullptr);
+  CHECK(dig().declaration("soil.stiffness") == nullptr);  // the dig's soil is a preset: its K is not read
+}
+
+TEST_CASE("tools/sweep knobs: a value set by a setting's path reaches the side that reads it, and one the readers refuse names the setting and its range") {
+  const SceneBundle& nominal = dig().nominal;
+  SceneChanges sensors(dig());
+  sensors.set("sensors.latency_cycles", YAML::Node("5"));
+  CHECK(sensors.read().scene.sensors.latency_cycles == 5);
+  // The plant's machine and the firmware's model of it apart.
+  SceneChanges plant_oil(dig());
+  plant_oil.set("machine.hydraulics.bulk_modulus", YAML::Node("3e8"));
+  const SceneBundle a = plant_oil.read();
+  CHECK(a.scene.machine.hydraulics.bulk_modulus == 3e8);
+  CHECK(a.firmware.machine.hydraulics.bulk_modulus == nominal.firmware.machine.hydraulics.bulk_modulus);
+  SceneChanges model_oil(dig());
+  model_oil.set("firmware.machine.hydraulics.bulk_modulus", YAML::Node("3e8"));
+  const SceneBundle b = model_oil.read();
+  CHECK(b.firmware.machine.hydraulics.bulk_modulus == 3e8);
+  CHECK(b.scene.machine.hydraulics.bulk_modulus == nominal.scene.machine.hydraulics.bulk_modulus);
+  SceneChanges controller(dig());
+  controller.set("controller.valves.force_time_constant", YAML::Node("0.01"));
+  CHECK(controller.read().firmware.controller.valves.force_time_constant == 0.01);
+
+  // Refused as the scene file would be: the sensors' ring, a machine range, a cross-field rule.
+  const exc::settings::SettingsError late = refusal("sensors.latency_cycles", YAML::Node("64"));
+  CHECK(late.field() == "sensors.latency_cycles");
+  CHECK(late.reason().find("[0, 63]") != std::string::npos);
+  const exc::settings::SettingsError oil = refusal("machine.hydraulics.bulk_modulus", YAML::Node("1e3"));
+  CHECK(oil.field() == "hydraulics.bulk_modulus");
+  CHECK(oil.reason().find("[1e+07, 5e+09] Pa") != std::string::npos);
+  YAML::Node ki(YAML::NodeType::Sequence);
+  for (int i = 0; i < 4; ++i) ki.push_back("2000");  // above kv kp = 1024: e''' + kv e'' + kp e' + ki e unstable
+  const exc::settings::SettingsError unstable = refusal("controller.ki", ki);
+  CHECK(unstable.field() == "controller.ki[0]");
+  CHECK(unstable.reason().find("unstable") != std::string::npos);
+}
+
+TEST_CASE("tools/sweep knobs: the named knobs write the settings their rows name, from the nominal scene's values") {
+  const SceneBundle& nominal = dig().nominal;
+  const SceneBundle gains = with("gain_scale", number(2));
+  CHECK(gains.firmware.controller.gains.kp == nominal.firmware.controller.gains.kp * 4);
+  CHECK(gains.firmware.controller.gains.kv == nominal.firmware.controller.gains.kv * 2);
+  CHECK(gains.firmware.controller.gains.ki == nominal.firmware.controller.gains.ki * 8);
+  CHECK(gains.firmware.controller.sl_lambda == nominal.firmware.controller.sl_lambda * 2);
+  const SceneBundle rates = with("adaptation_scale", number(0.01));
+  CHECK(rates.firmware.controller.adaptation_rate == nominal.firmware.controller.adaptation_rate * 0.01);
+  CHECK(rates.firmware.controller.sl_adaptation_rate == nominal.firmware.controller.sl_adaptation_rate * 0.01);
+  const SceneBundle heavy = with("model_mass", number(0.2));
+  for (std::size_t i = 0; i < heavy.firmware.machine.bodies.size(); ++i) {
+    CHECK(heavy.firmware.machine.bodies[i].mass == nominal.firmware.machine.bodies[i].mass * 1.2);
+    CHECK(heavy.firmware.machine.bodies[i].inertia == nominal.firmware.machine.bodies[i].inertia * 1.2);
+    CHECK(heavy.scene.machine.bodies[i].mass == nominal.scene.machine.bodies[i].mass);  // the plant keeps the true machine
+  }
+  const SceneBundle stiff = with("soil_stiffness", number(3));
+  CHECK(stiff.scene.soil.stiffness == nominal.scene.soil.stiffness * 3);
+  CHECK(stiff.scene.soil.damping == nominal.scene.soil.damping);
+  CHECK(with("delay_cycles", number(2)).scene.sensors.latency_cycles == 2);
+  CHECK(with("position_noise", number(1e-4)).scene.sensors.position_noise == exc::Vec4::Constant(1e-4));
+  // The open loop's: the integrator by its two names, the step with its cycle, the soil's damping ratio kept.
+  const SceneBundle rk4 = with("integrator", SweepValue{SweepValue::Type::name, 0, {}, "rk4/augmented_baumgarte"},
+                               SweepRun::open_loop);
+  CHECK(rk4.scene.integrator.method == exc::plant::IntegrationMethod::rk4);
+  CHECK(rk4.scene.integrator.formulation == exc::plant::Formulation::augmented_baumgarte);
+  const SceneBundle coarse = with("integrator.step", number(5e-3), SweepRun::open_loop);
+  CHECK(coarse.scene.integrator.step == 5e-3);
+  CHECK(coarse.scene.cycle == 5e-3);
+  const SceneBundle clay = with("soil.stiffness", number(2.8e5), SweepRun::open_loop);
+  CHECK(clay.scene.soil.stiffness.x() == doctest::Approx(2.8e5));
+  CHECK(clay.scene.soil.damping.x() == doctest::Approx(nominal.scene.soil.damping.x() * 2));  // K x 4: B x 2
+}
+
+TEST_CASE("tools/sweep knobs: docs/sweeps.md has a row for every named knob, and names no other") {
+  const std::string doc = read_text_file(std::string(EXC_SOURCE_DIR) + "/docs/sweeps.md");
+  const std::string start = "| run | knob | range | what it sets |";
+  REQUIRE(doc.find(start) != std::string::npos);
+  std::set<std::string> documented, declared;
+  for (std::size_t line = doc.find('\n', doc.find(start)) + 1; doc.compare(line, 1, "|") == 0; line = doc.find('\n', line) + 1) {
+    const std::size_t cell = doc.find('|', line + 1) + 1;  // the second cell: the knob, in backquotes
+    const std::size_t open = doc.find('`', cell), close = doc.find('`', open + 1);
+    if (open < doc.find('|', cell)) documented.insert(doc.substr(open + 1, close - open - 1));
+  }
+  for (const SweepRun run : {SweepRun::closed_loop, SweepRun::open_loop})
+    for (const exc::sim::Knob& k : exc::sim::named_knobs(run)) declared.insert(k.name);
+  CHECK(documented == declared);
+}
+
+TEST_CASE("tools/excavator-sim sweep refuses at load a value the scene's readers refuse, exit 2, naming the spec's line and the setting's range, and runs the boundary") {
+  const exc::test::Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  const std::string head = "sweep:\n  scene: " + kDig + "\n  controllers: [pid]\n  duration: 0.05\n";
+  struct Bad {
+    std::string spec, at, field, reason;
+  };
+  // Before, delay_cycles took 0..100 and the plant read its sensors' 64-slot ring at a negative index.
+  const std::vector<Bad> bad = {
+      {head + "  variants:\n    - {name: late, delay_cycles: 64}\n", "64}", "sweep.variants[0].delay_cycles",
+       "is 64; allowed: a whole number in [0, 63] (sensors.latency_cycles"},
+      {head + "  grid:\n    delay_cycles: [0, 100]\n", "100]", "sweep.grid.delay_cycles[1]", "a whole number in [0, 63]"},
+      {head + "  cases: 2\n  perturbations:\n    delay_cycles: [0, 100]\n", "100]", "sweep.perturbations.delay_cycles[1]",
+       "a whole number in [0, 63]"},
+      {head + "  grid:\n    sensors.position_noise: [0.5]\n", "0.5]", "sweep.grid.sensors.position_noise[0]",
+       "allowed: a number in [0, 0.1]"},
+      // Within the knob's own range, but the rates it scales leave theirs: the controller's reader refuses.
+      {head + "  grid:\n    adaptation_scale: [1, 1.0e+6]\n", "1.0e+6]", "sweep.grid.adaptation_scale[1]",
+       "controller.adaptation_rate[2]: is 3e+17; allowed range [0, 1e+16]"},
+      {head + "  grid:\n    machine.hydraulics.bulk_modulus: [1.0e+3]\n", "1.0e+3]",
+       "sweep.grid.machine.hydraulics.bulk_modulus[0]", "allowed: a number in [1e+07, 5e+09] Pa"},
+      {head + "  grid:\n    sensors.latency: [1]\n", "[1]", "sweep.grid.sensors.latency", "is no knob"},
+  };
+  for (const Bad& b : bad) {
+    CAPTURE(b.spec);
+    std::ofstream(dir / "spec.yaml") << b.spec;
+    const exc::test::Run r = run_sim("sweep " + (dir / "spec.yaml").string() + " --quiet --out x.jsonl");
+    CAPTURE(r.err);
+    CHECK(r.status == 2);
+    const auto [line, column] = exc::test::place_of(b.spec, b.at);
+    CHECK(r.err.find((dir / "spec.yaml").string() + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
+                     b.field + ": ") != std::string::npos);
+    CHECK(r.err.find(b.reason) != std::string::npos);
+    CHECK_FALSE(fs::exists(r.dir / "x.jsonl"));  // no case ran
+  }
+  // The control: the ring's last slot is a valid delay, and the case runs with it.
+  std::ofstream(dir / "spec.yaml") << head + "  variants:\n    - {name: late, delay_cycles: 63}\n";
+  const exc::test::Run ok = run_sim("sweep " + (dir / "spec.yaml").string() + " --quiet --out x.jsonl");
+  REQUIRE_MESSAGE(ok.status == 0, ok.err);
+  const nlohmann::json line = nlohmann::json::parse(read_text_file(ok.dir / "x.jsonl"));
+  CHECK(line["set"]["delay_cycles"] == 63);
+  CHECK(line["pid"].contains("ok"));
+}
+
+TEST_CASE("tools/excavator-sim sweep and sweep-merge open each scene file and its machine file once per process, counted by strace") {
+  const exc::test::Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  fs::copy_file(EXC_MACHINE_FILE, dir / "machine.yaml");
+  std::ofstream(dir / "scene.yaml") << read_text_file(kDig) << "machine: machine.yaml\n";
+  std::ofstream(dir / "spec.yaml") << "sweep:\n  scene: scene.yaml\n  controllers: [pid, adaptive]\n  duration: 0.05\n"
+                                      "  cases: 3\n  perturbations: {model_mass: [-0.1, 0.1], delay_cycles: [0, 2]}\n"
+                                      "  grid: {machine.hydraulics.bulk_modulus: [3.0e+8, 1.0e+9]}\n";
+  for (const std::string command : {"sweep spec.yaml --quiet --out one.jsonl", "sweep-merge spec.yaml one.jsonl --out merged --no-charts"}) {
+    CAPTURE(command);
+    const std::string trace = (dir / "opens.txt").string();
+    const std::string cmd = "cd '" + dir.string() + "' && strace -f -qq -e trace=open,openat -o '" + trace + "' " +
+                            EXC_SIM_TOOL + " " + command + " > /dev/null 2>&1";
+    REQUIRE_MESSAGE(std::system(cmd.c_str()) == 0, "strace (Debian package strace, installed by tools/install-deps test)");
+    std::ifstream in(trace);
+    int scene = 0, machine = 0, lines = 0;
+    for (std::string line; std::getline(in, line); ++lines) {
+      if (line.find("ENOENT") != std::string::npos) continue;
+      scene += line.find("/scene.yaml\"") != std::string::npos;
+      machine += line.find("/machine.yaml\"") != std::string::npos;
+    }
+    CHECK(lines > 10);  // the trace is real: the loader and libraries are opened too
+    CHECK(scene == 1);
+    CHECK(machine == 1);
+  }
+  CHECK(nlohmann::json::parse(read_text_file(dir / "merged" / "sweep.json"))["merged"] == 6);
+}
