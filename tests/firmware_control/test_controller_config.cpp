@@ -2,6 +2,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "control/controller_config.hpp"
+#include "model/machine.hpp"
 #include "settings_error_check.hpp"
 
 using namespace exc;
@@ -13,7 +14,7 @@ namespace {
 void check_error(const std::string& yaml, const std::string& field, const std::string& at, const std::string& reason) {
   CAPTURE(yaml);
   try {
-    read_controller_config(settings::Document::parse(yaml, "scene.yaml"));
+    read_controller_config(settings::Document::parse(yaml, "scene.yaml"), reference_machine());
     FAIL("no error");
   } catch (const SettingsError& e) {
     exc::test::check_settings_error(e, "scene.yaml", yaml, field, at, reason);
@@ -23,7 +24,7 @@ void check_error(const std::string& yaml, const std::string& field, const std::s
 }  // namespace
 
 TEST_CASE("firmware/controller config: a scene without controller gets the embedded defaults") {
-  const ControllerConfig c = read_controller_config(settings::Document::parse("name: x", "scene.yaml"));
+  const ControllerConfig c = read_controller_config(settings::Document::parse("name: x", "scene.yaml"), reference_machine());
   const ControllerConfig d;
   CHECK(c.kind == ControllerKind::adaptive);
   CHECK(c.gains.kp == d.gains.kp);
@@ -53,7 +54,7 @@ controller:
   actuator_lag_target: 0.006
   integral_action: true
   lyapunov_q_integral: [1, 2, 3, 4]
-)", "scene.yaml"));
+)", "scene.yaml"), reference_machine());
   CHECK(c.kind == ControllerKind::slotine_li);
   CHECK(c.period == 0.002);
   CHECK(c.filter.period == 0.002);
