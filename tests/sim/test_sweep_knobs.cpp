@@ -184,7 +184,7 @@ TEST_CASE("tools/excavator-sim sweep refuses at load a value the scene's readers
        "allowed: a number in [0, 0.1]"},
       // Within the knob's own range, but the rates it scales leave theirs: the controller's reader refuses.
       {head + "  grid:\n    adaptation_scale: [1, 1.0e+6]\n", "1.0e+6]", "sweep.grid.adaptation_scale[1]",
-       "controller.adaptation_rate[2]: is 3e+17; allowed range [0, 1e+16]"},
+       "controller.adaptation_rate[2]: is 1e+17; allowed range [0, 1e+16]"},  // the valves' derived 1e11 x 1e6
       {head + "  grid:\n    machine.hydraulics.bulk_modulus: [1.0e+3]\n", "1.0e+3]",
        "sweep.grid.machine.hydraulics.bulk_modulus[0]", "allowed: a number in [1e+07, 5e+09] Pa"},
       {head + "  grid:\n    sensors.latency: [1]\n", "[1]", "sweep.grid.sensors.latency", "is no knob"},
