@@ -33,6 +33,9 @@ ChamberFlows chamber_flows(const ChamberValves& v, double p, double& dnet_dp) {
     q.relief = v.relief_gain * (p - v.relief_setting);
     dnet_dp -= v.relief_gain;
   }
+  q.leakage = v.leakage_gain * (p - v.tank);
+  dnet_dp -= v.leakage_gain;
+  q.cross = v.cross_inflow;
   return q;
 }
 

@@ -4,10 +4,11 @@
 // couple the pressure to itself (beta / V * dQ/dp reaches 1e4 1/s). It is integrated by backward
 // Euler in the chamber's own pressure, with the piston's swept volume from the mechanical step:
 //   V1 / beta (p1 - p0) = dt Q(p1) - dV
-// Every element's net inflow Q(p) (meter-in, make-up, minus meter-out, minus relief) is
-// non-increasing in p, so the left side minus the right is strictly increasing in p1: one root,
-// found by Newton's method safeguarded by bisection once bracketed. Unconditionally stable, no
-// overshoot past a relief setting or below the make-up valve's tank pressure.
+// Every element's net inflow Q(p) (meter-in, make-up, minus meter-out, minus relief, minus leakage to
+// tank; the leakage across the piston is fixed over the substep) is non-increasing in p, so the left
+// side minus the right is strictly increasing in p1: one root, found by Newton's method safeguarded
+// by bisection once bracketed. Unconditionally stable, no overshoot past a relief setting or below
+// the make-up valve's tank pressure.
 // The alternative (integrator.pressure_method forward_euler) takes the flows at the start pressure:
 //   V1 / beta (p1 - p0) = dt Q(p0) - dV
 // one flow evaluation, no solve. It overshoots a valve that opens within the step (a make-up valve
@@ -44,11 +45,19 @@ struct ChamberValves {
   double relief_setting = 0;  // Pa
   double relief_gain = 0;     // m^3/s/Pa
   double laminar = 0;         // Pa, orifices are linear below this drop
+  // Internal leakage, laminar: to tank past the centred spool (and a swing motor's case drain),
+  // Q = leakage_gain (p - tank); and across the piston from the other chamber, a flow fixed over the
+  // substep (from the starting pressures: hydraulics.cpp, piston_leakage_flow), which couples the two
+  // chambers' solves no further.
+  double leakage_gain = 0;    // m^3/(s Pa)
+  double cross_inflow = 0;    // m^3/s, signed, into this chamber
 };
 
 struct ChamberFlows {
   double meter_in = 0, meter_out = 0, makeup = 0, relief = 0;  // m^3/s, each >= 0 except meter_out (signed, out)
-  double net() const { return meter_in + makeup - meter_out - relief; }
+  double leakage = 0;         // m^3/s to tank, signed (negative: from tank, below tank pressure)
+  double cross = 0;           // m^3/s across the piston into this chamber, signed
+  double net() const { return meter_in + makeup - meter_out - relief - leakage + cross; }
 };
 
 // Flows at pressure p; dnet_dp (<= 0) is the derivative of the net inflow.

@@ -11,7 +11,9 @@
 //   meter-out Q_out = K_out a sqrt(p - p_tank)
 //   make-up   Q_mk  = K_mk sqrt(p_tank - p) while p < p_tank
 //   relief    Q_r   = K_r (p - p_setting) above the port relief's setting
-//   chambers  dp_A/dt = beta / V_A (Q_A - A_A v),  dp_B/dt = beta / V_B (Q_B + A_B v)
+//   leakage   Q_l   = C_s (p - p_tank) to tank past the centred spool (swing: plus its case drain),
+//             Q_x   = C_p (p_A - p_B) across the piston (swing: cross-port), held over the substep
+//   chambers  dp_A/dt = beta / V_A (Q_A - Q_x - A_A v),  dp_B/dt = beta / V_B (Q_B + Q_x + A_B v)
 //   effort    F = p_A A_A - p_B A_B  (swing: T = D (p_A - p_B), D the displacement at the swing axis)
 // (orifices are linear below the laminar pressure). Cylinder areas, the swing displacement and the
 // valve gains are the machine's hydraulic geometry (model/hydraulic_geometry.hpp: effort limits at
@@ -43,8 +45,9 @@ struct HydraulicEnergy {
   double volume_term = 0;           // p0^2 / (2 beta) dV: the linear oil spring's term for a chamber
                                     // whose volume changes (it is not a state function then)
   double meter_in_loss = 0, meter_out_loss = 0, relief_loss = 0, makeup_loss = 0;
+  double leakage_loss = 0;          // internal leakage: across the pistons and to tank past the spools
   double piston_work = 0;           // sum of p dV of the moving chambers (the actuators' work on the machine)
-  double losses() const { return meter_in_loss + meter_out_loss + relief_loss + makeup_loss; }
+  double losses() const { return meter_in_loss + meter_out_loss + relief_loss + makeup_loss + leakage_loss; }
   // What entered the circuit from outside the machine's mechanism, net of its losses.
   double supplied() const { return pump_work + tank_work + vapour_work + volume_term - losses(); }
 };
@@ -59,6 +62,8 @@ struct HydraulicReport {
   Vec4 meter_out_flow = Vec4::Zero();
   Vec4 makeup_flow = Vec4::Zero();    // both chambers of the function together
   Vec4 relief_flow = Vec4::Zero();
+  Vec4 leakage_flow = Vec4::Zero();         // to tank past the spool (swing: and the case drain), both chambers
+  Vec4 piston_leakage_flow = Vec4::Zero();  // A -> B across the piston (swing: cross-port)
   std::int64_t relief_substeps = 0;     // substeps with any relief flow
   std::int64_t saturated_substeps = 0;  // substeps with a pump's demand above its flow
   std::int64_t cavitation_substeps = 0; // substeps with a chamber held at the vapour floor
@@ -114,6 +119,7 @@ class HydraulicCircuit {
   double volume_a(int i, const Vec4& q_a) const;
   double volume_b(int i, const Vec4& q_a) const;
   void update_pump_report(const Vec4& load_a, const Vec4& load_b);
+  double piston_leakage_flow(double coefficient, double dp, double volume_a, double volume_b, double dt) const;
 
   HydraulicParameters hp_;
   PressureMethod pressures_ = PressureMethod::backward_euler;

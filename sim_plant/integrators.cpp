@@ -130,6 +130,7 @@ Evaluation Integrator::evaluate_independent(Workspace& ws, const SoilModel& soil
   mass_matrix(*model_, ws, M_a);
   bias_forces(*model_, ws, h_a);
   const Mat2 M_t = e.load.added_mass.asDiagonal();
+  last_mass_ = M_a;
   last_effective_mass_ = M_a + ws.J_t.transpose() * M_t * ws.J_t;
   last_J_t_ = ws.J_t;
   const Vec4 b = tau_a - h_a - ws.J_t.transpose() * (e.load.force + M_t * ws.rhodd_bias);

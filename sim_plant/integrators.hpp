@@ -85,6 +85,9 @@ class Integrator {
   // Tip position, velocity and the tree poses/twists (for energy) at s, without dynamics.
   ModelReport kinematics(Workspace& ws, const MechanicalState& s, Vec2& rho, Vec2& rhod);
 
+  // M_a of the independent formulation's last evaluation (semi-implicit Euler: the step's start).
+  const Mat4& mass_matrix_a() const { return last_mass_; }
+
   // Forget the cached loop closure (call when something else wrote the workspace).
   void invalidate_cache() { cache_valid_ = false; }
 
@@ -108,6 +111,7 @@ class Integrator {
   ModelReport cached_report_;
   IntegratorSettings settings_;
   Mat4 last_effective_mass_ = Mat4::Identity();  // M_a + J_t^T M_t J_t of the last evaluation
+  Mat4 last_mass_ = Mat4::Identity();            // M_a of the last evaluation
   Mat2x4 last_J_t_ = Mat2x4::Zero();
 };
 

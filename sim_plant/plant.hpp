@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <string>
 
+#include "model/actuator_friction.hpp"
 #include "model/workspace.hpp"
 #include "sim_plant/actuators.hpp"
 #include "sim_plant/integrators.hpp"
@@ -41,7 +42,9 @@ struct PlantState {
   double constraint_residual = 0;  // m, |h(q)|
   int end_stop_events = 0;         // substeps at which an end stop or a speed limit acted
   double end_stop_loss = 0;        // J the end stops' impacts and the speed limits took (inelastic), in the energy balance
-  double friction_loss = 0;        // J the hydraulic machine's seal friction took (in the energy balance)
+  double friction_loss = 0;        // J the hydraulic machine's friction took, viscous and dry (in the energy balance)
+  unsigned friction_stuck = 0;     // hydraulic: bit i set while function i is held by its static friction
+  int friction_sweeps = 0;         // hydraulic: Gauss-Seidel sweeps of the last substep's dry friction
   int implicit_iterations = 0;     // of the last substep (implicit_midpoint)
 };
 
@@ -79,6 +82,7 @@ class Plant {
  private:
   bool accept_command(const ActuatorCommand& command);
   bool apply_limits(const Vec4& qd_start);
+  Vec4 apply_dry_friction(const MechanicalState& before);
   void account_work(const Vec4& tau, const MechanicalState& before, const Evaluation& start, const Vec2& rho1,
                     const Vec2& rhod1);
   void fill_state(const Evaluation& last);
@@ -94,6 +98,8 @@ class Plant {
   PlantState state_;
   PlantStatus status_;
   Vec4 hold_effort_ = Vec4::Zero();
+  ActuatorFriction friction_;  // hydraulic: the machine's friction (model/actuator_friction.hpp)
+  Vec4 dry_impulse_ = Vec4::Zero();  // the last substep's dry-friction impulses (the next one's first guess)
   Vec4 q_min_, q_max_, speed_max_;
   int substeps_ = 1;
   double energy0_ = 0, work_abs_ = 0;

@@ -201,8 +201,17 @@ void FirmwareNode::scan_state(SubnormalScan& scan) const {
   scan.scan("law rho", out_.rho);
   scan.scan("law rho_env", out_.rho_env);
   scan.scan("law velocity (flow law)", out_.velocity);
+  scan.scan("law disturbance (observer)", out_.disturbance);
+  scan.scan("law tip_force", out_.tip_force);
   if (const auto* pid = dynamic_cast<const control::ComputedTorquePid*>(controller_.get()))
     scan.scan("pid integral", pid->pid().integral());
+  if (const auto* a = dynamic_cast<const control::AdaptiveComputedTorque*>(controller_.get())) {
+    scan.scan("adaptive observer estimate", a->observer_estimate());
+    scan.scan("adaptive identification covariance", a->identification_covariance());
+    scan.scan("adaptive regression filter", a->regression_filtered());
+    scan.scan("adaptive tip filter chain", a->tip_chain());
+    scan.scan("adaptive anchor tip filter", a->tip_filtered());
+  }
   // The stages after the law: the actuator-lag lead and the valve stage.
   scan.scan("actuator-lag lead delivered effort", lag_compensator_.delivered());
   const control::ValveCommand& v = valves_.last();

@@ -71,6 +71,12 @@ class AdaptiveComputedTorque final : public Controller {
   // Gamma of V (the inverse of the adaptation rates; a zero rate gives an infinite weight, so V is
   // reported with that parameter's term left out).
   Vec6 gamma() const;
+  // The composite update's memory (the subnormal scan reads it: it decays while the machine holds).
+  const Vec4& observer_estimate() const { return observer_.estimate(); }
+  const Mat6& identification_covariance() const { return identification_.covariance(); }
+  const Eigen::Matrix<double, 12, 1>& regression_filtered() const { return regression_filter_.value(); }
+  const Eigen::Matrix<double, 16, 1>& tip_chain() const { return tip_chain_; }
+  const Vec2& tip_filtered() const { return tip_filtered_; }
 
  private:
   const Model& model_;

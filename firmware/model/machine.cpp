@@ -158,6 +158,20 @@ void read_hydraulics(SectionReader& h, HydraulicParameters& p, double relief_pre
   h.numbers("dead_zone_retract", p.dead_zone_retract, {0, 0.9}, "", "of the spool stroke, swing, boom, arm, bucket");
   h.numbers("viscous_friction", p.viscous_friction, {0, 1e7}, "",
             "seal friction: N m s/rad (swing), N s/m (cylinders); it damps a held machine's oil columns");
+  h.numbers("seal_preload", p.seal_preload, {0, 1e6}, "", "Coulomb friction at zero pressure: N m (swing), N (cylinders)");
+  h.numbers("seal_pressure_friction", p.seal_pressure_friction, {0, 1e-2}, "",
+            "Coulomb friction per Pa of p_A + p_B: N m/Pa (swing), N/Pa (cylinders)");
+  h.number("breakaway_ratio", p.breakaway_ratio, {1, 3}, "", "static over Coulomb friction (the Stribeck peak)");
+  h.numbers("stribeck_velocity", p.stribeck_velocity, {1e-4, 1}, "",
+            "speed over which the Stribeck peak decays: rad/s (swing), m/s (cylinders)");
+  h.number("swing_breakaway_pressure", p.swing_breakaway_pressure, {0, 20e6}, "Pa",
+           "the swing motor's breakaway pressure: its static friction over its displacement");
+  h.numbers("piston_leakage", p.piston_leakage, {0, 1e-9}, "m^3/(s Pa)",
+            "laminar leakage A <-> B across each piston (swing: cross-port)");
+  h.numbers("spool_leakage", p.spool_leakage, {0, 1e-9}, "m^3/(s Pa)",
+            "laminar leakage from each chamber to tank through its centred spool");
+  h.number("swing_drain_leakage", p.swing_drain_leakage, {0, 1e-9}, "m^3/(s Pa)",
+           "laminar leakage from each swing-motor port to its case drain");
   h.finish();
 }
 
@@ -235,6 +249,16 @@ Machine load_machine_from_string(const std::string& yaml, const std::string& fil
 }
 
 Machine load_machine(const std::string& path) { return read_machine(settings::Document::load(path)); }
+
+HydraulicParameters without_dry_friction_and_leakage(HydraulicParameters p) {
+  p.seal_preload.setZero();
+  p.seal_pressure_friction.setZero();
+  p.swing_breakaway_pressure = 0;
+  p.piston_leakage.setZero();
+  p.spool_leakage.setZero();
+  p.swing_drain_leakage = 0;
+  return p;
+}
 
 void validate_hydraulics(const Machine& machine) {
   // The same declarations over no file: every value is checked as a default is.

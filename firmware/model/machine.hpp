@@ -102,8 +102,41 @@ struct HydraulicParameters {
   // Viscous friction of the cylinders' seals and the swing's drive (N s/m; swing N m s/rad): what
   // damps a held machine's oil columns (estimate: 2-3 % of their critical damping at the dig pose,
   // where they ring at 0.4, 3, 7.5 and 23 Hz; a few kN at working speeds, well under the Coulomb
-  // friction of real seals, which this model leaves out). Range [0, 1e7].
+  // friction of real seals, the Coulomb terms below). Range [0, 1e7].
   Vec4 viscous_friction = (Vec4() << 2e4, 1e5, 3e4, 1e4).finished();
+
+  // Coulomb friction with a Stribeck peak (model/actuator_friction.hpp), per function:
+  //   F = Fc (1 + (breakaway_ratio - 1) exp(-|v| / stribeck_velocity)) sign(v) + viscous_friction v,
+  //   Fc = seal_preload + seal_pressure_friction (p_A + p_B)  (+ the swing's breakaway, below).
+  // Seal preload, N (cylinders; the swing N m): 20 N per cylinder (hydraulics.md's published
+  // excavator model), the boom's two cylinders 40 N; the swing's friction is its breakaway pressure's.
+  // Range [0, 1e6].
+  Vec4 seal_preload = (Vec4() << 0, 40, 20, 20).finished();
+  // N/Pa (swing N m/Pa): seal friction growing with the chamber pressures, 1e-4 N/Pa per cylinder
+  // (hydraulics.md: about 3.4 kN at p_A + p_B = 34 MPa), the boom's pair 2e-4. Range [0, 1e-2].
+  Vec4 seal_pressure_friction = (Vec4() << 0, 2e-4, 1e-4, 1e-4).finished();
+  // Static over Coulomb friction, Kbrk (1.2, hydraulics.md). Range [1, 3].
+  double breakaway_ratio = 1.2;
+  // m/s (swing rad/s): the Stribeck velocity over which the breakaway peak decays to Fc (0.01 m/s,
+  // hydraulics.md; the swing's 0.01 rad/s an estimate). Range [1e-4, 1].
+  Vec4 stribeck_velocity = Vec4::Constant(0.01);
+  // Pa: the swing motor's breakaway pressure (3.2-3.8 MPa on 20-36 t machines, field tests,
+  // hydraulics.md): the swing's static friction torque is this times its displacement D.
+  // Range [0, 20e6].
+  double swing_breakaway_pressure = 3.5e6;
+
+  // Internal leakage, laminar, m^3/(s Pa), per function (swing, boom, arm, bucket):
+  // A <-> B across each piston (the swing motor: cross-port), 1e-16 per piston seal of a new machine
+  // (hydraulics.md: 1e-16 to 1e-14 from new to worn; the boom's two pistons 2e-16); the swing's from
+  // its volumetric efficiency (docs/plant.md, "Friction and leakage"). Range [0, 1e-9].
+  Vec4 piston_leakage = (Vec4() << 1.9e-12, 2e-16, 1e-16, 1e-16).finished();
+  // Each chamber to tank through its centred spool's clearance: chosen so that a held boom with a
+  // 1050 kg bucket load and no firmware creeps 2 mm/min, the new-machine drift of safety.md (derived in
+  // docs/plant.md). Range [0, 1e-9].
+  Vec4 spool_leakage = Vec4::Constant(5.0e-14);
+  // Each swing-motor port to the motor's case drain (tank), m^3/(s Pa) (docs/plant.md: with the
+  // cross-port leakage, a volumetric efficiency of 95 % at 34.3 MPa and full swing speed). Range [0, 1e-9].
+  double swing_drain_leakage = 1.9e-12;
 };
 
 struct Machine {
@@ -146,6 +179,9 @@ Machine reference_machine();
 // The built-in machine's file as it was compiled in (what a sweep's digest covers for scenes without
 // a machine file).
 const char* reference_machine_text();
+// The hydraulics without dry friction and internal leakage, viscous friction kept: the machine as it
+// was modelled before them, for comparisons (the fidelity chart) and for tests of one element.
+HydraulicParameters without_dry_friction_and_leakage(HydraulicParameters p);
 // Checks hydraulics built or changed in C++ against the ranges the machine file's reader declares
 // (SettingsError naming machine.source and the field, e.g. "hydraulics.pump_flow").
 void validate_hydraulics(const Machine& machine);

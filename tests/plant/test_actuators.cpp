@@ -47,14 +47,17 @@ TEST_CASE("plant/limited actuator clamps efforts to the relief limits (area x 34
   // Two 120 mm boom cylinders at 34.3 MPa push ~776 kN; the arm's 95 mm-rod annulus pulls ~248 kN.
   const double boom_push = 2 * M_PI / 4 * 0.120 * 0.120 * 34.3e6;
   const double arm_pull = M_PI / 4 * (0.135 * 0.135 - 0.095 * 0.095) * 34.3e6;
-  CHECK(a.effort(kMid)[0] == doctest::Approx(65000));
-  CHECK(a.effort(kMid)[1] == doctest::Approx(boom_push).epsilon(0.002));
-  CHECK(a.effort(kMid)[2] == doctest::Approx(-arm_pull).epsilon(0.002));
-  CHECK(a.effort(kMid)[3] == doctest::Approx(m.bucket.max_force));
+  CHECK(a.effort(kMid)[0] == doctest::Approx(65000).scale(0));
+  CHECK(a.effort(kMid)[1] == doctest::Approx(boom_push).epsilon(0.002).scale(0));
+  CHECK(a.effort(kMid)[2] == doctest::Approx(-arm_pull).epsilon(0.002).scale(0));
+  CHECK(a.effort(kMid)[3] == doctest::Approx(m.bucket.max_force).scale(0));
 }
 
 TEST_CASE("plant/hydraulic closed valve: the chamber pressure follows the oil spring dp/dt = -beta A v / V") {
+  // Trapped oil alone: the machine's internal leakage (a laminar drain, tested on its own in
+  // test_friction_leakage.cpp) is left out of this closed form.
   Machine m = reference_machine();
+  m.hydraulics = without_dry_friction_and_leakage(m.hydraulics);
   m.hydraulics.bulk_modulus = 1.2e9;
   const HydraulicParameters& h = m.hydraulics;
   ActuatorParameters p;
@@ -75,11 +78,11 @@ TEST_CASE("plant/hydraulic closed valve: the chamber pressure follows the oil sp
     const double Va = h.dead_volume + Aa * (kMid[i] - m.q_min()[i]);
     const double Vb = h.dead_volume + Ab * (m.q_max()[i] - kMid[i]);
     (void)stroke;
-    CHECK(a.pressure_a()[i] == doctest::Approx(pa0[i] - 1.2e9 * Aa * v[i] * 0.02 / Va).epsilon(1e-9));
-    CHECK(a.pressure_b()[i] == doctest::Approx(pb0[i] + 1.2e9 * Ab * v[i] * 0.02 / Vb).epsilon(1e-9));
+    CHECK(a.pressure_a()[i] == doctest::Approx(pa0[i] - 1.2e9 * Aa * v[i] * 0.02 / Va).epsilon(1e-9).scale(0));
+    CHECK(a.pressure_b()[i] == doctest::Approx(pb0[i] + 1.2e9 * Ab * v[i] * 0.02 / Vb).epsilon(1e-9).scale(0));
   }
   // The effort is the pressure difference times the areas.
-  CHECK(a.effort(kMid)[1] == doctest::Approx(a.area_a()[1] * a.pressure_a()[1] - a.area_b()[1] * a.pressure_b()[1]));
+  CHECK(a.effort(kMid)[1] == doctest::Approx(a.area_a()[1] * a.pressure_a()[1] - a.area_b()[1] * a.pressure_b()[1]).scale(0));
 }
 
 TEST_CASE("plant/hydraulic spool follows its first-order lag") {
@@ -101,10 +104,10 @@ TEST_CASE("plant/orifice flow is continuous at the laminar limit") {
   double f1, d1, f2, d2;
   orifice_flow(0.2e6 * (1 - 1e-9), 0.2e6, f1, d1);
   orifice_flow(0.2e6 * (1 + 1e-9), 0.2e6, f2, d2);
-  CHECK(f1 == doctest::Approx(f2).epsilon(1e-6));
-  CHECK(f2 == doctest::Approx(std::sqrt(0.2e6)).epsilon(1e-6));
+  CHECK(f1 == doctest::Approx(f2).epsilon(1e-6).scale(0));
+  CHECK(f2 == doctest::Approx(std::sqrt(0.2e6)).epsilon(1e-6).scale(0));
   orifice_flow(-4e6, 0.2e6, f1, d1);
-  CHECK(f1 == doctest::Approx(-2000.0));
+  CHECK(f1 == doctest::Approx(-2000.0).scale(0));
 }
 
 TEST_CASE("plant/hydraulic plant holds its load with closed valves and extends the boom when opened") {
@@ -165,7 +168,7 @@ TEST_CASE("plant/limited actuator with lag 0 acts in the cycle it is sent: the s
   c.value = fresh.hold_effort();
   c.value[0] = 2e4;
   REQUIRE(fresh.step(c).ok());
-  CHECK(fresh.state().qd_a[0] == doctest::Approx(1e-3 * 2e4 / inertia).epsilon(1e-6));
+  CHECK(fresh.state().qd_a[0] == doctest::Approx(1e-3 * 2e4 / inertia).epsilon(1e-6).scale(0));
 }
 
 TEST_CASE("plant/limited actuator with lag tau: the swing's speed is the impulse of exactly T (1 - exp(-t / tau))") {
@@ -186,10 +189,10 @@ TEST_CASE("plant/limited actuator with lag tau: the swing's speed is the impulse
     const double time = k * h;
     const double expected = T / inertia * (time - tau * (1.0 - std::exp(-time / tau)));
     CAPTURE(k);
-    CHECK(p.state().qd_a[0] == doctest::Approx(expected).epsilon(1e-6));
+    CHECK(p.state().qd_a[0] == doctest::Approx(expected).epsilon(1e-6).scale(0));
   }
   // The effort reported is the one that acted over the last step: the lag's mean over that step.
   const double t1 = 0.2, t0 = t1 - h;
   const double mean = T * (1.0 - tau / h * (std::exp(-t0 / tau) - std::exp(-t1 / tau)));
-  CHECK(p.state().effort[0] == doctest::Approx(mean).epsilon(1e-9));
+  CHECK(p.state().effort[0] == doctest::Approx(mean).epsilon(1e-9).scale(0));
 }

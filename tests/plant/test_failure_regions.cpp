@@ -119,15 +119,15 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
                                  << moved.tail<3>().transpose() << " m of " << asked.tail<3>().transpose()
                                  << "; firmware: " << r.pump_limited_cycles << " cycles asking more");
   CHECK(saturated > 1.0);
-  CHECK(mean_flow == doctest::Approx(pumps).epsilon(0.03));
+  CHECK(mean_flow == doctest::Approx(pumps).epsilon(0.03).scale(0));
   for (int j = 1; j < 4; ++j) {
     CAPTURE(j);
     CHECK(moved[j] / asked[j] > 0);
     CHECK(moved[j] / asked[j] < 0.97);  // every function behind its path
   }
   // The run counts it on both sides: the plant's time short of flow, the firmware's cycles.
-  CHECK(r.flow_saturated_seconds == doctest::Approx(saturated).epsilon(1e-9));
-  CHECK(static_cast<double>(r.pump_limited_cycles) * dt == doctest::Approx(saturated).epsilon(0.2));
+  CHECK(r.flow_saturated_seconds == doctest::Approx(saturated).epsilon(1e-9).scale(0));
+  CHECK(static_cast<double>(r.pump_limited_cycles) * dt == doctest::Approx(saturated).epsilon(0.2).scale(0));
   // The firmware's warning: raised once within 0.1 s of the pumps falling short, cleared once after.
   const std::vector<exlcm::fault_t> faults = faults_in(log_path);
   fs::remove(log_path);
@@ -143,7 +143,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   CHECK(warnings[0].utime * 1e-6 >= first - 0.1);
   CHECK(warnings[0].utime * 1e-6 <= first + 0.1);
   CHECK_FALSE(warnings[1].active);
-  CHECK(warnings[1].utime * 1e-6 == doctest::Approx(last).epsilon(0.05));
+  CHECK(warnings[1].utime * 1e-6 == doctest::Approx(last).epsilon(0.05).scale(0));
   CHECK(r.safe_stops == 0);
 }
 
@@ -253,7 +253,7 @@ TEST_CASE("firmware/relief in hard digging: on a rock the arm's bore side peaks 
   MESSAGE("arm bore side peak " << peak * 1e-6 << " MPa at " << v_at_peak << " m/s (closed form " << expected * 1e-6
                                 << " MPa); relief open " << r.relief_seconds << " s; " << r.failure);
   CHECK(v_at_peak < -0.05);  // pushed back by the rock
-  CHECK(peak == doctest::Approx(expected).epsilon(0.003));
+  CHECK(peak == doctest::Approx(expected).epsilon(0.003).scale(0));
   // The run's highest chamber: this one, or the bucket's bore side, which meets the rock too and is
   // pushed back through its own port relief (by the same law) for an instant at the rock's onset.
   CHECK(r.peak_pressure >= peak);
@@ -328,16 +328,16 @@ TEST_CASE("firmware/a boom valve stuck half open: the boom runs at the opening's
                       << q_stop << " m; end stop at " << t_end_stop << " s (closed form " << predicted_end
                       << "); bore side " << end.pressure_a[1] * 1e-6 << " MPa at the end; the closed forms' error at the stop "
                       << e_stick + predicted_error << " m");
-  CHECK(v_before == doctest::Approx(v_stuck).epsilon(0.05));
+  CHECK(v_before == doctest::Approx(v_stuck).epsilon(0.05).scale(0));
   REQUIRE(node.safe_stops() == 1);
   CHECK(node.last_fault() == app::FirmwareFault::tracking_error);
   CHECK(std::string(node.last_fault_text()).find("boom") != std::string::npos);
   const double limit = b.firmware.controller.tracking_error_limit[1];
-  CHECK(e_stick + predicted_error == doctest::Approx(limit).epsilon(0.05));  // stopped where the error met it
+  CHECK(e_stick + predicted_error == doctest::Approx(limit).epsilon(0.05).scale(0));  // stopped where the error met it
   CHECK(others_max < 1e-3);  // the safe state centred the other spools (within 0.2 s: 30 ms lag) ...
   CHECK(end.spool[1] == stuck);  // ... not the stuck one
-  CHECK(t_end_stop == doctest::Approx(predicted_end).epsilon(0.05));
-  CHECK(end.q_a[1] == doctest::Approx(m.boom.max_length));
-  CHECK(end.pressure_a[1] == doctest::Approx(m.hydraulics.main_relief_pressure).epsilon(1e-3));
+  CHECK(t_end_stop == doctest::Approx(predicted_end).epsilon(0.05).scale(0));
+  CHECK(end.q_a[1] == doctest::Approx(m.boom.max_length).scale(0));
+  CHECK(end.pressure_a[1] == doctest::Approx(m.hydraulics.main_relief_pressure).epsilon(1e-3).scale(0));
   CHECK(end.q_a.allFinite());
 }

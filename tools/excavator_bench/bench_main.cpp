@@ -40,7 +40,39 @@ struct Options {
   std::string json_file;
   std::string scenes_dir = EXC_SOURCE_DIR "/scenes";
   bool plots = true;
+  std::string figures;  // where the README's charts go after a complete full run (docs/figures)
 };
+
+// The README's and docs' charts of a full run: the file in OUT, the name in the figures directory.
+const std::pair<const char*, const char*> kFigures[] = {
+    {"work_precision.png", "work_precision.png"},
+    {"pressure_integration.png", "pressure_integration.png"},
+    {"peer.png", "peer.png"},
+    {"fidelity.png", "fidelity.png"},
+    {"stability_step.png", "stability_step.png"},
+    {"stability_control.png", "stability_control.png"},
+    {"stability_valves/stability.png", "stability_valves.png"},
+    {"stability_hydraulic_gains/stability.png", "stability_hydraulic_gains.png"},
+};
+
+// Copies the charts of a complete run into `dir`, each named; false (and why on stderr) if one is
+// missing or cannot be written.
+bool copy_figures(const std::string& out, const std::string& dir) {
+  bool ok = true;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  for (const auto& [from, to] : kFigures) {
+    const fs::path src = fs::path(out) / from, dst = fs::path(dir) / to;
+    fs::copy_file(src, dst, fs::copy_options::overwrite_existing, ec);
+    if (ec) {
+      std::fprintf(stderr, "excavator-bench: cannot copy %s to %s: %s\n", src.c_str(), dst.c_str(), ec.message().c_str());
+      ok = false;
+    } else {
+      std::printf("figure: %s\n", dst.c_str());
+    }
+  }
+  return ok;
+}
 
 int run_bench(const Options& o) {
   const auto wall0 = std::chrono::steady_clock::now();
@@ -78,7 +110,8 @@ int run_bench(const Options& o) {
   write_pressure_csv(o.out + "/pressure_integration.csv", pressures);
 
   const double closed_duration = o.quick ? 1.0 : 0.0;  // 0: the scenes' own durations
-  const std::vector<FidelityRow> fidelity = fidelity_chart(scenes, closed_duration);
+  // Three runs of each variant (one with --quick) for the CPU time: the least is kept.
+  const std::vector<FidelityRow> fidelity = fidelity_chart(scenes, closed_duration, o.quick ? 1 : 3);
   write_fidelity_csv(o.out + "/fidelity.csv", fidelity);
 
   // The stability maps: sweep specs (sweeps/stability_*.yaml) through the sweep's shard and merge.
@@ -171,9 +204,10 @@ int run_bench(const Options& o) {
   std::printf("\nFidelity (closed loop, adaptive; tolerance: tip %.0f mm, forces %.0f %%, tracking %.0f mm):\n",
               kTipTolerance * 1e3, kForceTolerance * 100, kTrackingTolerance * 1e3);
   for (const FidelityRow& r : fidelity)
-    std::printf("  %-12s %-38s %s cpu %8.3g s/s tip %9.3g m force %8.3g tracking %9.3g %s\n", r.scene.c_str(),
-                r.fidelity.c_str(), r.ok ? "ok  " : "FAIL", r.cpu_per_s, r.tip_rms, r.force_rel, r.tracking,
-                r.recommended ? "<- recommended" : r.failure.substr(0, 70).c_str());
+    std::printf("  %-12s %-54s %s cpu %8.3g s/s (%5.1f %% of the reference's) tip %6.2f mm force %5.1f %% tracking "
+                "%6.2f mm %s%s\n", r.scene.c_str(), r.fidelity.c_str(), r.ok ? "ok  " : "FAIL", r.cpu_per_s,
+                100 * r.cost_ratio, 1e3 * r.tip_rms, 100 * r.force_rel, 1e3 * r.tracking_diff,
+                r.reference ? "(reference) " : "", r.recommended ? "<- recommended" : r.failure.substr(0, 70).c_str());
   std::printf("\nLargest stable step (plant checks) against soil stiffness and joint speed:\n");
   for (const StepStability& r : step_map)
     std::printf("  %-42s %-24s %10.3g  %s\n", r.method.c_str(), r.axis.c_str(), r.value,
@@ -200,6 +234,13 @@ int run_bench(const Options& o) {
       std::fprintf(stderr, "excavator-bench: the plotting script failed (%s); the CSV files are complete\n", cmd.c_str());
       complete = false;
     }
+  }
+  if (!o.figures.empty()) {
+    if (!complete)
+      std::fprintf(stderr, "excavator-bench: the run is incomplete (above): the figures in %s are left as they were\n",
+                   o.figures.c_str());
+    else
+      complete = copy_figures(o.out, o.figures);
   }
   std::printf("json: %s (%.1f s wall)\n", json_path.c_str(),
               std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count());
@@ -244,7 +285,12 @@ int main(int argc, char** argv) {
   app.add_option("--json", o.json_file, "write the summary JSON here (default: OUT/bench.json)");
   app.add_option("--scenes", o.scenes_dir, "directory holding free_motion.yaml and dig.yaml")->capture_default_str();
   bool no_plots = false;
-  app.add_flag("--no-plots", no_plots, "write the CSV files only");
+  auto* no_plots_flag = app.add_flag("--no-plots", no_plots, "write the CSV files only");
+  app.add_option("--figures", o.figures,
+                 "after a complete full run, copy the README's charts into this directory (docs/figures: the one "
+                 "command that regenerates them, docs/bench.md)")
+      ->excludes("--quick")
+      ->excludes(no_plots_flag);
   auto* exp = app.add_subcommand("export-mjcf", "write the machine as MJCF (MuJoCo XML), loops as connect equalities");
   std::string machine_file, xml_out = "-";
   std::vector<double> q_a;

@@ -187,6 +187,7 @@ ClosedLoopResult run_closed_loop(const BenchScene& s, const ClosedLoopVariant& v
     scene.soil = plant::SoilParameters{};
     scene.soil_preset = plant::SoilPreset::none;
   }
+  if (!v.dry_friction_and_leakage) scene.machine.hydraulics = without_dry_friction_and_leakage(scene.machine.hydraulics);
   if (v.massless_cylinders)
     for (int k : kCylinderBodies) {
       scene.machine.bodies[k].mass *= 1e-3;

@@ -73,6 +73,7 @@ struct ClosedLoopVariant {
   control::ControllerKind controller = control::ControllerKind::adaptive;
   plant::ActuatorFidelity fidelity = plant::ActuatorFidelity::ideal;
   bool soil = true;                 // false: soil removed from the scene
+  bool dry_friction_and_leakage = true;  // false: the hydraulic machine with viscous friction only (the old plant)
   bool massless_cylinders = false;  // cylinder bodies at 1e-3 of their mass (earlier works' model)
   double gain_scale = 1.0;          // omega_n of the error dynamics multiplied (kp x s^2, kv x s, ki x s^3)
   double adaptation_scale = 1.0;    // adaptation rates multiplied

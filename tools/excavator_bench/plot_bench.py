@@ -7,6 +7,7 @@ import csv
 import math
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -69,19 +70,52 @@ def work_precision(out):
 
 
 def fidelity(out):
-    data = [r for r in rows(os.path.join(out, "fidelity.csv")) if r["ok"] == "1"]
-    scenes = sorted({r["scene"] for r in data})
-    fig, axes = plt.subplots(1, max(1, len(scenes)), figsize=(7 * max(1, len(scenes)), 5), squeeze=False)
+    """Per scene, what a reader compares: each model variant's tip path, cylinder force and tracking
+    difference from the reference (the most complete model) against the tolerances, and its CPU time
+    as a share of the reference's. Linear axes: the reference is the zero of every difference, not a
+    point of its own."""
+    data = rows(os.path.join(out, "fidelity.csv"))
+    scenes = list(dict.fromkeys(r["scene"] for r in data))
+    panels = [("tip_rms_m", 1e3, "tip path vs the reference, mm RMS", 10.0),
+              ("force_rel", 100.0, "cylinder forces vs the reference, % RMS", 5.0),
+              ("tracking_diff", 1e3, "change of the worst tracking RMS, mm", 2.0),
+              ("cost_ratio", 100.0, "CPU time, % of the reference's", None)]
+    n = max(len([r for r in data if r["scene"] == scene]) for scene in scenes) if scenes else 1
+    fig, axes = plt.subplots(max(1, len(scenes)), len(panels), figsize=(20, 1.0 + (0.5 * n + 1.2) * max(1, len(scenes))),
+                             squeeze=False, sharey="row")
     for i, scene in enumerate(scenes):
-        ax = axes[0][i]
-        for r in (r for r in data if r["scene"] == scene):
-            x, y = num(r["cpu_s_per_sim_s"]), max(num(r["tip_rms_m"]), 1e-9)
-            style = "*" if r["recommended"] == "1" else ("o" if r["within_tolerance"] == "1" else "x")
-            ax.loglog([x], [y], style, ms=12 if style == "*" else 7,
-                      label=r["fidelity"] + (" (recommended)" if r["recommended"] == "1" else ""))
-        ax.axhline(0.01, color="grey", ls="--", lw=1, label="tolerance 10 mm")
-        decorate(ax, "CPU time per simulated second (s)", "tip path RMS against the most complete model (m)",
-                 f"fidelity: {scene}", legend=7)
+        sel = [r for r in data if r["scene"] == scene]
+        labels = [textwrap.fill(r["fidelity"] + (" [reference]" if r.get("reference") == "1" else "") +
+                                (" [recommended]" if r["recommended"] == "1" else ""), 34) for r in sel]
+        y = list(range(len(sel)))[::-1]
+        for j, (key, scale, name, tolerance) in enumerate(panels):
+            ax = axes[i][j]
+            values = [num(r[key]) * scale if r["ok"] == "1" else math.nan for r in sel]
+            colours = ["grey" if r.get("reference") == "1" else ("tab:green" if r["within_tolerance"] == "1" else "tab:red")
+                       for r in sel]
+            finite = [v for v in values if not math.isnan(v)]
+            top = max(finite + ([tolerance] if tolerance else []) + [1e-9])
+            ax.barh(y, [0 if math.isnan(v) else v for v in values], color=colours, height=0.6)
+            for yy, v, r in zip(y, values, sel):
+                if r["ok"] != "1":
+                    ax.text(0, yy, " failed: " + r["failure"][:40], va="center", fontsize=7, color="tab:red")
+                elif r.get("reference") == "1" and key != "cost_ratio":
+                    ax.text(0, yy, " 0: the reference", va="center", fontsize=7)
+                else:
+                    ax.text(v, yy, f" {v:.3g}", va="center", fontsize=7)
+            if tolerance:
+                ax.axvline(tolerance, color="black", ls="--", lw=1)
+                name += f" (dashed: tolerance {tolerance:g})"
+            else:
+                ax.axvline(100.0, color="black", ls=":", lw=1)
+            ax.set_xlim(0, 1.2 * top)
+            ax.set_yticks(y)
+            ax.set_yticklabels(labels, fontsize=8)
+            ax.set_xlabel(name, fontsize=8)
+            ax.grid(True, axis="x", alpha=0.3)
+            if j == 0:
+                ax.set_title(f"{scene} (closed loop, adaptive law): green within every tolerance, red outside one",
+                             loc="left", fontsize=9)
     save(fig, out, "fidelity.png")
 
 

@@ -199,9 +199,11 @@ std::string content_digest(const std::string& spec_text, const std::vector<std::
 
 SweepSpec load_sweep_spec(const std::string& path) {
   const settings::Document doc = settings::Document::load(path);
-  const YAML::Node raw = doc.root()["sweep"];
+  // The reader first: it refuses a file that is no mapping naming it (indexing a scalar root would
+  // throw yaml-cpp's own error, which names no file).
   SectionReader top(doc);
   SectionReader s = top.section("sweep", "the sweep's mapping", Need::required);
+  const YAML::Node raw = doc.root()["sweep"];
   SweepSpec spec;
   spec.file = path;
   // One scene, or several: case i runs scene i mod their number.

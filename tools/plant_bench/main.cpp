@@ -1,6 +1,7 @@
 // excavator-plant-bench: the plant's figures (README "Plant figures"). Build without EXC_TEST_BUILD
 // (Release) for meaningful times.
 #include <algorithm>
+#include <bitset>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -118,6 +119,12 @@ int main(int argc, char** argv) {
   app.add_option("--scene", scene_path, "the dig scene (default: scenes/dig.yaml)");
   app.add_option("--repeats", repeats, "runs of the dig scene for the real-time factors (best is reported)")
       ->check(exc::cli::count_in(1, 1000));
+  long profile_steps = 0;
+  app.add_option("--profile-steps", profile_steps,
+                 "only step the scene through its valves (its own pressure method) this many cycles, then print what "
+                 "the steps did: the run to count under valgrind --tool=callgrind "
+                 "--toggle-collect='exc::plant::Plant::step(*)' (docs/plant.md)")
+      ->check(exc::cli::count_in(1, 100000000));
   CLI11_PARSE(app, argc, argv);
 
   Scene base;
@@ -129,6 +136,34 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "excavator-plant-bench: %s\n", e.what());
     return 2;
+  }
+
+  if (profile_steps > 0) {
+    // One run, nothing else: under callgrind, Plant::step's inclusive count over its calls is the
+    // hydraulic step's cost in instructions.
+    Scene s = base;
+    s.actuators.fidelity = ActuatorFidelity::hydraulic;
+    const ValveDriver driver(task, s.machine);
+    Plant p(s);
+    ActuatorCommand c;
+    c.mode = ActuatorCommand::valve;
+    double iterations = 0, sweeps = 0, stuck = 0;
+    for (long k = 0; k < profile_steps; ++k) {
+      c.value = driver.opening(p.state().time, p.state());
+      if (!p.step(c).ok()) {
+        std::fprintf(stderr, "excavator-plant-bench: %s\n", p.status().text());
+        return 1;
+      }
+      iterations += p.state().hydraulics.solver_iterations;
+      sweeps += p.state().friction_sweeps;
+      stuck += std::bitset<4>(p.state().friction_stuck).count();
+    }
+    const double n = static_cast<double>(profile_steps);
+    std::printf("stepped %ld cycles of %s through its valves (%s pressures): per cycle %.2f chamber iterations, %.2f "
+                "dry-friction sweeps, %.2f functions held by their static friction\n",
+                profile_steps, s.name.c_str(), to_string(s.integrator.pressure_method), iterations / n, sweeps / n,
+                stuck / n);
+    return 0;
   }
 
   // The mechanics' cost: the scene with ideal force actuators, driven by the task's efforts.
