@@ -12,9 +12,11 @@ struct TipLoad {
   Vec2 added_mass = Vec2::Zero();
 };
 
-// Position, velocity and acceleration-bias level: loop closure, H, Psi, gamma, tree twists, and the
-// tip kinematics (rho, rhod, J_t, rhodd_bias). Every other function here needs it called first;
-// none of them needs the passive angles in ws.q (skipped: 8 atan2 fewer, ws.q's passive entries NaN).
+// Position, velocity and acceleration-bias level: loop closure, Psi, gamma, tree twists, and the
+// tip kinematics (rho, rhod, J_t, rhodd_bias); the general path also forms H. Every other function
+// here needs it called first; none of them needs the passive angles in ws.q (skipped: 8 atan2 fewer,
+// ws.q's passive entries NaN). update_closed_chain, mass_matrix and bias_forces take the path
+// model.closed_chain_path names (planar: planar_closed_chain.hpp; general: the passes below).
 ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q_a, const Vec4& qd_a,
                                 PassiveAngles angles = PassiveAngles::computed);
 
@@ -22,6 +24,10 @@ ModelReport update_closed_chain(const Model& model, Workspace& ws, const Vec4& q
 // inertial part) acting at the tip; also fills ws.F_c (eq. 7a). Needs update_closed_chain.
 void inverse_dynamics(const Model& model, Workspace& ws, const Vec4& qdd_a, const Vec2& f_soil,
                       Vec4& tau_a);
+
+// H (eq. 4) and H_p^-1 at the state of the last update_closed_chain, when that update did not form
+// them (the planar path; model.closed_chain_path): inverse_dynamics calls it for F_c.
+void ensure_loop_jacobian(const Model& model, Workspace& ws);
 
 // M_a = Psi^T M_r Psi (eq. 17). Needs update_closed_chain.
 void mass_matrix(const Model& model, Workspace& ws, Mat4& M_a);

@@ -2,7 +2,10 @@
 // joint conventions of docs/model.md (front pins turn about -y so a positive angle lifts x toward z).
 #include "model.hpp"
 
+#include <atomic>
+
 #include "lie_group.hpp"
+#include "planar_closed_chain.hpp"
 #include "model_status.hpp"
 #include "workspace.hpp"
 
@@ -68,8 +71,18 @@ Model build_model(const Machine& machine) {
 
   m.tip_in_bucket = in_plane(k.T);
   m.base_acceleration << 0, 0, 0, 0, 0, k.gravity;
+  m.closed_chain_path = closed_chain_path_preference() == ClosedChainPath::planar && has_planar_closed_chain_structure(m)
+                            ? ClosedChainPath::planar
+                            : ClosedChainPath::general;
   return m;
 }
+
+namespace {
+std::atomic<ClosedChainPath> g_closed_chain_path{ClosedChainPath::planar};
+}  // namespace
+
+void set_closed_chain_path_preference(ClosedChainPath path) { g_closed_chain_path = path; }
+ClosedChainPath closed_chain_path_preference() { return g_closed_chain_path; }
 
 const char* to_string(ModelStatus s) {
   switch (s) {
@@ -99,6 +112,16 @@ Workspace::Workspace(const Model& model) {
     origin[i].setZero();
     origin_d[i].setZero();
     origin_dd[i].setZero();
+  }
+}
+
+Workspace::PlanarLinks::PlanarLinks() {
+  for (int i = 0; i < kNumJoints; ++i) {
+    acceleration[i].setZero();
+    com[i].setZero();
+    J_angle[i].setZero();  // the columns a link's cylinders cannot move stay zero: the passes read them
+    J_origin[i].setZero();
+    J_com[i].setZero();
   }
 }
 

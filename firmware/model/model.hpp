@@ -11,6 +11,13 @@ struct LoopCut {
   Vec3 point_p, point_s;        // the pin, in the frame of P_l and of S_l
 };
 
+// How update_closed_chain, mass_matrix and bias_forces evaluate the closed chain (docs/model.md):
+// `planar`, straight-line code written for this machine's planar front and its four loops
+// (planar_closed_chain.hpp), or `general`, the Lie-group passes over any tree and the loop Jacobian
+// (the reference the planar code is tested against). build_model takes planar when the tree has
+// that structure and the process has not asked for general (set_closed_chain_path_preference).
+enum class ClosedChainPath { planar, general };
+
 struct Model {
   Machine machine;                         // the description it was built from
   std::array<int, kNumJoints> parent;      // JointIndex of lambda(k), -1 for the base
@@ -26,8 +33,14 @@ struct Model {
   std::array<LoopCut, kNumLoops> loops;
   Vec3 tip_in_bucket;                      // T in the bucket frame
   Vec6 base_acceleration;                  // Vd_0 = (0, 0, 0, 0, 0, +g): gravity (model.md s.3)
+  ClosedChainPath closed_chain_path = ClosedChainPath::general;
 };
 
 Model build_model(const Machine& machine);
+
+// The path the models built from now on take where the planar one applies (default planar). For
+// benches that measure both in one run and tests that compare them; set before building models.
+void set_closed_chain_path_preference(ClosedChainPath path);
+ClosedChainPath closed_chain_path_preference();
 
 }  // namespace exc

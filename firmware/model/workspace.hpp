@@ -62,6 +62,25 @@ struct Workspace {
   // loop, arm loop, bucket four-bar): the links common to both sides of a cut cancel.
   Mat8 Hp_inv = Mat8::Zero();
   Eigen::PartialPivLU<Mat8> lu_Hp;              // full factor of H_p (Newton loop closure)
+  // H and Hp_inv are those of the last update_closed_chain. The planar path does not form them (nor
+  // Hd_qd, J_tip_tree, tip_acc_tree, alpha, origin_dd, the general path's intermediates):
+  // ensure_loop_jacobian forms H and Hp_inv when they are needed (inverse_dynamics' F_c).
+  bool loop_jacobian_valid = false;
+
+  // The planar path's per-link buffers (planar_closed_chain.hpp), in tree order; in the swing plane
+  // (x, z) unless named otherwise. Columns k = 0..2 are the boom, arm and bucket cylinders' rates;
+  // a link's columns beyond those that can move it stay zero.
+  struct PlanarLinks {
+    std::array<double, kNumJoints> origin_y{};     // each origin's out-of-plane offset (the homes' y summed)
+    std::array<double, kNumJoints> alpha{};        // angular acceleration at qdd_a = 0 (qdd = gamma)
+    std::array<Vec2, kNumJoints> acceleration;     // origin's acceleration at qdd_a = 0
+    std::array<Vec2, kNumJoints> com;              // centre of mass
+    std::array<double, kNumJoints> com_y{};        // its out-of-plane offset
+    std::array<Vec3, kNumJoints> J_angle;          // d angle / d q_a (cylinder columns)
+    std::array<Eigen::Matrix<double, 2, 3>, kNumJoints> J_origin, J_com;  // d origin, d com / d q_a
+    bool jacobians_valid = false;                  // com, com_y, J_angle, J_origin, J_com
+    PlanarLinks();
+  } planar;
 };
 
 }  // namespace exc

@@ -8,6 +8,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -44,7 +45,9 @@ TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the
   REQUIRE(at != std::string::npos);
 
   std::vector<Row> rows;
-  std::istringstream lines(out.substr(at));
+  const std::size_t model_at = out.find("# One evaluation of the closed-chain model", at);
+  REQUIRE(model_at != std::string::npos);
+  std::istringstream lines(out.substr(at, model_at - at));  // the stage table only
   std::string line;
   while (std::getline(lines, line)) {
     if (line.rfind("| ", 0) != 0 || line.rfind("| stage", 0) == 0) continue;
@@ -108,5 +111,28 @@ TEST_CASE("tools/excavator-loop-bench --split: each stage within its caller, the
     CHECK(node_sum <= loop + 300);
     CHECK(node_sum >= 0.85 * loop);
   }
+
+  // One evaluation per node and path, counted in a child run of its own on random states: each
+  // node's planar count below its general one (the same states), and the two nodes' together near
+  // what the loop's own two evaluations per cycle counted above (other states: atan2 and the loop
+  // closure's branches cost a little more or less).
+  std::istringstream model_lines(out.substr(model_at));
+  std::vector<std::pair<double, double>> evaluations;  // (planar, general) per node
+  while (std::getline(model_lines, line)) {
+    if (line.rfind("| the ", 0) != 0) continue;
+    std::vector<std::string> cells;
+    for (std::size_t a = 2, b; (b = line.find(" | ", a)) != std::string::npos; a = b + 3) cells.push_back(line.substr(a, b - a));
+    REQUIRE(cells.size() == 3);
+    REQUIRE(cells[1].back() == 'k');
+    REQUIRE(cells[2].back() == 'k');
+    evaluations.emplace_back(std::stod(cells[1]) * 1e3, std::stod(cells[2]) * 1e3);
+  }
+  REQUIRE(evaluations.size() == 2);  // the firmware's, the plant's
+  for (const auto& [planar, general] : evaluations) {
+    CHECK(planar > 1e3);
+    CHECK(planar < general);
+  }
+  CHECK(std::abs(evaluations[0].first + evaluations[1].first - models) <= 0.15 * models);
+  CHECK(out.find("Goal: one evaluation in at most 7.1k instructions: ") != std::string::npos);
   fs::remove_all(dir);
 }

@@ -12,17 +12,8 @@
 extern char** environ;
 
 namespace exc::bench {
-namespace {
 
-// A stage: the functions whose inclusive counts it sums (substrings of callgrind_annotate's
-// "file:function" column; a template's instantiations all match).
-struct Stage {
-  const char* label;
-  int depth;
-  std::vector<const char*> functions;
-};
-
-const std::vector<Stage>& stages() {
+const std::vector<Stage>& loop_stages() {
   static const std::vector<Stage> s = {
       {"the loop (run_lockstep, start-up included)", 0, {"exc::sim::run_lockstep("}},
       {"firmware: SYNC and heartbeat (FirmwareNode::begin_cycle)", 1, {"exc::app::FirmwareNode::begin_cycle()"}},
@@ -53,6 +44,30 @@ const std::vector<Stage>& stages() {
   return s;
 }
 
+const std::vector<std::string>& loop_toggles() {
+  // Counted only inside the loop and the telemetry thread: the model functions also run while the
+  // scene loads (the effort-feasibility check), which is not a cycle's cost.
+  static const std::vector<std::string> t = {"exc::sim::run_lockstep*", "exc::telemetry::TelemetryPublisher::run*"};
+  return t;
+}
+
+const std::vector<Stage>& model_evaluation_stages() {
+  static const std::vector<Stage> s = {
+      {"the firmware's (passive angles skipped), planar path", 0, {"exc::bench::firmware_evaluations_planar("}},
+      {"the firmware's, general path (the code before)", 0, {"exc::bench::firmware_evaluations_general("}},
+      {"the plant's (with the 8 passive angles), planar path", 0, {"exc::bench::plant_evaluations_planar("}},
+      {"the plant's, general path (the code before)", 0, {"exc::bench::plant_evaluations_general("}},
+  };
+  return s;
+}
+
+const std::vector<std::string>& model_evaluation_toggles() {
+  static const std::vector<std::string> t = {"exc::bench::*_evaluations_*"};
+  return t;
+}
+
+namespace {
+
 bool run(const std::vector<std::string>& argv) {
   std::vector<char*> raw;
   for (const std::string& a : argv) raw.push_back(const_cast<char*>(a.c_str()));
@@ -77,6 +92,7 @@ double leading_count(const std::string& line) {
 }  // namespace
 
 std::vector<StageCount> callgrind_split(const std::string& program, const std::vector<std::string>& args, double cycles,
+                                        const std::vector<Stage>& stages, const std::vector<std::string>& toggles,
                                         std::string& why) {
   std::vector<StageCount> out;
   char dir[] = "/tmp/loop-bench-XXXXXX";
@@ -85,12 +101,9 @@ std::vector<StageCount> callgrind_split(const std::string& program, const std::v
   // Without debug information: with it callgrind splits a function by the source file of each inlined
   // piece (Eigen's headers), and the inclusive counts of the pieces no longer add up.
   const bool copied = run({"objcopy", "--strip-debug", program, stripped});
-  // Counted only inside the loop and the telemetry thread: the model functions also run while the
-  // scene loads (the effort-feasibility check), which is not a cycle's cost.
-  std::vector<std::string> argv = {"valgrind", "-q", "--tool=callgrind", "--callgrind-out-file=" + profile,
-                                   "--toggle-collect=exc::sim::run_lockstep*",
-                                   "--toggle-collect=exc::telemetry::TelemetryPublisher::run*",
-                                   copied ? stripped : program};
+  std::vector<std::string> argv = {"valgrind", "-q", "--tool=callgrind", "--callgrind-out-file=" + profile};
+  for (const std::string& t : toggles) argv.push_back("--toggle-collect=" + t);
+  argv.push_back(copied ? stripped : program);
   argv.insert(argv.end(), args.begin(), args.end());
   if (!run(argv)) {
     std::remove(stripped.c_str());
@@ -101,15 +114,15 @@ std::vector<StageCount> callgrind_split(const std::string& program, const std::v
   const std::string annotate = "callgrind_annotate --inclusive=yes --threshold=100 " + profile + " 2>/dev/null";
   FILE* pipe = popen(annotate.c_str(), "r");
   if (pipe == nullptr) return why = "callgrind_annotate did not run", out;
-  std::vector<double> sums(stages().size(), 0.0);
-  std::vector<bool> seen(stages().size(), false);
+  std::vector<double> sums(stages.size(), 0.0);
+  std::vector<bool> seen(stages.size(), false);
   char buffer[8192];
   while (std::fgets(buffer, sizeof buffer, pipe) != nullptr) {
     const std::string line(buffer);
     const double count = leading_count(line);
     if (count < 0) continue;
-    for (std::size_t s = 0; s < stages().size(); ++s) {
-      for (const char* f : stages()[s].functions) {
+    for (std::size_t s = 0; s < stages.size(); ++s) {
+      for (const char* f : stages[s].functions) {
         if (line.find(f) == std::string::npos) continue;
         sums[s] += count;
         seen[s] = true;
@@ -120,9 +133,9 @@ std::vector<StageCount> callgrind_split(const std::string& program, const std::v
   std::remove(profile.c_str());
   std::remove(stripped.c_str());
   rmdir(dir);
-  if (!annotated || !seen[0]) return why = "callgrind_annotate gave no count of run_lockstep", out;
-  for (std::size_t s = 0; s < stages().size(); ++s)
-    out.push_back(StageCount{stages()[s].label, stages()[s].depth, seen[s] ? sums[s] / cycles : -1});
+  if (!annotated || !seen[0]) return why = std::string("callgrind_annotate gave no count of ") + stages[0].functions[0], out;
+  for (std::size_t s = 0; s < stages.size(); ++s)
+    out.push_back(StageCount{stages[s].label, stages[s].depth, seen[s] ? sums[s] / cycles : -1});
   return out;
 }
 

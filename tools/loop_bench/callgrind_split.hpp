@@ -15,9 +15,26 @@ struct StageCount {
   double per_cycle = -1;  // instructions per cycle; -1: no such function in the profile (inlined)
 };
 
-// Runs `program` with `args` (a child run of `cycles` cycles) under callgrind. Empty, with the reason
-// in `why`, when valgrind or callgrind_annotate is missing or the child run failed.
+// A stage: the functions whose inclusive counts it sums (substrings of callgrind_annotate's
+// "file:function" column; a template's instantiations all match).
+struct Stage {
+  const char* label;
+  int depth;
+  std::vector<const char*> functions;
+};
+
+// The stages of one cycle of the closed loop (counted inside run_lockstep and the telemetry thread).
+const std::vector<Stage>& loop_stages();
+const std::vector<std::string>& loop_toggles();
+// One evaluation of the closed-chain model per node and path (model_evaluations.hpp).
+const std::vector<Stage>& model_evaluation_stages();
+const std::vector<std::string>& model_evaluation_toggles();
+
+// Runs `program` with `args` (a child run of `cycles` cycles, or evaluations) under callgrind,
+// collecting only inside the functions `toggles` name, and sums `stages` per cycle. Empty, with the
+// reason in `why`, when valgrind or callgrind_annotate is missing or the child run failed.
 std::vector<StageCount> callgrind_split(const std::string& program, const std::vector<std::string>& args, double cycles,
+                                        const std::vector<Stage>& stages, const std::vector<std::string>& toggles,
                                         std::string& why);
 
 }  // namespace exc::bench

@@ -21,10 +21,15 @@ struct State {
   exc::Vec4 q_a, qd_a, qdd_a, tau_a;
 };
 
+// The reference machine with each closed-chain path: planar (the straight-line pass, now) and general
+// (the Lie-group passes it replaced), benchmarked side by side in one run.
 struct Fixture {
   exc::Model model = exc::build_model(exc::reference_machine());
+  exc::Model general = model;
   std::vector<State> states;
+  const exc::Model& with(exc::ClosedChainPath path) const { return path == exc::ClosedChainPath::planar ? model : general; }
   Fixture() {
+    general.closed_chain_path = exc::ClosedChainPath::general;
     std::mt19937 rng(1);
     auto u = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
     const exc::Vec4 lo = model.machine.q_min(), hi = model.machine.q_max();
@@ -47,24 +52,27 @@ Fixture& fixture() {
 }
 
 // Closed-chain inverse dynamics from the active state: loop closure, Psi, gamma, Newton-Euler, Psi^T.
-void BM_InverseDynamics(benchmark::State& st) {
+void BM_InverseDynamics(benchmark::State& st, exc::ClosedChainPath path) {
   Fixture& f = fixture();
-  exc::Workspace ws(f.model);
+  const exc::Model& model = f.with(path);
+  exc::Workspace ws(model);
   exc::Vec4 tau;
   std::size_t k = 0;
   for (auto _ : st) {
     const State& s = f.states[k++ & 1023];
-    exc::update_closed_chain(f.model, ws, s.q_a, s.qd_a);
-    exc::inverse_dynamics(f.model, ws, s.qdd_a, exc::Vec2(1e3, -2e3), tau);
+    exc::update_closed_chain(model, ws, s.q_a, s.qd_a);
+    exc::inverse_dynamics(model, ws, s.qdd_a, exc::Vec2(1e3, -2e3), tau);
     benchmark::DoNotOptimize(tau);
   }
 }
-BENCHMARK(BM_InverseDynamics);
+BENCHMARK_CAPTURE(BM_InverseDynamics, planar, exc::ClosedChainPath::planar);
+BENCHMARK_CAPTURE(BM_InverseDynamics, general, exc::ClosedChainPath::general);
 
 // Forward dynamics in independent coordinates (update, M_a, h_a, 4x4 Cholesky), with soil.
-void BM_ForwardDynamics(benchmark::State& st) {
+void BM_ForwardDynamics(benchmark::State& st, exc::ClosedChainPath path) {
   Fixture& f = fixture();
-  exc::Workspace ws(f.model);
+  const exc::Model& model = f.with(path);
+  exc::Workspace ws(model);
   exc::TipLoad load;
   load.force = exc::Vec2(1e4, -2e4);
   load.added_mass = exc::Vec2(200, 200);
@@ -72,49 +80,58 @@ void BM_ForwardDynamics(benchmark::State& st) {
   std::size_t k = 0;
   for (auto _ : st) {
     const State& s = f.states[k++ & 1023];
-    exc::forward_dynamics(f.model, ws, s.q_a, s.qd_a, s.tau_a, load, qdd);
+    exc::forward_dynamics(model, ws, s.q_a, s.qd_a, s.tau_a, load, qdd);
     benchmark::DoNotOptimize(qdd);
   }
 }
-BENCHMARK(BM_ForwardDynamics);
+BENCHMARK_CAPTURE(BM_ForwardDynamics, planar, exc::ClosedChainPath::planar);
+BENCHMARK_CAPTURE(BM_ForwardDynamics, general, exc::ClosedChainPath::general);
 
-// M_a = Psi^T M_r Psi alone (after update_closed_chain, which is outside the timed region).
-void BM_MassMatrix(benchmark::State& st) {
+// M_a alone (after update_closed_chain, which is outside the timed region): Psi^T M_r Psi (general),
+// or the links' Jacobians and energies (planar).
+void BM_MassMatrix(benchmark::State& st, exc::ClosedChainPath path) {
   Fixture& f = fixture();
+  const exc::Model& model = f.with(path);
   std::vector<exc::Workspace> ws;
   ws.reserve(64);
   for (int i = 0; i < 64; ++i) {
-    ws.emplace_back(f.model);
-    exc::update_closed_chain(f.model, ws.back(), f.states[i].q_a, f.states[i].qd_a);
+    ws.emplace_back(model);
+    exc::update_closed_chain(model, ws.back(), f.states[i].q_a, f.states[i].qd_a);
   }
   exc::Mat4 M;
   std::size_t k = 0;
   for (auto _ : st) {
-    exc::mass_matrix(f.model, ws[k++ & 63], M);
+    exc::Workspace& w = ws[k++ & 63];
+    w.planar.jacobians_valid = false;  // the planar path's links' Jacobians are part of M_a's cost
+    exc::mass_matrix(model, w, M);
     benchmark::DoNotOptimize(M);
   }
 }
-BENCHMARK(BM_MassMatrix);
+BENCHMARK_CAPTURE(BM_MassMatrix, planar, exc::ClosedChainPath::planar);
+BENCHMARK_CAPTURE(BM_MassMatrix, general, exc::ClosedChainPath::general);
 
 // The position/velocity update alone (closed-form closure, H, Psi, gamma, tip, tree kinematics).
-void BM_UpdateClosedChain(benchmark::State& st) {
+void BM_UpdateClosedChain(benchmark::State& st, exc::ClosedChainPath path) {
   Fixture& f = fixture();
-  exc::Workspace ws(f.model);
+  const exc::Model& model = f.with(path);
+  exc::Workspace ws(model);
   std::size_t k = 0;
   for (auto _ : st) {
     const State& s = f.states[k++ & 1023];
-    benchmark::DoNotOptimize(exc::update_closed_chain(f.model, ws, s.q_a, s.qd_a));
+    benchmark::DoNotOptimize(exc::update_closed_chain(model, ws, s.q_a, s.qd_a));
   }
 }
-BENCHMARK(BM_UpdateClosedChain);
+BENCHMARK_CAPTURE(BM_UpdateClosedChain, planar, exc::ClosedChainPath::planar);
+BENCHMARK_CAPTURE(BM_UpdateClosedChain, general, exc::ClosedChainPath::general);
 
 // The augmented form (eq. 8, 20x20 LU) for comparison.
-void BM_ForwardDynamicsAugmented(benchmark::State& st) {
+void BM_ForwardDynamicsAugmented(benchmark::State& st, exc::ClosedChainPath path) {
   Fixture& f = fixture();
-  exc::Workspace ws(f.model);
+  const exc::Model& model = f.with(path);
+  exc::Workspace ws(model);
   std::vector<std::pair<exc::Vec12, exc::Vec12>> tree(64);
   for (int i = 0; i < 64; ++i) {
-    exc::update_closed_chain(f.model, ws, f.states[i].q_a, f.states[i].qd_a);
+    exc::update_closed_chain(model, ws, f.states[i].q_a, f.states[i].qd_a);
     tree[i] = {ws.q, ws.qd};
   }
   exc::Vec12 qdd;
@@ -122,12 +139,13 @@ void BM_ForwardDynamicsAugmented(benchmark::State& st) {
   std::size_t k = 0;
   for (auto _ : st) {
     const std::size_t i = k++ & 63;
-    exc::forward_dynamics_augmented(f.model, ws, tree[i].first, tree[i].second, f.states[i].tau_a, exc::TipLoad{},
+    exc::forward_dynamics_augmented(model, ws, tree[i].first, tree[i].second, f.states[i].tau_a, exc::TipLoad{},
                                     0.0, 0.0, qdd, lambda);
     benchmark::DoNotOptimize(qdd);
   }
 }
-BENCHMARK(BM_ForwardDynamicsAugmented);
+BENCHMARK_CAPTURE(BM_ForwardDynamicsAugmented, planar, exc::ClosedChainPath::planar);
+BENCHMARK_CAPTURE(BM_ForwardDynamicsAugmented, general, exc::ClosedChainPath::general);
 
 }  // namespace
 
