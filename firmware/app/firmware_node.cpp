@@ -23,6 +23,10 @@ namespace exc::app {
 namespace {
 
 constexpr int kHeartbeatPeriod = hal::kHeartbeatPeriodCycles;
+// Sensor sets in a row that say the plant holds while the firmware commands motion before that is a
+// fault: the plant applies a command one cycle after it is sent, so a hold it reports on entering
+// hold/track lasts one or two sets; five is a machine that does not obey.
+constexpr int kPlantHoldCycles = 5;
 
 Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]); }
 
@@ -38,6 +42,22 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::tracking_error: return "tracking error";
     case FirmwareFault::no_pressures: return "no pressures";
     case FirmwareFault::pump_limited: return "pumps short of flow";
+    case FirmwareFault::plant_emergency: return "plant emergency";
+    case FirmwareFault::plant_fault: return "plant fault";
+    case FirmwareFault::plant_holding: return "plant holding";
+    case FirmwareFault::deadline_overrun: return "missed deadlines";
+    case FirmwareFault::velocity_implausible: return "velocity implausible";
+    case FirmwareFault::exited: return "firmware exited";
+    case FirmwareFault::fatal_error: return "firmware fatal error";
+  }
+  return "unknown";
+}
+
+const char* to_string(StopKind stop) {
+  switch (stop) {
+    case StopKind::none: return "none";
+    case StopKind::controlled: return "controlled";
+    case StopKind::emergency: return "emergency";
   }
   return "unknown";
 }
@@ -65,6 +85,7 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       lag_compensator_(config.controller.actuator_lag, config.controller.actuator_lag_target,
                        config.controller.period, control::effort_limits_of(model.machine)),
       valves_(control::valve_loop_model(model.machine), config.controller.valves, config.controller.period),
+      plausibility_(config.controller.plausibility, config.controller.period),
       control_timing_("control", 100.0),
       cycle_timing_("cycle", config.controller.period * 1e6),
       read_timing_("read", 100.0),
@@ -86,7 +107,75 @@ void FirmwareNode::begin_cycle() {
   // every 10 ms while it lasts, so a node that missed the first frame still learns of the stop.
   if (machine_.mode() == control::Mode::safe_stop && cycle_ > safe_stop_cycle_ &&
       (cycle_ - safe_stop_cycle_) % hal::kEmergencyRepeatCycles == 0)
-    port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
+    send_stop_frame();
+}
+
+void FirmwareNode::check_standstill(bool complete) {
+  if (machine_.mode() != control::Mode::safe_stop || escalated_ || stop_of(fault_code_) != StopKind::controlled ||
+      !complete || static_cast<double>(cycle_ - safe_stop_cycle_) * period_ < kStandstillDelay) {
+    moving_run_ = 0;
+    return;
+  }
+  bool moving = std::abs(sensors_.velocity[0]) > kStandstillSwingRate;
+  for (int j = 1; j < 4; ++j) moving = moving || std::abs(sensors_.velocity[j]) > kStandstillCylinderRate;
+  moving_run_ = moving ? moving_run_ + 1 : 0;
+  if (moving_run_ < kStandstillCycles) return;
+  escalated_ = true;
+  send_stop_frame();
+  char text[sizeof(exlcm::fault_t::text)];
+  std::snprintf(text, sizeof text, "controlled stop escalated to the emergency stop: the machine still moves %.2f s after it (%s)",
+                static_cast<double>(cycle_ - safe_stop_cycle_) * period_, fault_text_);
+  publish_fault(fault_code_, 2, true, text);
+}
+
+void FirmwareNode::send_stop_frame() {
+  const bool emergency = escalated_ || stop_of(fault_code_) == StopKind::emergency;
+  emergency_sent_ = emergency_sent_ || emergency;
+  port_.send_fault(emergency, static_cast<std::uint16_t>(fault_code_));
+}
+
+void FirmwareNode::send_safe_command(FirmwareFault why) {
+  command_.mode = hal::CommandMode::valve;
+  command_.value = {0, 0, 0, 0};
+  command_.cycle = cycle_;
+  command_.firmware_mode = static_cast<std::uint8_t>(control::Mode::safe_stop);
+  port_.write(command_);
+  // A standing safe state keeps its own fault (and its stop); otherwise the reason of leaving.
+  const FirmwareFault code = machine_.mode() == control::Mode::safe_stop ? fault_code_ : why;
+  const bool emergency = (machine_.mode() == control::Mode::safe_stop && escalated_) ||
+                         stop_of(code) == StopKind::emergency || stop_of(why) == StopKind::emergency;
+  emergency_sent_ = emergency_sent_ || emergency;
+  port_.send_fault(emergency, static_cast<std::uint16_t>(code));
+  safe_command_sent_ = true;
+}
+
+void FirmwareNode::check_plant_signals(bool complete) {
+  // PLANT_EMERGENCY is an event the plant repeats every 10 ms while it lasts: taken once per frame.
+  if (sensors_.plant_emergency) {
+    sensors_.plant_emergency = false;
+    if (!fault_) {
+      raise(FirmwareFault::plant_emergency);
+      std::snprintf(pending_text_, sizeof pending_text_,
+                    "plant emergency: PLANT_EMERGENCY code %u, plant heartbeat state %u, at t = %.3f s",
+                    static_cast<unsigned>(sensors_.plant_fault_code), static_cast<unsigned>(sensors_.plant_heartbeat_state),
+                    time());
+    }
+  }
+  if (!complete) return;
+  if (sensors_.plant_faults != 0 && !fault_) {
+    raise(FirmwareFault::plant_fault);
+    std::snprintf(pending_text_, sizeof pending_text_, "plant fault: SENS_MACHINE PlantFaults 0x%02x at t = %.3f s",
+                  static_cast<unsigned>(sensors_.plant_faults), time());
+  }
+  const bool commanding = machine_.mode() == control::Mode::hold || machine_.mode() == control::Mode::track;
+  plant_hold_run_ = commanding && (sensors_.plant_state & hal::kPlantStateHolding) != 0 ? plant_hold_run_ + 1 : 0;
+  if (plant_hold_run_ >= kPlantHoldCycles && !fault_) {
+    raise(FirmwareFault::plant_holding);
+    std::snprintf(pending_text_, sizeof pending_text_,
+                  "plant holding: PlantState %u for %d sensor sets while commanded (heartbeat state %u) at t = %.3f s",
+                  static_cast<unsigned>(sensors_.plant_state), plant_hold_run_,
+                  static_cast<unsigned>(sensors_.plant_heartbeat_state), time());
+  }
 }
 
 bool FirmwareNode::receive() {
@@ -97,10 +186,21 @@ bool FirmwareNode::receive() {
 void FirmwareNode::end_cycle() {
   const std::int64_t start_ns = hal::monotonic_now_ns();
   const double t = time();
-  if (receive()) {
+  const bool complete = receive();
+  if (complete) {
     have_valid_ = true;
     last_valid_time_ = t;
   }
+  // An acknowledge is spent on this cycle: it clears the latched faults of the safe state, and the
+  // monitors that watch standing conditions (the plant's signals below, the watchdog) raise again
+  // if theirs still stands.
+  const bool acknowledged = acknowledge_requested_ && machine_.mode() == control::Mode::safe_stop;
+  acknowledge_requested_ = false;
+  if (acknowledged) {
+    fault_ = false;
+    pending_fault_ = FirmwareFault::none;
+  }
+  check_plant_signals(complete);
   const std::int64_t read_ns = hal::monotonic_now_ns();
   read_timing_.record_ns(read_ns - start_ns);
 
@@ -116,6 +216,7 @@ void FirmwareNode::end_cycle() {
   in.trajectory_finished =
       finished_ || (machine_.mode() == control::Mode::track && t - track_start_ + task_.start_time() >= task_.end_time());
   in.fault = fault_;
+  in.acknowledged = acknowledged;
   const control::Transition transition = machine_.step(in);
   transition_ = transition;
   if (transition.changed) {
@@ -131,6 +232,10 @@ void FirmwareNode::end_cycle() {
       }
       fault_ = false;
       pending_fault_ = FirmwareFault::none;
+      // Leaving an acknowledged stop: the machine's emergency latch is released (EmergencyStop = 0,
+      // no fault) so it obeys the commands again.
+      if (transition.from == control::Mode::safe_stop) port_.send_fault(false, 0);
+      escalated_ = false;
     }
     if (transition.to == control::Mode::track) track_start_ = t;
     if (transition.to == control::Mode::safe_stop) {
@@ -144,10 +249,11 @@ void FirmwareNode::end_cycle() {
                       (t - last_valid_time_) * 1e3, t);
       else
         std::memcpy(fault_text_, pending_text_, sizeof fault_text_);
-      port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
+      send_stop_frame();
     }
   }
 
+  check_standstill(complete);
   compute_command(transition);
   const std::int64_t write_start_ns = hal::monotonic_now_ns();
   port_.write(command_);
@@ -262,8 +368,18 @@ void FirmwareNode::update_pump_warning(bool limited, double demanded_flow) {
 
 void FirmwareNode::record_wakeup(std::int64_t interval_ns, std::uint64_t overruns, std::uint64_t skipped) {
   interval_timing_.record_ns(interval_ns);
+  const bool missed = overruns > deadline_overruns_ || skipped > skipped_deadlines_;
+  missed_in_a_row_ = missed ? missed_in_a_row_ + 1 : 0;
   deadline_overruns_ = overruns;
   skipped_deadlines_ = skipped;
+  const bool commanding = machine_.mode() == control::Mode::hold || machine_.mode() == control::Mode::track;
+  if (missed_in_a_row_ >= config_.controller.max_missed_deadlines && commanding && !fault_) {
+    raise(FirmwareFault::deadline_overrun);
+    pending_time_ = time() + period_;  // the cycle about to start
+    std::snprintf(pending_text_, sizeof pending_text_,
+                  "missed deadlines: %d wake-ups in a row after their deadline (limit %d) at t = %.3f s", missed_in_a_row_,
+                  config_.controller.max_missed_deadlines, pending_time_);
+  }
 }
 
 void FirmwareNode::compute_command(const control::Transition& transition) {
@@ -277,6 +393,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     command_.value = {0, 0, 0, 0};
     last_sent_.setZero();
     update_pump_warning(false, 0);  // centred valves ask nothing
+    plausibility_.update(false, Vec4::Zero(), to_vec(sensors_.velocity));
     return;
   }
   const std::int64_t start_ns = hal::monotonic_now_ns();
@@ -346,6 +463,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     blender_.on_switch(t, last_sent_, out_.tau);
   if (valve_interface()) {
     command_valves(q);
+    check_plausibility(restarted);
   } else {
     const Vec4 tau = blender_.apply(t, out_.tau);
     // After a restart the actuator is taken to deliver what the law asks for first (the plant's
@@ -382,6 +500,24 @@ control::AppliedEffort FirmwareNode::applied_effort() const {
   a.valid = true;
   a.suspect = static_cast<std::uint8_t>(lag_compensator_.clamped() | out_.saturated);
   return a;
+}
+
+void FirmwareNode::check_plausibility(bool restarted) {
+  // The command just computed is what the valves are told from now on; the velocity measured now
+  // answers the commands before it, which the monitor's lag stands for.
+  const control::ValveCommand& v = valves_.last();
+  const std::uint8_t found =
+      plausibility_.update(!restarted, v.velocity, estimator_.velocity(), !out_.velocity_command, last_sent_, v.force);
+  if (found == 0 || fault_) return;
+  int j = 0;
+  while (((found >> j) & 1) == 0) ++j;
+  raise(FirmwareFault::velocity_implausible);
+  const char* const unit = j == 0 ? "rad/s" : "m/s";
+  // (fits pending_text_: the times first, the figures after)
+  std::snprintf(pending_text_, sizeof pending_text_, "velocity implausible at t = %.3f s: %s %.3f %s (cmd %.3f), effort %.3g (asked %.3g)",
+                time(), kActiveNames[static_cast<std::size_t>(j)], estimator_.velocity()[j], unit, plausibility_.expected()[j],
+                v.force[j], plausibility_.effort_expected()[j]);
+  // Detected when the debounce is complete: the time a fault's start is judged against.
 }
 
 void FirmwareNode::raise(FirmwareFault fault) {

@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <exception>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -55,6 +56,24 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
   return {{"median", c.median_us()}, {"p99", c.p99_us()}, {"p99_9", c.percentile_us(0.999)}, {"max", c.max_us()},
           {"count", c.count()}};
 }
+
+// Every way out of the loop once the node exists (end of run, SIGINT/SIGTERM, a second signal, an
+// exception) leaves a safe command on the bus: valves centred and FW_EMERGENCY (docs/safety.md, H8).
+// An exception unwinding through it takes the emergency stop.
+class LastSafeCommand {
+ public:
+  explicit LastSafeCommand(exc::app::FirmwareNode& node) : node_(node) {}
+  LastSafeCommand(const LastSafeCommand&) = delete;
+  LastSafeCommand& operator=(const LastSafeCommand&) = delete;
+  ~LastSafeCommand() {
+    if (!node_.safe_command_sent())
+      node_.send_safe_command(std::uncaught_exceptions() > 0 ? exc::app::FirmwareFault::fatal_error
+                                                             : exc::app::FirmwareFault::exited);
+  }
+
+ private:
+  exc::app::FirmwareNode& node_;
+};
 
 }  // namespace
 
@@ -143,6 +162,7 @@ int main(int argc, char** argv) {
     }
     exc::hal::FirmwareCanPort port(*io.bus);
     exc::app::FirmwareNode node(model, settings.task, fc, port, io.publisher.get());
+    LastSafeCommand last_safe_command(node);
 
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
@@ -211,6 +231,11 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     }
+    // The run is over (its end, or a signal): the machine is left with its valves centred.
+    node.send_safe_command(exc::app::FirmwareFault::exited);
+    std::printf("excavator-firmware: last command sent: valves centred, FW_EMERGENCY %s stop (%s)\n",
+                exc::app::to_string(node.emergency_sent() ? exc::app::StopKind::emergency : exc::app::StopKind::controlled),
+                node.mode() == exc::control::Mode::safe_stop ? node.last_fault_text() : "firmware exited");
     node.publish_counters();
     if (io.publisher) io.publisher->stop();
 
@@ -261,6 +286,7 @@ int main(int argc, char** argv) {
       j["deadlines"] = {{"overruns", overruns}, {"skipped_periods", skipped},
                         {"interval_us", timing_json(node.interval_timing())}};
       j["safe_stops"] = node.safe_stops();
+      j["estop"] = node.emergency_sent();  // any FW_EMERGENCY with EmergencyStop = 1, the last command included
       if (node.safe_stops() > 0) j["last_fault"] = node.last_fault_text();
       j["task_finished"] = node.trajectory_finished();
       j["can_frames_rejected"] = port.rx_stats().rejected();

@@ -1,0 +1,63 @@
+#pragma once
+// The firmware's fault kinds and the stop each one takes (docs/safety.md, "The two stops"). The
+// codes travel in FW_EMERGENCY's FaultCode and in fault_t.code.
+#include <cstdint>
+
+namespace exc::app {
+
+enum class FirmwareFault : std::uint16_t {
+  none = 0,
+  sensor_timeout = 1,  // watchdog: no valid sensor set within the timeout
+  model = 2,           // the closed-chain model refused the state (no assembly, toggle)
+  tracking_error = 3,  // a joint's |q_a - q_d| exceeded controller.tracking_error_limit
+  no_pressures = 4,    // the valve stage's force loop needs chamber pressures the sensor frame lacks
+  // A warning (EXC_FAULT severity 1, no safe stop): the valves ask the pumps for more than their flow
+  // for kPumpWarningCycles in a row, so every function slows; cleared after as many within it.
+  pump_limited = 5,
+  plant_emergency = 6,     // PLANT_EMERGENCY received: the machine stopped on its own
+  plant_fault = 7,         // SENS_MACHINE's PlantFaults non-zero: the machine reports a failure
+  plant_holding = 8,       // the machine says it holds (PlantState) while the firmware commands motion
+  deadline_overrun = 9,    // real time: controller.max_missed_deadlines wake-ups in a row after their deadline
+  velocity_implausible = 10,  // a function moves unlike its valve's command (stuck or runaway spool)
+  exited = 11,         // the program leaves (end of run, a signal): its last command centres the valves
+  fatal_error = 12,    // the program leaves on an error: the same, with the emergency stop
+};
+
+// The stop a fault takes. controlled: valves centred, EmergencyStop = 0 (the valves still obey).
+// emergency: EmergencyStop = 1 as well, so the machine cuts the pilot supply and stops the engine
+// (the valves or the sensors cannot be trusted). none: a warning, no stop.
+enum class StopKind : std::uint8_t { none, controlled, emergency };
+
+constexpr StopKind stop_of(FirmwareFault fault) {
+  switch (fault) {
+    case FirmwareFault::none:
+    case FirmwareFault::pump_limited: return StopKind::none;
+    case FirmwareFault::model:
+    case FirmwareFault::tracking_error:
+    case FirmwareFault::no_pressures:
+    case FirmwareFault::deadline_overrun:
+    case FirmwareFault::exited: return StopKind::controlled;
+    case FirmwareFault::sensor_timeout:
+    case FirmwareFault::plant_emergency:
+    case FirmwareFault::plant_fault:
+    case FirmwareFault::plant_holding:
+    case FirmwareFault::velocity_implausible:
+    case FirmwareFault::fatal_error: return StopKind::emergency;
+  }
+  return StopKind::emergency;  // an unknown code: the stronger stop
+}
+
+// The standstill monitor of a controlled stop: from kStandstillDelay after the safe state began, a
+// function faster than its standstill rate in kStandstillCycles sensor sets in a row escalates the
+// stop to the emergency stop. The valves' spools centre in 30 ms and a 20 t machine's functions stop
+// within a few hundred ms of it (the campaign's times to rest); still moving after 0.3 s is a
+// function the valves do not stop.
+inline constexpr double kStandstillDelay = 0.3;          // s
+inline constexpr int kStandstillCycles = 20;
+inline constexpr double kStandstillCylinderRate = 0.01;  // m/s
+inline constexpr double kStandstillSwingRate = 0.01;     // rad/s
+
+const char* to_string(FirmwareFault fault);
+const char* to_string(StopKind stop);
+
+}  // namespace exc::app
