@@ -131,6 +131,13 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   const bool hold = timed_out || command_.emergency_stop || firmware_holds;
   if (hold && !holding_) ++holds_;
   holding_ = hold;
+  // The machine's safety controller on the firmware's emergency stop (FW_EMERGENCY EmergencyStop):
+  // pilot supply cut (every spool springs to centre), engine stopped (the pumps run down), and so
+  // the load-holding valves closed; all back when the stop is released (docs/safety.md).
+  if (hydraulic) {
+    plant_.set_pilot_supply(!command_.emergency_stop);
+    plant_.set_engine_running(!command_.emergency_stop);
+  }
 
   // Any other command goes to the plant as the kind it is: a kind the actuators cannot use (efforts
   // for valves, openings or pilots for force actuators) stops the plant with its message, so a
@@ -174,7 +181,11 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   for (int p = 0; p < hal::kPumpCount; ++p) sensors_.pump_pressure[p] = r.pump_pressure[p];
   sensors_.pressure_valid = hydraulic;
   apply_sensor_fault();
-  sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
+  const plant::HydraulicReport& h = plant_.state().hydraulics;
+  const bool estop = hydraulic && command_.emergency_stop;
+  sensors_.plant_state = static_cast<std::uint8_t>((hold ? hal::kPlantStateHolding : 0) | (estop ? hal::kPlantStatePilotCut : 0) |
+                                                   (estop ? hal::kPlantStateEngineStopped : 0) |
+                                                   (hydraulic && h.holding_valves_closed ? hal::kPlantStateHoldingValvesClosed : 0));
   sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
   if (answer && !failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
   if (answer && cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
