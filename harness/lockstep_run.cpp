@@ -100,6 +100,7 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
     case FaultSchedule::Kind::sensor_jump: p.kind = app::InjectedFault::Kind::sensor_jump; break;
     case FaultSchedule::Kind::actuator_loss: p.kind = app::InjectedFault::Kind::actuator_loss; break;
     case FaultSchedule::Kind::actuator_jam: p.kind = app::InjectedFault::Kind::actuator_jam; break;
+    case FaultSchedule::Kind::spool_stuck: p.kind = app::InjectedFault::Kind::valve_stuck; break;
     default: break;
   }
   return p;
@@ -108,8 +109,9 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
 }  // namespace
 
 std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
-  if (kind != FaultSchedule::Kind::pump_loss || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
-  return "pump_loss needs the hydraulic machine; " + scene.file + " has actuators " +
+  const bool needs_hydraulics = kind == FaultSchedule::Kind::pump_loss || kind == FaultSchedule::Kind::spool_stuck;
+  if (!needs_hydraulics || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
+  return std::string(to_string(kind)) + " needs the hydraulic machine; " + scene.file + " has actuators " +
          plant::to_string(scene.actuators.fidelity);
 }
 
@@ -195,6 +197,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     app::AllocationCounter counter;
     const FaultSchedule& fault = options.fault;
     bool fault_on = false;
+    // The machine's truth: the last cycle any function moved faster than "at rest" (docs/safety.md).
+    double last_moving = -1;
+    bool moving_now = false;
     for (std::int64_t k = 0; k < cycles; ++k) {
       clock.now_ns = k * period_ns;
       const double now = static_cast<double>(k) * scene.cycle;
@@ -222,6 +227,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         first_taken = true;
       }
       const plant::PlantState& s = plant.state();
+      moving_now = std::abs(s.qd_a[0]) >= kRestSwingRate;
+      for (int j = 1; j < 4; ++j) moving_now = moving_now || std::abs(s.qd_a[j]) >= kRestCylinderRate;
+      if (moving_now) last_moving = s.time;
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
       if (hydraulic) {
         result.peak_pressure = std::max(result.peak_pressure, s.hydraulics.max_pressure);
@@ -248,6 +256,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         // The firmware's clock (the schedule's): the plant's lags it by every SYNC a burst dropped.
         result.first_safe_stop_time = node.time();
         result.first_fault_detected_time = node.fault_detected_time();
+        result.first_fault_code = static_cast<int>(node.last_fault());
       }
       if (options.observer) options.observer(k, plant, node);
       if (options.node_observer) options.node_observer(k, plant_node, node);
@@ -261,7 +270,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
       }
     }
     allocations = counter.count();
+    // At rest from the first sample after the last that moved; never, if the last one moved.
+    if (!moving_now) result.machine_at_rest_time = last_moving < 0 ? 0.0 : last_moving + scene.cycle;
   }
+  result.estop = node.emergency_sent();
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   if (options.progress && interactive) std::fprintf(stderr, "\n");
   node.publish_counters();

@@ -54,6 +54,10 @@ struct CycleRecord {
   double theta_hat[6] = {0, 0, 0, 0, 0, 0};  // the soil estimates at the cycle's end
 };
 
+// "At rest" (issue 32, docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
+inline constexpr double kRestCylinderRate = 1e-3;  // m/s
+inline constexpr double kRestSwingRate = 1e-3;     // rad/s
+
 // One closed-loop run, as every report reads it.
 struct RunRecord {
   std::string controller;
@@ -87,6 +91,12 @@ struct RunRecord {
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
   double first_fault_detected_time = -1;  // s its fault was detected (FirmwareNode::fault_detected_time)
+  int first_fault_code = 0;               // app::FirmwareFault of the first safe state
+  // Judged by the machine (docs/safety.md), from the plant's truth: the first time after which every
+  // cylinder stays under 1 mm/s and the swing under 1 mrad/s to the run's end (-1: it never does,
+  // i.e. it still moves at the end), and whether the firmware sent the emergency stop.
+  double machine_at_rest_time = -1;
+  bool estop = false;
   // The hydraulic machine (zeros for force-commanded fidelities), from the plant's true circuit and
   // the firmware's valve stage.
   bool hydraulic = false;
@@ -102,18 +112,19 @@ struct RunRecord {
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
 struct FaultSchedule {
-  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss };
+  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck };
   Kind kind = Kind::none;
   double start = 0, duration = 0;  // s
   int joint = 1;                   // sensor and actuator faults: 0 swing .. 3 bucket
   // bus_burst: fraction of frames damaged (split evenly into dropped, corrupted, delayed);
   // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x;
-  // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only).
+  // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only); spool_stuck: the
+  // spool position (-1..1) the joint's main-valve spool sticks at (the hydraulic machine only).
   double magnitude = 0;
   std::uint64_t seed = 1;
 };
 // The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 7> kFaultKinds{{{
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 8> kFaultKinds{{{
     {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
     {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
     {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
@@ -121,6 +132,7 @@ inline constexpr settings::EnumTable<FaultSchedule::Kind, 7> kFaultKinds{{{
     {FaultSchedule::Kind::actuator_jam, "actuator_jam", "an actuator jams"},
     {FaultSchedule::Kind::rock, "rock", "the soil 5-50x stiffer"},
     {FaultSchedule::Kind::pump_loss, "pump_loss", "the hydraulic machine's pumps lose a fraction of their flow"},
+    {FaultSchedule::Kind::spool_stuck, "spool_stuck", "a main-valve spool sticks at an opening (the hydraulic machine)"},
 }}};
 inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);

@@ -1,0 +1,117 @@
+// Issue 32's stops judged by the machine (docs/safety.md): a main-valve spool stuck on any of the
+// four functions, at openings both ways, under every law that drives the valves, in the dig scene:
+// the velocity plausibility monitor finds it within 100 ms of the stick, the firmware sends the
+// emergency stop (the machine cuts its pilot supply and stops its engine), and the machine is at rest
+// (plant truth: cylinders under 1 mm/s, swing under 1 mrad/s, to the run's end) within 1.5 s. And
+// without a fault the monitor stays inside its band on every shipped hydraulic scene's law: its
+// margin is printed. Firmware and plant in lockstep over the in-memory bus (harness/lockstep_run.hpp).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "app/firmware_node.hpp"
+#include "control/controller_kinds.hpp"
+#include "harness/lockstep_run.hpp"
+
+using namespace exc;
+
+namespace {
+
+// The valve-driving laws the dig scene runs (flow-based control included: the dig's swing is still).
+constexpr control::ControllerKind kLaws[] = {control::ControllerKind::pid, control::ControllerKind::adaptive,
+                                             control::ControllerKind::slotine_li, control::ControllerKind::flow};
+
+}  // namespace
+
+TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent; detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
+  // Issue 32's requirement is detection within 100 ms and the machine at rest within 1.5 s of the
+  // stick. What this branch reaches is asserted (every case found, by the velocity monitor within
+  // 0.3 s but a flow law's swing, the emergency stop sent) and the figures against the requirement
+  // are printed per case; docs/safety.md reports which cases miss it and why (not met).
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  const double t_stick = 3.0;
+  double worst_detection = 0, worst_rest = 0;
+  int cases = 0, detected_in_time = 0, at_rest_in_time = 0, never_at_rest = 0;
+  std::string worst_detection_case, worst_rest_case;
+  for (const control::ControllerKind law : kLaws) {
+    for (int joint = 0; joint < 4; ++joint) {
+      for (const double opening : {-0.8, -0.4, 0.4, 0.8}) {
+        sim::LockstepOptions o;
+        o.controller = law;
+        o.duration = t_stick + 4.0;
+        o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
+        o.fault.start = t_stick;
+        o.fault.duration = 1e9;  // to the run's end
+        o.fault.joint = joint;
+        o.fault.magnitude = opening;
+        const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+        const std::string name = std::string(control::to_string(law)) + ", " + kActiveNames[static_cast<std::size_t>(joint)] +
+                                 " stuck at " + std::to_string(opening);
+        INFO(name << ": " << r.failure);
+        ++cases;
+        REQUIRE(r.first_safe_stop_time >= 0);
+        // A flow law asks no effort, so only the velocity test watches it: a stuck swing spool barely
+        // moves the swing's inertia at first and is found by the tracking error later (the standstill
+        // monitor then escalates to the emergency stop).
+        const bool flow_swing = law == control::ControllerKind::flow && joint == 0;
+        CHECK(r.first_fault_code == static_cast<int>(flow_swing ? app::FirmwareFault::tracking_error
+                                                                : app::FirmwareFault::velocity_implausible));
+        const double detection = r.first_fault_detected_time - t_stick;
+        CHECK(detection > 0);
+        CHECK(detection <= (flow_swing ? 1.0 : 0.3));
+        CHECK(r.estop);
+        const double rest = r.machine_at_rest_time >= 0 ? r.machine_at_rest_time - t_stick : -1;
+        MESSAGE(name << ": detected after " << detection * 1e3 << " ms, at rest "
+                     << (rest >= 0 ? std::to_string(rest) + " s" : std::string("never (moving at the end)"))
+                     << " after the stick");
+        detected_in_time += detection <= 0.1 ? 1 : 0;
+        at_rest_in_time += rest >= 0 && rest <= 1.5 ? 1 : 0;
+        never_at_rest += rest < 0 ? 1 : 0;
+        if (detection > worst_detection) {
+          worst_detection = detection;
+          worst_detection_case = name;
+        }
+        if (rest > worst_rest) {
+          worst_rest = rest;
+          worst_rest_case = name;
+        }
+      }
+    }
+  }
+  MESSAGE("spool stuck, " << cases << " cases (4 laws x 4 functions x 4 openings): detected within 100 ms " << detected_in_time
+                          << ", at rest within 1.5 s " << at_rest_in_time << ", never at rest " << never_at_rest
+                          << "; worst detection " << worst_detection * 1e3 << " ms (" << worst_detection_case
+                          << "), worst time to rest of those at rest " << worst_rest << " s (" << worst_rest_case << ")");
+}
+
+TEST_CASE("firmware/plausibility: without a fault the velocity monitor never trips on the shipped hydraulic scenes under every law they run, its margins printed") {
+  // The shipped scenes that drive the hydraulic machine through its valves, the laws each runs
+  // without faulting (flow-based control lags a moving swing past its tracking limit: not run there).
+  const struct {
+    const char* scene;
+    bool swing_moves;
+  } scenes[] = {{"dig.yaml", false}, {"free_motion.yaml", true}, {"clay_slope.yaml", false}, {"sand_skim.yaml", false}};
+  for (const auto& sc : scenes) {
+    const sim::SceneBundle b = sim::load_scene_bundle(std::string(EXC_SOURCE_DIR "/scenes/") + sc.scene);
+    for (const control::ControllerKind law : kLaws) {
+      if (law == control::ControllerKind::flow && sc.swing_moves) continue;
+      Vec4 worst = Vec4::Zero();
+      sim::LockstepOptions o;
+      o.controller = law;
+      o.node_observer = [&worst](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+        worst = node.plausibility().worst_ratio();
+      };
+      const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+      const std::string what = std::string(sc.scene) + ", " + control::to_string(law);
+      INFO(what << ": " << r.failure);
+      MESSAGE(what << ": largest test value / floor per function " << worst.transpose()
+                       << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
+      // The monitor's own criterion: outside its floor for its debounce time in a row. A single
+      // cycle beyond the floor is no fault (the printed figure is the largest single cycle's).
+      CHECK(r.first_fault_code != static_cast<int>(app::FirmwareFault::velocity_implausible));
+      CHECK(r.safe_stops == 0);
+    }
+  }
+}
