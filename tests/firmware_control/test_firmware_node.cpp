@@ -497,7 +497,7 @@ TEST_CASE("firmware/node: consecutive missed deadlines in real time are a fault 
   CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::deadline_overrun));
 }
 
-TEST_CASE("firmware/node: the last command of a program that leaves centres the valves and says why; an error takes the emergency stop") {
+TEST_CASE("firmware/node: the last command of a program that leaves centres the valves and says why, an error takes the emergency stop") {
   const Model model = build_model(reference_machine());
   for (const app::FirmwareFault why : {app::FirmwareFault::exited, app::FirmwareFault::fatal_error}) {
     app::FirmwareNodeConfig cfg;
@@ -519,7 +519,7 @@ TEST_CASE("firmware/node: the last command of a program that leaves centres the 
   }
 }
 
-TEST_CASE("firmware/faults: every fault kind names its stop; those the valves or sensors cannot be trusted in take the emergency stop") {
+TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or sensors cannot be trusted in take the emergency stop") {
   using app::FirmwareFault;
   using app::StopKind;
   CHECK(app::stop_of(FirmwareFault::none) == StopKind::none);

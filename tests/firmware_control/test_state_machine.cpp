@@ -34,7 +34,7 @@ TEST_CASE("firmware/state machine: init, wait for sensors, hold, track, finish")
   CHECK(std::strcmp(sm.last_reason(), "trajectory finished") == 0);
 }
 
-TEST_CASE("firmware/state machine watchdog: lost frames stop safely; the stop latches until acknowledged, then hold") {
+TEST_CASE("firmware/state machine watchdog: lost frames stop safely, the stop latches until acknowledged, then hold") {
   ControlStateMachine sm(0.02);
   StateMachineInputs in;
   in.have_valid_frame = true;

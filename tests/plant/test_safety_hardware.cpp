@@ -53,7 +53,7 @@ TEST_CASE("plant/safety hardware: with the pilot supply cut every spool springs 
   CHECK_FALSE(plant.state().hydraulics.holding_valves_closed);
 }
 
-TEST_CASE("plant/safety hardware: an engine stop takes the pumps' flow linearly to zero over its run-down; a swing on a stuck spool coasts on, and the pilot cut's parking brake stops it") {
+TEST_CASE("plant/safety hardware: an engine stop takes the pumps' flow linearly to zero over its run-down, a swing on a stuck spool coasts on, and the pilot cut's parking brake stops it") {
   // The swing spool stuck open: the pumps drive the swing until their flow is gone; then the swing
   // coasts, its oil pumped from the make-up valve to tank through the open spool, hardly throttled.
   // The pilot cut applies the swing parking brake.

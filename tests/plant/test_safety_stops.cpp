@@ -25,7 +25,7 @@ constexpr control::ControllerKind kLaws[] = {control::ControllerKind::pid, contr
 
 }  // namespace
 
-TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent; detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
+TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent, detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
   // Issue 32's requirement is detection within 100 ms and the machine at rest within 1.5 s of the
   // stick. What this branch reaches is asserted (every case found, by the velocity monitor within
   // 0.3 s but a flow law's swing, the emergency stop sent) and the figures against the requirement
