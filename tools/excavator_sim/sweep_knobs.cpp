@@ -61,6 +61,9 @@ double number_at(const YAML::Node& map, const char* key) { return map[key].as<do
 // in the air) stays, as the scene's initial state is its inverse kinematics.
 void tilt_terrain(SceneChanges& c, const SweepValue& v) {
   const Terrain& ground = c.source().nominal.firmware.terrain;
+  if (!c.nominal("task")["path"])
+    throw std::invalid_argument("needs a task path (task.type dig or truck_loading) to tilt the ground under; " +
+                                c.source().scene.file() + " has none");
   const YAML::Node nominal_path = c.nominal("task.path");
   double sum = 0;
   int n = 0;
@@ -159,26 +162,30 @@ double open_loop_cycle(double step) { return std::max(step, 1e-3); }
 
 const std::vector<Knob>& named_knobs(SweepRun run) {
   static const std::vector<Knob> closed = {
-      {"model_mass", nullptr, {-0.9, 9}, "", "the firmware's link masses and inertias x (1 + value)", scale_model_masses},
-      {"soil_stiffness", nullptr, {0.01, 100}, "", "the plant's soil K x value", scale_soil_stiffness},
+      {"model_mass", nullptr, {-0.9, 9}, "", "the firmware's link masses and inertias x (1 + value)", scale_model_masses, false,
+       "firmware.machine.bodies"},
+      {"soil_stiffness", nullptr, {0.01, 100}, "", "the plant's soil K x value", scale_soil_stiffness, false, "soil"},
       {"soil_blend", nullptr, {0, 1}, "", "the plant's soil from loose sand (0) to stiff clay (1), K, B and mass log-linear",
-       blend_soil},
+       blend_soil, false, "soil"},
       {"terrain_slope", nullptr, {-45, 45}, "deg",
        "the ground tilted through the dig's working area (terrain.profile), the path's poses after the first moved with it",
-       tilt_terrain},
+       tilt_terrain, false, "terrain"},
       {"path_speed", nullptr, {0.1, 10}, "", "the task's times and the run's duration / value", scale_path_speed},
       {"position_noise", "sensors.position_noise"},
       {"velocity_noise", "sensors.velocity_noise"},
       {"delay_cycles", "sensors.latency_cycles"},
       {"gain_scale", nullptr, {0.01, 100}, "",
-       "the outer law's omega_n x value (kp x s^2, kv x s, ki x s^3, Slotine-Li's lambda and kd x s)", scale_gains},
-      {"adaptation_scale", nullptr, {1e-6, 1e6}, "", "adaptation rates x value", scale_adaptation},
+       "the outer law's omega_n x value (kp x s^2, kv x s, ki x s^3, Slotine-Li's lambda and kd x s)", scale_gains, false,
+       "controller.kp controller.kv controller.ki controller.slotine_li.lambda controller.slotine_li.kd"},
+      {"adaptation_scale", nullptr, {1e-6, 1e6}, "", "adaptation rates x value", scale_adaptation, false,
+       "controller.adaptation_rate controller.slotine_li.adaptation_rate"},
   };
   static const std::vector<Knob> open = {
-      {"integrator", nullptr, {0, 0}, "", "method/formulation, e.g. rk4/augmented_baumgarte", set_integrator, true},
+      {"integrator", nullptr, {0, 0}, "", "method/formulation, e.g. rk4/augmented_baumgarte", set_integrator, true,
+       "integrator.method integrator.formulation"},
       {"integrator.step", nullptr, {1e-6, 1e-2}, "s", "the plant's step (its cycle: the step above 1 ms, else 1 ms)",
-       set_open_loop_step},
-      {"soil.stiffness", nullptr, {1, 1e9}, "N/m", "the soil's K_t, its damping ratio kept", set_soil_stiffness},
+       set_open_loop_step, false, "integrator.step integrator.cycle"},
+      {"soil.stiffness", nullptr, {1, 1e9}, "N/m", "the soil's K_t, its damping ratio kept", set_soil_stiffness, false, "soil"},
       {"profile.speed", nullptr, {0.1, 10}, "", "the effort profile's task run this many times faster"},
   };
   return run == SweepRun::open_loop ? open : closed;
@@ -207,6 +214,20 @@ Declaration knob_values(SweepRun run, const std::string& knob, const SceneSource
   Declaration values = *d;
   values.field = path;
   return values;
+}
+
+std::vector<std::string> knob_writes(SweepRun run, const std::string& knob) {
+  const Knob* k = named(run, knob);
+  if (k == nullptr) return {knob};
+  if (k->setting != nullptr) return {k->setting};
+  std::vector<std::string> paths;
+  const std::string all = k->writes;
+  for (std::size_t start = 0; start < all.size();) {
+    const std::size_t end = std::min(all.find(' ', start), all.size());
+    if (end > start) paths.push_back(all.substr(start, end - start));
+    start = end + 1;
+  }
+  return paths;
 }
 
 void set_knob(SweepRun run, const std::string& knob, const SweepValue& value, SceneChanges& changes) {
