@@ -177,7 +177,7 @@ def main(argv):
     fig.suptitle("%s RMS over %s's (worse of arm and bucket) per drawn knob; below the dashed line: 2x better"
                  % (o["law"], o["baseline"]))
     fig.tight_layout()
-    fig.savefig(os.path.join(o["figures"], "generalisation_regions.png"), dpi=110)
+    fig.savefig(os.path.join(o["figures"], "generalisation_regions.png"), dpi=80)
     plt.close(fig)
     return 0
 
