@@ -73,7 +73,9 @@ def main(argv):
         fail("%s is not there: run excavator-sim sweep-merge first" % table, 2)
     with open(table) as f:
         rows = list(csv.DictReader(f))
-    laws = [c[:-3] for c in rows[0].keys() if c.endswith("_ok")] if rows else []
+    if not rows:
+        fail("%s has no cases" % table)
+    laws = [c[:-3] for c in rows[0].keys() if c.endswith("_ok")]
     for law in (o["baseline"], o["law"]):
         if law not in laws:
             fail("law '%s' is not in %s (laws: %s)" % (law, table, ", ".join(laws)), 2)
