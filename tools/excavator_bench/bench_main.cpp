@@ -14,20 +14,20 @@
 #include <nlohmann/json.hpp>
 
 #include "app/float_environment.hpp"
-#include "bench_common.hpp"
-#include "bench_runs.hpp"
-#include "fidelity_chart.hpp"
-#include "output_file.hpp"
-#include "peer_comparison.hpp"
-#include "pressure_integration.hpp"
-#include "stability_map.hpp"
-#include "work_precision.hpp"
-#include "mjcf_export.hpp"
+#include "bench/bench_common.hpp"
+#include "bench/bench_runs.hpp"
+#include "bench/fidelity_chart.hpp"
+#include "output_files/output_file.hpp"
+#include "bench/peer_comparison.hpp"
+#include "bench/pressure_integration.hpp"
+#include "bench/stability_map.hpp"
+#include "bench/work_precision.hpp"
+#include "bench/mjcf_export.hpp"
 #ifdef EXC_HAVE_MUJOCO
-#include "mujoco_peer.hpp"
+#include "bench/mujoco_peer.hpp"
 #endif
 #include "sim_plant/plant.hpp"
-#include "helper_program.hpp"
+#include "output_files/helper_program.hpp"
 #include "option_checks.hpp"
 
 namespace fs = std::filesystem;

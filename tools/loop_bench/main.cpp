@@ -21,12 +21,12 @@
 
 #include "app/float_environment.hpp"
 #include "app/firmware_node.hpp"
-#include "callgrind_split.hpp"
+#include "bench/callgrind_split.hpp"
 #include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
 #include "model/forward_dynamics.hpp"
-#include "model_evaluations.hpp"
-#include "output_file.hpp"
+#include "bench/model_evaluations.hpp"
+#include "output_files/output_file.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/lcm_output.hpp"
 

@@ -15,7 +15,7 @@
 #include "app/float_environment.hpp"
 #include "control/task.hpp"
 #include "model/closed_chain.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "sim_plant/plant.hpp"
 
 using namespace exc;
