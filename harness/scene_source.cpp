@@ -129,6 +129,14 @@ YAML::Node SceneChanges::nominal(const std::string& path) const {
   return n;
 }
 
+YAML::Node SceneChanges::current(const std::string& path) const {
+  if (scene_ && !starts_with(path, kPlantMachine) && !starts_with(path, kFirmwareMachine)) {
+    const YAML::Node n = node_at(*scene_, path);
+    if (n.IsDefined()) return YAML::Clone(n);
+  }
+  return YAML::Clone(nominal(path));
+}
+
 SceneBundle SceneChanges::read() const {
   if (!scene_ && !plant_machine_ && !firmware_machine_) return source_.nominal;
   const settings::Document scene = scene_ ? source_.scene.with_root(*scene_) : source_.scene;

@@ -56,6 +56,10 @@ class SceneChanges {
   // The setting's value as the nominal scene reads it (a scene path: the effective configuration, every
   // default filled in; a machine path: the machine file's); throws std::invalid_argument when absent.
   YAML::Node nominal(const std::string& path) const;
+  // A scene setting as this case has it so far (a copy): what a knob set before wrote, else the
+  // nominal's. Two derived knobs that change different fields of one setting (the task path's times
+  // and its heights) compose through it, in either order.
+  YAML::Node current(const std::string& path) const;
   // The scene with the changes, read again by the readers of what changed (SettingsError when a
   // reader refuses a value).
   SceneBundle read() const;

@@ -13,7 +13,7 @@ namespace exc::plant {
 HydraulicCircuit::HydraulicCircuit(const Machine& machine, PressureMethod pressures)
     : hp_(machine.hydraulics), pressures_(pressures) {
   validate_hydraulics(machine);
-  main_relief_ = hp_.supply_pressure > 0 ? hp_.supply_pressure : hp_.main_relief_pressure;
+  main_relief_ = hp_.pump_pressure_limit();
   q_min_ = machine.q_min();
   q_max_ = machine.q_max();
   g_ = hydraulic_geometry(machine);

@@ -23,8 +23,7 @@ void check_task_efforts(FirmwareSettings& s) {
   o.terrain = s.terrain;
   if (s.controller.command_interface == control::CommandInterface::valve) {
     // A hydraulic machine: its seals and the swing motor's breakaway take part of each limit.
-    const HydraulicParameters& h = s.machine.hydraulics;
-    const double pump = h.main_relief_pressure;
+    const double pump = s.machine.hydraulics.pump_pressure_limit();
     o.friction = coulomb_level(actuator_friction(s.machine), Vec4::Constant(pump), Vec4::Zero());
   }
   const Model model = build_model(s.machine);

@@ -21,7 +21,8 @@ AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const Control
       regression_filter_(config.filter),
       identification_(config.theta_max, config.external_force.identification_memory, config.period,
                       config.external_force.force_scale),
-      tip_alpha_(1.0 - std::exp(-2.0 * 3.14159265358979323846 * config.filter.velocity_cutoff_hz * config.period)) {
+      tip_filter_(first_order_gain(config.filter.velocity_cutoff_hz, config.period)),
+      tip_chain_filter_(first_order_gain(config.filter.velocity_cutoff_hz, config.period)) {
   PidGains gains = config.gains;
   if (config.integral_action) {
     const Mat12 A = integral_error_dynamics_matrix(gains.kp, gains.kv, gains.ki);
@@ -49,8 +50,8 @@ void AdaptiveComputedTorque::reset() {
   tip_force_.setZero();
   regression_filter_.reset();
   identification_.reset();
-  tip_filter_primed_ = false;
-  tip_chain_primed_ = false;
+  tip_filter_.reset();
+  tip_chain_filter_.reset();
   feedback_.reset();
   saturated_ = 0;
 }
@@ -78,15 +79,14 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   // efforts to observe) takes the tip as measured: with its events late by the lag, its update read
   // the spring the soil had shed as its error's cause and ran away at high rates (the projection
   // test's 10x rate).
-  tip_filtered_ = tip_filter_primed_ ? Vec2(tip_filtered_ + tip_alpha_ * (ws_.rho - tip_filtered_)) : ws_.rho;
-  tip_filter_primed_ = true;
+  const Vec2& tip_filtered = tip_filter_.update(ws_.rho);
   const bool observing = config_.external_force.observer && in.applied.valid;
-  const Vec2& command_tip = observing ? tip_filtered_ : ws_.rho;
+  const Vec2& command_tip = observing ? tip_filtered : ws_.rho;
   const Vec2* tip_force = observer_.primed() ? &tip_force_ : nullptr;
   contact_.resolve(in.soil, command_tip, tip_force, out.in_soil, out.rho_env);
   bool in_soil_filtered = out.in_soil;
   Vec2 anchor_filtered = out.rho_env;
-  if (!observing) update_contact_.resolve(in.soil, tip_filtered_, tip_force, in_soil_filtered, anchor_filtered);
+  if (!observing) update_contact_.resolve(in.soil, tip_filtered, tip_force, in_soil_filtered, anchor_filtered);
   const Vec4& qdd_for_y = config_.regressor_acceleration == RegressorAcceleration::desired ? in.qdd_d : in.qdd;
   const Vec2 rhodd = ws_.J_t * qdd_for_y + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, command_tip, ws_.rhod, rhodd, out.rho_env, out.in_soil);
@@ -103,24 +103,23 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   // estimator's two stages, L) and then the anchor's tip filter (F): the soil spring's stretch is
   // taken from the filtered tip the anchors come from, so its events fall when the anchors' do.
   const Vec2 rhod_measured = ws_.J_t * in.qd_measured;
-  const Vec2 stretch = in_soil_filtered ? Vec2(tip_filtered_ - anchor_filtered) : Vec2::Zero();
+  const Vec2 stretch = in_soil_filtered ? Vec2(tip_filtered - anchor_filtered) : Vec2::Zero();
   RegressionSignals raw;  // through L (then F, below, but for the stretch: F is in it already)
   raw << (in.applied.valid ? in.applied.effort : h_a), h_a, (in_soil_filtered ? rhod_measured : Vec2::Zero()), stretch;
   const RegressionSignals& l = regression_filter_.update(raw);
   TipFilterSignals on_l;  // already through L: through F
   on_l << l.head<10>(), M_a * in.qdd, (in_soil_filtered ? rhodd : Vec2::Zero());
-  tip_chain_ = tip_chain_primed_ ? TipFilterSignals(tip_chain_ + tip_alpha_ * (on_l - tip_chain_)) : on_l;
-  tip_chain_primed_ = true;
+  const TipFilterSignals& tip_chain = tip_chain_filter_.update(on_l);
   Mat2x6 S = Mat2x6::Zero();  // F_soil = S Theta, from the signals through R
-  S(0, 0) = tip_chain_[14];
-  S(1, 3) = tip_chain_[15];
-  S(0, 1) = tip_chain_[8];
-  S(1, 4) = tip_chain_[9];
+  S(0, 0) = tip_chain[14];
+  S(1, 3) = tip_chain[15];
+  S(0, 1) = tip_chain[8];
+  S(1, 4) = tip_chain[9];
   S(0, 2) = l[10];
   S(1, 5) = l[11];
   const Mat4x6 Y_filtered = ws_.J_t.transpose() * S;
   const Vec4 id_residual =
-      tip_chain_.head<4>() - (tip_chain_.segment<4>(10) + tip_chain_.segment<4>(4)) - Y_filtered * theta_hat_;
+      tip_chain.head<4>() - (tip_chain.segment<4>(10) + tip_chain.segment<4>(4)) - Y_filtered * theta_hat_;
   out.disturbance = observer_.estimate();
   out.tip_force = tip_force_;
 

@@ -75,8 +75,8 @@ class AdaptiveComputedTorque final : public Controller {
   const Vec4& observer_estimate() const { return observer_.estimate(); }
   const Mat6& identification_covariance() const { return identification_.covariance(); }
   const Eigen::Matrix<double, 12, 1>& regression_filtered() const { return regression_filter_.value(); }
-  const Eigen::Matrix<double, 16, 1>& tip_chain() const { return tip_chain_; }
-  const Vec2& tip_filtered() const { return tip_filtered_; }
+  const Eigen::Matrix<double, 16, 1>& tip_chain() const { return tip_chain_filter_.value(); }
+  const Vec2& tip_filtered() const { return tip_filter_.value(); }
 
  private:
   const Model& model_;
@@ -97,14 +97,11 @@ class AdaptiveComputedTorque final : public Controller {
   using RegressionSignals = Eigen::Matrix<double, 12, 1>;
   EstimatorLowPass<12> regression_filter_;
   SoilLeastSquares identification_;
-  double tip_alpha_ = 1;              // the anchor rule's tip filter (first order at the velocity cut-off)
-  Vec2 tip_filtered_ = Vec2::Zero();
-  bool tip_filter_primed_ = false;
+  FirstOrderLowPass<2> tip_filter_;  // the anchor rule's tip filter (first order at the velocity cut-off)
   // The tip filter's stage for the update's other signals: applied efforts, h_a, the tip's velocity
   // (all through L first), M_a qdd and the tip's acceleration (through L by the estimator).
   using TipFilterSignals = Eigen::Matrix<double, 16, 1>;
-  TipFilterSignals tip_chain_ = TipFilterSignals::Zero();
-  bool tip_chain_primed_ = false;
+  FirstOrderLowPass<16> tip_chain_filter_;
 };
 
 }  // namespace exc::control

@@ -14,6 +14,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "control/state_estimator.hpp"
 #include "model/types.hpp"
 
 namespace exc::control {
@@ -23,7 +24,7 @@ class ExternalForceObserver {
   ExternalForceObserver() = default;
   // period of the calls (s); cutoff of the first-order low-pass (Hz).
   ExternalForceObserver(double period, double cutoff_hz)
-      : alpha_(1.0 - std::exp(-2.0 * 3.14159265358979323846 * cutoff_hz * period)) {}
+      : alpha_(first_order_gain(cutoff_hz, period)) {}
 
   void reset() {
     primed_ = 0;

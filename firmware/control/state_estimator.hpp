@@ -42,6 +42,33 @@ struct EstimatorCoefficients {
   }
 };
 
+// The gain a of a first-order low-pass y += a (u - y) sampled every `period` s with this cut-off:
+// 1 - exp(-2 pi f T), the step-invariant discretisation of 1 / (s / (2 pi f) + 1).
+inline double first_order_gain(double cutoff_hz, double period) {
+  return 1.0 - std::exp(-2.0 * 3.14159265358979323846 * cutoff_hz * period);
+}
+
+// N signals through that first-order low-pass, started at its first sample (no start-up transient).
+template <int N>
+class FirstOrderLowPass {
+ public:
+  using Vec = Eigen::Matrix<double, N, 1>;
+  explicit FirstOrderLowPass(double gain = 1.0) : gain_(gain) {}
+  void reset() { primed_ = false; }
+  const Vec& update(const Vec& u) {
+    if (primed_) out_ += gain_ * (u - out_);
+    else out_ = u;
+    primed_ = true;
+    return out_;
+  }
+  const Vec& value() const { return out_; }
+
+ private:
+  double gain_ = 1.0;
+  bool primed_ = false;
+  Vec out_ = Vec::Zero();
+};
+
 // N signals through the chain the estimator's acceleration sees (the Butterworth low-pass, then the
 // acceleration stage's 1 / (tau s + 1)): a signal filtered here lines up in time with the filtered
 // acceleration, so a regression may mix them (the adaptive law's composite update does).

@@ -43,9 +43,7 @@ struct ValveLoopModel {
   HydraulicGeometry geometry;
   HydraulicParameters hydraulics;
   Vec4 q_min = Vec4::Zero(), q_max = Vec4::Zero();  // strokes (chamber volumes)
-  double main_relief() const {
-    return hydraulics.supply_pressure > 0 ? hydraulics.supply_pressure : hydraulics.main_relief_pressure;
-  }
+  double main_relief() const { return hydraulics.pump_pressure_limit(); }
 };
 ValveLoopModel valve_loop_model(const Machine& nominal);
 

@@ -54,6 +54,8 @@ struct HydraulicParameters {
   // Pa, the pumps' pressure limit; 0: main_relief_pressure. Range [0, 1e8], at most the
   // actuators' relief_pressure.
   double supply_pressure = 0;
+  // Pa: what the pumps deliver at most (supply_pressure, or the main relief when it is 0).
+  double pump_pressure_limit() const { return supply_pressure > 0 ? supply_pressure : main_relief_pressure; }
   // Pa, return-line back pressure (the make-up valves draw from it). Range [0, 5e6].
   double tank_pressure = 0.3e6;
   // Pa: a fully open meter-out passes the speed-limit flow at this drop. Range [1e5, 3e7].

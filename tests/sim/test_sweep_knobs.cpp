@@ -3,6 +3,8 @@
 // refused when the spec loads, and each file is loaded once per process.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -151,6 +153,80 @@ TEST_CASE("tools/sweep knobs: the named knobs write the settings their rows name
   CHECK(clay.scene.soil.damping.x() == doctest::Approx(nominal.scene.soil.damping.x() * 2));  // K x 4: B x 2
 }
 
+TEST_CASE("tools/sweep knobs: soil_blend runs from loose sand to stiff clay log-linearly, terrain_slope tilts both sides' ground through the dig and the path with it, path_speed divides the task's times, and the two path knobs compose in either order") {
+  const SceneBundle& nominal = dig().nominal;
+  // Soil between the presets (machine.md's loose sand K 20 kN/m, B 2.5 kN s/m; stiff clay 200, 9).
+  const SceneBundle sand = with("soil_blend", number(0)), clay = with("soil_blend", number(1));
+  CHECK(sand.scene.soil.stiffness.x() == doctest::Approx(2e4));
+  CHECK(sand.scene.soil.damping.y() == doctest::Approx(2.5e3));
+  CHECK(clay.scene.soil.stiffness.y() == doctest::Approx(2e5));
+  CHECK(clay.scene.soil.damping.x() == doctest::Approx(9e3));
+  CHECK(clay.scene.soil.mass.x() == doctest::Approx(200));
+  const SceneBundle middle = with("soil_blend", number(0.5));
+  CHECK(middle.scene.soil.stiffness.x() == doctest::Approx(std::sqrt(2e4 * 2e5)));  // geometric, not 110 kN/m
+  CHECK(middle.scene.soil.damping.x() == doctest::Approx(std::sqrt(2.5e3 * 9e3)));
+  CHECK(std::abs(middle.scene.soil.stiffness.x() / 7e4 - 1) < 0.1);  // within 10 % of loam's K
+  CHECK(nominal.scene.soil.stiffness.x() == doctest::Approx(7e4));   // the nominal scene untouched
+
+  // The ground rising 10 degrees away from the machine, through the dig's working area: the mean x of the
+  // poses at or below the ground (6.8, 6.5, 5.6, 5.1 m: 6.0 m), where it keeps the nominal ground's height.
+  const double rise = std::tan(10 * 3.14159265358979323846 / 180);
+  const SceneBundle slope = with("terrain_slope", number(10));
+  for (const exc::Terrain* ground : {&slope.firmware.terrain, &slope.scene.terrain}) {  // the site map and the plant's soil surface
+    CHECK(ground->height_at(6.0) == doctest::Approx(0).epsilon(1e-12));
+    CHECK(ground->height_at(7.0) == doctest::Approx(rise));
+    CHECK(ground->height_at(5.0) == doctest::Approx(-rise));
+  }
+  // Every pose after the first keeps its depth below the local ground; the first (the approach in the
+  // air, the initial state's inverse kinematics) stays where it was.
+  const auto& tilted = slope.firmware.task.path;
+  const auto& flat = nominal.firmware.task.path;
+  REQUIRE(tilted.size() == flat.size());
+  CHECK(tilted[0].pose.z == flat[0].pose.z);
+  for (std::size_t i = 1; i < tilted.size(); ++i) {
+    CAPTURE(i);
+    CHECK(tilted[i].pose.x == flat[i].pose.x);
+    CHECK(tilted[i].pose.z - slope.firmware.terrain.height_at(tilted[i].pose.x) ==
+          doctest::Approx(flat[i].pose.z - nominal.firmware.terrain.height_at(flat[i].pose.x)));
+  }
+  CHECK(with("terrain_slope", number(-10)).firmware.terrain.height_at(7.0) == doctest::Approx(-rise));
+
+  // The path run 1.25x as fast: every time and the run / 1.25.
+  const SceneBundle fast = with("path_speed", number(1.25));
+  CHECK(fast.firmware.task.end_time() == doctest::Approx(nominal.firmware.task.end_time() / 1.25));
+  CHECK(fast.firmware.duration == doctest::Approx(nominal.firmware.duration / 1.25));
+  CHECK(fast.scene.duration == fast.firmware.duration);  // the plant runs as long
+  for (std::size_t i = 0; i < flat.size(); ++i) CHECK(fast.firmware.task.path[i].t == doctest::Approx(flat[i].t / 1.25));
+
+  // Both on one case, in either order: the tilted heights at the faster times.
+  for (const bool slope_first : {true, false}) {
+    CAPTURE(slope_first);
+    SceneChanges both(dig());
+    const std::vector<std::pair<std::string, double>> order =
+        slope_first ? std::vector<std::pair<std::string, double>>{{"terrain_slope", 10}, {"path_speed", 1.25}}
+                    : std::vector<std::pair<std::string, double>>{{"path_speed", 1.25}, {"terrain_slope", 10}};
+    for (const auto& [knob, x] : order) exc::sim::set_knob(SweepRun::closed_loop, knob, number(x), both);
+    const SceneBundle b = both.read();
+    for (std::size_t i = 0; i < flat.size(); ++i) {
+      CHECK(b.firmware.task.path[i].t == doctest::Approx(fast.firmware.task.path[i].t));
+      CHECK(b.firmware.task.path[i].pose.z == doctest::Approx(tilted[i].pose.z));
+    }
+    CHECK(b.firmware.duration == doctest::Approx(fast.firmware.duration));
+  }
+
+  // A joint-waypoint task: path_speed divides its waypoints' times; there is no path to tilt.
+  const exc::sim::SceneSource free = exc::sim::load_scene_source(std::string(EXC_SOURCE_DIR) + "/scenes/free_motion.yaml");
+  SceneChanges quick(free);
+  exc::sim::set_knob(SweepRun::closed_loop, "path_speed", number(0.8), quick);
+  const SceneBundle slow = quick.read();
+  REQUIRE(slow.firmware.task.waypoint_times.size() == free.nominal.firmware.task.waypoint_times.size());
+  for (std::size_t i = 0; i < slow.firmware.task.waypoint_times.size(); ++i)
+    CHECK(slow.firmware.task.waypoint_times[i] == doctest::Approx(free.nominal.firmware.task.waypoint_times[i] / 0.8));
+  SceneChanges tilt(free);
+  CHECK_THROWS_WITH_AS(exc::sim::set_knob(SweepRun::closed_loop, "terrain_slope", number(5), tilt),
+                       doctest::Contains("needs a task path"), std::exception);
+}
+
 TEST_CASE("tools/sweep knobs: docs/sweeps.md has a row for every named knob, and names no other") {
   const std::string doc = read_text_file(std::string(EXC_SOURCE_DIR) + "/docs/sweeps.md");
   const std::string start = "| run | knob | range | what it sets |";
@@ -188,6 +264,12 @@ TEST_CASE("tools/excavator-sim sweep refuses at load a value the scene's readers
       {head + "  grid:\n    machine.hydraulics.bulk_modulus: [1.0e+3]\n", "1.0e+3]",
        "sweep.grid.machine.hydraulics.bulk_modulus[0]", "allowed: a number in [1e+07, 5e+09] Pa"},
       {head + "  grid:\n    sensors.latency: [1]\n", "[1]", "sweep.grid.sensors.latency", "is no knob"},
+      // The generalisation sweep's knobs: their own ranges, and a path too fast for the actuators refused
+      // by the firmware's effort check as the scene file's would be.
+      {head + "  grid:\n    terrain_slope: [0, 50]\n", "50]", "sweep.grid.terrain_slope[1]", "allowed: a number in [-45, 45] deg"},
+      {head + "  cases: 2\n  perturbations:\n    soil_blend: [0, 1.5]\n", "1.5]", "sweep.perturbations.soil_blend[1]",
+       "allowed: a number in [0, 1]"},
+      {head + "  grid:\n    path_speed: [1, 5]\n", "5]", "sweep.grid.path_speed[1]", "is 5, refused by the scene: "},
   };
   for (const Bad& b : bad) {
     CAPTURE(b.spec);
@@ -208,6 +290,35 @@ TEST_CASE("tools/excavator-sim sweep refuses at load a value the scene's readers
   const nlohmann::json line = nlohmann::json::parse(read_text_file(ok.dir / "x.jsonl"));
   CHECK(line["set"]["delay_cycles"] == 63);
   CHECK(line["pid"].contains("ok"));
+}
+
+TEST_CASE("tools/excavator-sim sweep refuses two knobs that write one setting whole (the later would undo the earlier), and takes knobs that compose") {
+  const exc::test::Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  const std::string head = "sweep:\n  scene: " + kDig + "\n  controllers: [pid]\n  duration: 0.05\n  cases: 2\n";
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"  perturbations: {soil_blend: [0, 1], soil_stiffness: [0.5, 2]}\n", "'soil_blend' and 'soil_stiffness' both write soil"},
+      {"  perturbations: {terrain_slope: [-5, 5]}\n  grid: {terrain.height: [0.1]}\n", "both write terrain"},
+      {"  perturbations: {model_mass: [-0.1, 0.1]}\n  grid: {firmware.machine.bodies.boom.mass: [2000]}\n",
+       "both write firmware.machine.bodies"},
+      {"  perturbations: {position_noise: [0, 1.0e-4]}\n  grid: {sensors.position_noise: [0]}\n", "both write sensors.position_noise"},
+  };
+  for (const auto& [knobs, reason] : bad) {
+    CAPTURE(knobs);
+    std::ofstream(dir / "spec.yaml") << head + knobs;
+    const exc::test::Run r = run_sim("sweep " + (dir / "spec.yaml").string() + " --quiet --out x.jsonl");
+    CHECK(r.status == 2);
+    CHECK(r.err.find(reason) != std::string::npos);
+    CHECK(r.err.find("choose one") != std::string::npos);
+    CHECK_FALSE(fs::exists(r.dir / "x.jsonl"));
+  }
+  // The generalisation sweep's knobs compose: both path knobs, the soil between presets, the sensors.
+  std::ofstream(dir / "spec.yaml") << head + "  perturbations: {soil_blend: [0, 1], terrain_slope: [-15, 15], path_speed: [0.7, 1.3], "
+                                             "position_noise: [0, 3.0e-4], delay_cycles: [0, 3], model_mass: [-0.2, 0.2]}\n";
+  const exc::test::Run ok = run_sim("sweep " + (dir / "spec.yaml").string() + " --quiet --out x.jsonl");
+  REQUIRE_MESSAGE(ok.status == 0, ok.err);
+  const std::string lines = read_text_file(ok.dir / "x.jsonl");
+  CHECK(std::count(lines.begin(), lines.end(), '\n') == 2);  // both cases ran
 }
 
 TEST_CASE("tools/excavator-sim sweep and sweep-merge open each scene file and its machine file once per process, counted by strace") {

@@ -11,9 +11,9 @@
 #include <filesystem>
 #include <string>
 
-#include "log_export.hpp"
-#include "output_file.hpp"
-#include "helper_program.hpp"
+#include "log_export/log_export.hpp"
+#include "output_files/output_file.hpp"
+#include "output_files/helper_program.hpp"
 #include "option_checks.hpp"
 
 namespace {

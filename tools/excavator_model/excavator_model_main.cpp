@@ -16,7 +16,7 @@
 
 #include "model/closed_chain.hpp"
 #include "model/forward_dynamics.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "option_checks.hpp"
 
 namespace {

@@ -16,7 +16,7 @@
 #include "app/float_environment.hpp"
 #include "app/node_io.hpp"
 #include "hal/can_protocol.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "sim_plant/plant.hpp"
 #include "telemetry/telemetry_publisher.hpp"

@@ -17,14 +17,14 @@
 
 #include "app/float_environment.hpp"
 #include "control/controller_kinds.hpp"
-#include "in_process_run.hpp"
-#include "output_file.hpp"
-#include "robustness.hpp"
-#include "paper_report.hpp"
-#include "run_report.hpp"
-#include "scene_job.hpp"
+#include "report/in_process_run.hpp"
+#include "output_files/output_file.hpp"
+#include "sweep/robustness.hpp"
+#include "report/paper_report.hpp"
+#include "report/run_report.hpp"
+#include "report/scene_job.hpp"
 #include "settings/section_reader.hpp"
-#include "sweep.hpp"
+#include "sweep/sweep.hpp"
 #include "telemetry/telemetry_channels.hpp"
 
 namespace fs = std::filesystem;
@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   paper->add_flag("--quiet", paper_quiet, "no progress output");
   auto* sweep = app.add_subcommand(
       "sweep", "run a sweep's cases (all, or one shard of them for GNU parallel or a Slurm job array) into a JSON-lines "
-               "file; spec format: tools/excavator_sim/sweep.hpp and docs/sweeps.md");
+               "file; spec format: sweep/sweep.hpp and docs/sweeps.md");
   std::string sweep_spec, sweep_shard = "0/1", sweep_out;
   bool sweep_quiet = false;
   sweep->add_option("spec", sweep_spec, "sweep spec (YAML)")->required();

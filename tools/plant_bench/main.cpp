@@ -13,99 +13,20 @@
 #include "option_checks.hpp"
 
 #include "app/float_environment.hpp"
-#include "control/task.hpp"
-#include "model/closed_chain.hpp"
-#include "output_file.hpp"
+#include "bench/plant_drivers.hpp"
+#include "output_files/output_file.hpp"
 #include "sim_plant/plant.hpp"
 
 using namespace exc;
 using namespace exc::plant;
 using Clock = std::chrono::steady_clock;
 
-namespace {
+using bench::Stats;
+using bench::TaskDriver;
+using bench::ValveDriver;
+using bench::stable_in_stiff_clay;
+using bench::stats;
 
-struct Stats {
-  double median = 0, p99 = 0, max = 0;
-};
-
-Stats stats(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  Stats s;
-  s.median = v[v.size() / 2];
-  s.p99 = v[std::min(v.size() - 1, static_cast<std::size_t>(0.99 * v.size()))];
-  s.max = v.back();
-  return s;
-}
-
-// Joint-space computed torque on the scene's task (no soil compensation): what drives the dig scene
-// here, so that the plant's cost is measured on the real motion. Not the firmware's controller.
-struct TaskDriver {
-  control::Task task;
-  Model model;
-  Workspace ws;
-  TaskDriver(const control::Task& t, const Machine& m) : task(t), model(build_model(m)), ws(model) {}
-  Vec4 effort(double t, const PlantState& s) {
-    Vec4 q, qd, qdd;
-    task.trajectory.evaluate(std::min(t, task.end_time()), q, qd, qdd);
-    const Vec4 kp(400, 400, 400, 400), kd(40, 40, 40, 40);
-    const Vec4 a = qdd + kp.cwiseProduct(q - s.q_a) + kd.cwiseProduct(qd - s.qd_a);
-    Vec4 tau = Vec4::Zero();
-    if (update_closed_chain(model, ws, s.q_a, s.qd_a).ok()) inverse_dynamics(model, ws, a, Vec2::Zero(), tau);
-    return tau;
-  }
-};
-
-// The hydraulic machine on the scene's task: each valve opened for the desired velocity plus a
-// correction of the position error over the function's speed limit (the flow law's u = qd_d - K_p e
-// at the compensated meter-in's speed-limit flow, past the dead zone of its direction). What drives
-// the shipped, valve-commanded dig here; not the firmware's valve stage.
-struct ValveDriver {
-  control::Task task;
-  Vec4 speed_max, dead_extend, dead_retract;
-  explicit ValveDriver(const control::Task& t, const Machine& m)
-      : task(t), speed_max(m.speed_max()), dead_extend(m.hydraulics.dead_zone_extend),
-        dead_retract(m.hydraulics.dead_zone_retract) {}
-  Vec4 opening(double t, const PlantState& s) const {
-    Vec4 q, qd, qdd, x;
-    task.trajectory.evaluate(std::min(t, task.end_time()), q, qd, qdd);
-    for (int i = 0; i < 4; ++i) {
-      const double a = std::clamp((qd[i] + 2.0 * (q[i] - s.q_a[i])) / speed_max[i], -1.0, 1.0);
-      const double d = a >= 0 ? dead_extend[i] : dead_retract[i];
-      x[i] = a == 0 ? 0.0 : std::copysign(d + (1 - d) * std::abs(a), a);
-    }
-    return x;
-  }
-};
-
-// The stiff-clay stability probe (as tests/plant/test_stability.cpp): the reference pose with the
-// tip 0.1 m deep, moving into the soil, efforts holding the weight, 2 s.
-bool stable_in_stiff_clay(const Scene& base, IntegrationMethod m, Formulation f, double h, std::string& why) {
-  Scene s = base;
-  s.integrator.method = m;
-  s.integrator.formulation = f;
-  s.integrator.step = h;
-  s.cycle = h;
-  s.q_a0 = Vec4(0.0, 2.4626, 2.3231, 2.1447);
-  s.qd_a0 = Vec4(0.05, -0.1, 0.05, -0.05);
-  s.terrain = Terrain{};
-  s.terrain.height = 1.93;
-  s.soil = soil_preset(SoilPreset::stiff_clay);
-  s.actuators.fidelity = ActuatorFidelity::ideal;
-  Plant p(s);
-  ActuatorCommand c;
-  c.value = p.hold_effort();
-  const long n = std::lround(2.0 / h);
-  for (long k = 0; k < n; ++k) {
-    const PlantStatus st = p.step(c);
-    if (!st.ok()) {
-      why = st.text();
-      return false;
-    }
-  }
-  return true;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   exc::output::check_stdout_at_exit("excavator-plant-bench");  // stdout lost to a full disk is not exit 0

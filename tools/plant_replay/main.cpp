@@ -18,7 +18,7 @@
 #include "option_checks.hpp"
 
 #include "app/float_environment.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "sim_plant/plant.hpp"
 
 namespace {

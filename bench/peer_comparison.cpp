@@ -8,7 +8,7 @@
 
 #include "control/make_controller.hpp"
 #include "mjcf_export.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
 #ifdef EXC_HAVE_MUJOCO

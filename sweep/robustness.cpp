@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "control/controller_kinds.hpp"
-#include "run_report.hpp"
+#include "report/run_report.hpp"
 
 namespace exc::sim {
 namespace {

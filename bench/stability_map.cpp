@@ -8,8 +8,8 @@
 #include <tuple>
 
 #include "bench_common.hpp"
-#include "output_file.hpp"
-#include "sweep.hpp"
+#include "output_files/output_file.hpp"
+#include "sweep/sweep.hpp"
 
 namespace exc::bench {
 

@@ -335,6 +335,20 @@ SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
             for (const SweepAxis& a : g)
               if (a.knob == vs.first) s.fail("variants", "'" + vs.first + "' is set by the grid and by variant " + v.name);
   }
+  // Two knobs writing one setting (or one inside the other) whole: the later would undo the earlier.
+  std::vector<std::string> all = set;
+  for (const SweepDraw& d : spec.perturbations) all.push_back(d.knob);
+  if (!spec.search.knob.empty()) all.push_back(spec.search.knob);
+  const auto inside = [](const std::string& a, const std::string& b) {  // a is b or a setting within b
+    return a.compare(0, b.size(), b) == 0 && (a.size() == b.size() || a[b.size()] == '.');
+  };
+  for (std::size_t i = 0; i < all.size(); ++i)
+    for (std::size_t j = i + 1; j < all.size(); ++j)
+      for (const std::string& a : knob_writes(spec.run, all[i]))
+        for (const std::string& b : knob_writes(spec.run, all[j]))
+          if (inside(a, b) || inside(b, a))
+            s.fail_here("'" + all[i] + "' and '" + all[j] + "' both write " + (a.size() < b.size() ? a : b) +
+                        " (the later one would undo the other): choose one");
   if (spec.total_cases() > 10'000'000) s.fail_here("more than 10 million cases");
   s.finish();
   top.finish();

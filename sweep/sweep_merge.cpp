@@ -10,9 +10,9 @@
 #include <regex>
 #include <stdexcept>
 
-#include "helper_program.hpp"
-#include "output_file.hpp"
-#include "run_report.hpp"
+#include "output_files/helper_program.hpp"
+#include "output_files/output_file.hpp"
+#include "report/run_report.hpp"
 #include "fault_campaign.hpp"
 #include "sweep.hpp"
 

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "helper_program.hpp"
+#include "output_files/helper_program.hpp"
 
 namespace exc::sim {
 namespace {

@@ -14,7 +14,7 @@
 
 #include "control/flow_position_control.hpp"
 #include "harness/log_volume.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "run_report.hpp"
 #include "settings/section_reader.hpp"
 

@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "in_process_run.hpp"
+#include "report/in_process_run.hpp"
 #include "sweep.hpp"
 
 namespace exc::sim {

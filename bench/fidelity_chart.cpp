@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "bench_common.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 
 namespace exc::bench {
 

@@ -7,8 +7,8 @@
 
 #include "control/controller_kinds.hpp"
 #include "fault_campaign.hpp"
-#include "output_file.hpp"
-#include "run_report.hpp"
+#include "output_files/output_file.hpp"
+#include "report/run_report.hpp"
 #include "sweep.hpp"
 
 namespace exc::sim {

@@ -13,7 +13,7 @@
 #include "harness/lockstep_run.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
-#include "sweep_knobs.hpp"
+#include "sweep/sweep_knobs.hpp"
 
 namespace exc::bench {
 

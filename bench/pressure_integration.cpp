@@ -10,7 +10,7 @@
 #include "app/firmware_node.hpp"
 #include "bench_common.hpp"
 #include "harness/lockstep_run.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 #include "sim_plant/plant.hpp"
 
 namespace exc::bench {

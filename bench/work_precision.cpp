@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "bench_common.hpp"
-#include "output_file.hpp"
+#include "output_files/output_file.hpp"
 
 namespace exc::bench {
 

@@ -31,6 +31,10 @@ struct Knob {
   const char* what = "";
   void (*apply)(SceneChanges& changes, const SweepValue& value) = nullptr;
   bool names = false;  // takes a name instead of a number
+  // A derived knob: the settings it writes whole from the nominal scene's values (space-separated
+  // paths), which a knob changing the same setting before it would see undone. Fields it changes from
+  // the case's current values (SceneChanges::current) compose and are not listed.
+  const char* writes = "";
 };
 
 // The named knobs of a run kind (docs/sweeps.md has a row for each; tests/sim checks them).
@@ -40,6 +44,10 @@ const std::vector<Knob>& named_knobs(SweepRun run);
 // readers declared it (field: the setting's path). std::invalid_argument saying what a knob can be
 // when `knob` is neither.
 settings::Declaration knob_values(SweepRun run, const std::string& knob, const SceneSource& scene);
+
+// The settings a knob writes whole (a setting's knob: its path): two knobs of one spec whose settings
+// are the same or one inside the other would undo each other, and the spec is refused.
+std::vector<std::string> knob_writes(SweepRun run, const std::string& knob);
 
 // Puts one value of a knob into a case's changes.
 void set_knob(SweepRun run, const std::string& knob, const SweepValue& value, SceneChanges& changes);

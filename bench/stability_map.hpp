@@ -3,7 +3,7 @@
 // speed, each controller's stability against gains, adaptation, noise, delay and mass error, and the
 // hydraulic maps (the valve stage's gains and the outer law's against the plant's spool lag and bulk
 // modulus). Each is a sweep spec (sweeps/stability_*.yaml) run in this process through the sweep's
-// shard and merge (tools/excavator_sim/sweep.hpp); the merge's files are in OUT/<spec name>/.
+// shard and merge (sweep/sweep.hpp); the merge's files are in OUT/<spec name>/.
 #include <string>
 #include <vector>
 
