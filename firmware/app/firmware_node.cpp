@@ -111,20 +111,61 @@ void FirmwareNode::begin_cycle() {
 }
 
 void FirmwareNode::check_standstill(bool complete) {
-  if (machine_.mode() != control::Mode::safe_stop || escalated_ || stop_of(fault_code_) != StopKind::controlled ||
-      !complete || static_cast<double>(cycle_ - safe_stop_cycle_) * period_ < kStandstillDelay) {
-    moving_run_ = 0;
+  if (machine_.mode() != control::Mode::safe_stop) return;  // tracking: check_plausibility runs the monitor
+  if (escalated_ || stop_of(fault_code_) != StopKind::controlled || !complete) {
+    plausibility_.update(false);
+    standstill_origin_set_ = false;
     return;
   }
-  bool moving = std::abs(sensors_.velocity[0]) > kStandstillSwingRate;
-  for (int j = 1; j < 4; ++j) moving = moving || std::abs(sensors_.velocity[j]) > kStandstillCylinderRate;
-  moving_run_ = moving ? moving_run_ + 1 : 0;
-  if (moving_run_ < kStandstillCycles) return;
+  const Vec4 q = to_vec(sensors_.position);
+  char why[120] = "";
+  // What a function took: its motion plus, with pressures, its oil columns' compression (a load
+  // that changes, as a braking swing's pull on the front, moves a held cylinder as much as it
+  // compresses its oil; no oil arrives).
+  Vec4 taken = q;
+  if (valve_interface() && sensors_.pressure_valid) {
+    // The valves are centred: every bit of oil that arrives is unasked for.
+    const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+    const Vec4 compression = valves_.measured_force(p_a, p_b).cwiseQuotient(valves_.hydraulic_stiffness(q));
+    taken += compression;
+    plausibility_.update(true, Vec4::Zero(), q, compression, valves_.at_relief(p_a, p_b));
+    const std::uint8_t found = plausibility_.implausible();
+    for (int j = 0; j < 4 && why[0] == 0; ++j)
+      if ((found >> j) & 1)
+        std::snprintf(why, sizeof why, "%s took %.4f %s with its valve centred", kActiveNames[static_cast<std::size_t>(j)],
+                      plausibility_.delivered()[j], j == 0 ? "rad" : "m");
+  } else {
+    plausibility_.update(false);
+  }
+  const double since = static_cast<double>(cycle_ - safe_stop_cycle_) * period_;
+  if (why[0] == 0 && since >= kStandstillDelay) {
+    if (!standstill_origin_set_) {
+      standstill_origin_ = taken;
+      standstill_origin_cycle_ = cycle_;
+      standstill_origin_set_ = true;
+      standstill_windows_ = 0;
+    }
+    const double window = static_cast<double>(cycle_ - standstill_origin_cycle_) * period_;
+    if (window >= kStandstillWindow) {
+      const Vec4 mean = (taken - standstill_origin_) / window;
+      // Cylinders only: the swing motor's cross-port leakage (5 % of its flow at relief) lets a
+      // swing trapped on its oil spring move on for seconds; the flow test watches it.
+      for (int j = 1; j < 4 && why[0] == 0 && standstill_windows_ > 0; ++j)
+        if (std::abs(mean[j]) > kStandstillCylinderRate &&
+            std::abs(mean[j]) > (1 - kStandstillSlowing) * std::abs(standstill_mean_[j]))
+          std::snprintf(why, sizeof why, "%s takes %.4f %s/s on average over %.1f s, not slowing", kActiveNames[static_cast<std::size_t>(j)],
+                        mean[j], "m", window);
+      standstill_mean_ = mean;
+      ++standstill_windows_;
+      standstill_origin_ = taken;
+      standstill_origin_cycle_ = cycle_;
+    }
+  }
+  if (why[0] == 0) return;
   escalated_ = true;
   send_stop_frame();
   char text[sizeof(exlcm::fault_t::text)];
-  std::snprintf(text, sizeof text, "controlled stop escalated to the emergency stop: the machine still moves %.2f s after it (%s)",
-                static_cast<double>(cycle_ - safe_stop_cycle_) * period_, fault_text_);
+  std::snprintf(text, sizeof text, "controlled stop escalated to the emergency stop %.2f s after it: %s (%s)", since, why, fault_text_);
   publish_fault(fault_code_, 2, true, text);
 }
 
@@ -393,7 +434,6 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     command_.value = {0, 0, 0, 0};
     last_sent_.setZero();
     update_pump_warning(false, 0);  // centred valves ask nothing
-    plausibility_.update(false, Vec4::Zero(), to_vec(sensors_.velocity));
     return;
   }
   const std::int64_t start_ns = hal::monotonic_now_ns();
@@ -503,20 +543,26 @@ control::AppliedEffort FirmwareNode::applied_effort() const {
 }
 
 void FirmwareNode::check_plausibility(bool restarted) {
-  // The command just computed is what the valves are told from now on; the velocity measured now
-  // answers the commands before it, which the monitor's lag stands for.
+  // The command just computed is what the valves are told from now on; the motion and pressures
+  // measured now answer the commands before it, which the monitor's lag stands for.
   const control::ValveCommand& v = valves_.last();
-  const std::uint8_t found =
-      plausibility_.update(!restarted, v.velocity, estimator_.velocity(), !out_.velocity_command, last_sent_, v.force);
-  if (found == 0 || fault_) return;
+  const Vec4 q = to_vec(sensors_.position);
+  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  // Without pressures the compression is unknown: the monitor then sees the motion alone.
+  const Vec4 compression = sensors_.pressure_valid ? Vec4(v.force.cwiseQuotient(valves_.hydraulic_stiffness(q))) : Vec4::Zero();
+  const std::uint8_t at_relief = sensors_.pressure_valid ? valves_.at_relief(p_a, p_b) : 0;
+  const std::uint8_t found = plausibility_.update(!restarted, v.velocity, q, compression, at_relief);
+  if (found == 0 || fault_ || !plausibility_.settings().enabled) return;
   int j = 0;
   while (((found >> j) & 1) == 0) ++j;
   raise(FirmwareFault::velocity_implausible);
-  const char* const unit = j == 0 ? "rad/s" : "m/s";
+  const char* const unit = j == 0 ? "rad" : "m";
+  const double window = plausibility_.settings().window;
   // (fits pending_text_: the times first, the figures after)
-  std::snprintf(pending_text_, sizeof pending_text_, "velocity implausible at t = %.3f s: %s %.3f %s (cmd %.3f), effort %.3g (asked %.3g)",
-                time(), kActiveNames[static_cast<std::size_t>(j)], estimator_.velocity()[j], unit, plausibility_.expected()[j],
-                v.force[j], plausibility_.effort_expected()[j]);
+  std::snprintf(pending_text_, sizeof pending_text_,
+                "flow implausible at t = %.3f s: %s took %.4f %s over %.2f s, asked %.4f (velocity %.3f, flow asked %.3f)", time(),
+                kActiveNames[static_cast<std::size_t>(j)], plausibility_.delivered()[j], unit, window, plausibility_.asked()[j],
+                estimator_.velocity()[j], plausibility_.expected()[j]);
   // Detected when the debounce is complete: the time a fault's start is judged against.
 }
 

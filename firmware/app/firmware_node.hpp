@@ -233,7 +233,11 @@ class FirmwareNode {
   bool emergency_sent_ = false;
   bool safe_command_sent_ = false;
   bool escalated_ = false;  // the controlled stop became an emergency stop (standstill monitor)
-  int moving_run_ = 0;      // sensor sets in a row above the standstill rates in a controlled stop
+  Vec4 standstill_origin_ = Vec4::Zero();  // position at the start of the standstill window
+  Vec4 standstill_mean_ = Vec4::Zero();    // the window before's mean velocity
+  int standstill_windows_ = 0;
+  std::uint64_t standstill_origin_cycle_ = 0;
+  bool standstill_origin_set_ = false;
   int plant_hold_run_ = 0;        // consecutive sensor sets saying the plant holds while commanded
   int missed_in_a_row_ = 0;
   std::uint64_t safe_stops_ = 0;

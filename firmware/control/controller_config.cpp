@@ -83,10 +83,9 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   SectionReader pl = r.section("plausibility", "commanded against measured velocity per function, valve interface (docs/safety.md)");
   pl.flag("enabled", c.plausibility.enabled, "the monitor runs (a fault, emergency stop, when a function moves unlike its command)");
   pl.numbers("velocity_floor", c.plausibility.velocity_floor, {1e-4, 10}, "",
-             "rad/s (swing), m/s: how much faster than commanded a function may move (default: kPlausibilityVelocityShare of its top speed)");
-  pl.number("velocity_fraction", c.plausibility.velocity_fraction, {0, 10}, "", "the commanded speed's own allowance, of |u_lagged|");
-  pl.numbers("effort_floor", c.plausibility.effort_floor, {1, 1e8}, "",
-             "N m (swing), N: the law's and the measured effort both beyond it, opposed, is implausible (default: kPlausibilityEffortShare of the largest effort)");
+             "rad/s (swing), m/s: how much more flow per piston area than commanded may arrive, averaged over the window (default: kPlausibilityVelocityShare of its top speed)");
+  pl.number("velocity_fraction", c.plausibility.velocity_fraction, {0, 10}, "", "the command's own allowance, of the commanded displacement");
+  pl.number("window", c.plausibility.window, {1e-3, 10}, "s", "high-pass time constant of the delivered and commanded displacements");
   pl.number("lag", c.plausibility.lag, {0, 1}, "s", "first-order lag the commands are expected through");
   pl.number("debounce", c.plausibility.debounce, {1e-3, 1}, "s", "how long the residual must stay outside the band");
   pl.finish();
@@ -161,7 +160,6 @@ ControllerConfig controller_defaults(const Machine& nominal) {
   c.valves.force_time_constant = std::max(nominal.hydraulics.valve_time_constant, 0.005);
   c.valves.spool_lag_target = nominal.hydraulics.valve_time_constant / 3;
   c.plausibility.velocity_floor = kPlausibilityVelocityShare * nominal.speed_max();
-  c.plausibility.effort_floor = kPlausibilityEffortShare * nominal.effort_max().cwiseMax(-nominal.effort_min());
   return c;
 }
 

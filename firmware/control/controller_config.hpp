@@ -132,11 +132,10 @@ struct ControllerConfig {
 
 // The defaults a nominal machine implies (before the scene's section is read): the force loop's T_f
 // is its spools' time constant (at least 5 ms), the spool lead aims at a third of it.
-// The plausibility tests' floors as shares of each function's top speed (Machine::speed_max) and
-// largest effort: the shipped hydraulic scenes' fault-free figures stay inside them (test
-// firmware/plausibility prints the margins).
-inline constexpr double kPlausibilityVelocityShare = 0.25;
-inline constexpr double kPlausibilityEffortShare = 0.3;
+// The flow plausibility floor as a share of each function's top speed (Machine::speed_max): the
+// shipped hydraulic scenes' fault-free figures stay inside it (test firmware/plausibility prints the
+// margins), and a spool stuck at a share s of its opening is found after about share / s windows.
+inline constexpr double kPlausibilityVelocityShare = 0.1;
 ControllerConfig controller_defaults(const Machine& nominal);
 // Reads the `controller:` section into c (a field the section does not give keeps c's value, which
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,

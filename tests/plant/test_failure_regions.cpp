@@ -345,7 +345,8 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity monitor off: the 
   CHECK(e_stick + predicted_error == doctest::Approx(limit).epsilon(0.05).scale(0));  // stopped where the error met it
   CHECK(others_max < 1e-3);  // the safe state centred the other spools (within 0.2 s: 30 ms lag) ...
   CHECK(end.spool[1] == stuck);  // ... not the stuck one
-  // Still moving 0.3 s into the controlled stop: escalated to the emergency stop, the engine stopped;
+  // Oil arriving through a centred valve in the controlled stop (the standstill monitor's flow test,
+  // which runs with the tracking fault off): escalated to the emergency stop, the engine stopped;
   // the boom stops short of the end stop it would have reached at predicted_end.
   MESSAGE("standstill monitor: escalated " << node.stop_escalated() << "; boom at " << end.q_a[1] << " m at the end (end stop "
                                            << m.boom.max_length << " m, reached before at " << predicted_end << " s)");

@@ -27,9 +27,12 @@ constexpr control::ControllerKind kLaws[] = {control::ControllerKind::pid, contr
 
 TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent, detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
   // Issue 32's requirement is detection within 100 ms and the machine at rest within 1.5 s of the
-  // stick. What this branch reaches is asserted (every case found, by the velocity monitor within
-  // 0.3 s but a flow law's swing, the emergency stop sent) and the figures against the requirement
-  // are printed per case; docs/safety.md reports which cases miss it and why (not met).
+  // stick. Asserted: every case found by the flow plausibility monitor, within 100 ms under the
+  // laws that command an effort (the flow law asks only a small flow against a stuck swing, so less
+  // oil arrives against its command: 150 ms), the emergency stop sent. The time to rest is printed
+  // per case against 1.5 s: after the engine's run-down the machine's own dynamics (a gravity load
+  // through a stuck spool to its end stop, a boom ringing on its oil column) decide it;
+  // docs/safety.md reports which cases miss it and why.
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   const double t_stick = 3.0;
   double worst_detection = 0, worst_rest = 0;
@@ -52,15 +55,11 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
         INFO(name << ": " << r.failure);
         ++cases;
         REQUIRE(r.first_safe_stop_time >= 0);
-        // A flow law asks no effort, so only the velocity test watches it: a stuck swing spool barely
-        // moves the swing's inertia at first and is found by the tracking error later (the standstill
-        // monitor then escalates to the emergency stop).
         const bool flow_swing = law == control::ControllerKind::flow && joint == 0;
-        CHECK(r.first_fault_code == static_cast<int>(flow_swing ? app::FirmwareFault::tracking_error
-                                                                : app::FirmwareFault::velocity_implausible));
+        CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible));
         const double detection = r.first_fault_detected_time - t_stick;
         CHECK(detection > 0);
-        CHECK(detection <= (flow_swing ? 1.0 : 0.3));
+        CHECK(detection <= (flow_swing ? 0.15 : 0.1));
         CHECK(r.estop);
         const double rest = r.machine_at_rest_time >= 0 ? r.machine_at_rest_time - t_stick : -1;
         MESSAGE(name << ": detected after " << detection * 1e3 << " ms, at rest "
@@ -92,7 +91,9 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor never tri
   const struct {
     const char* scene;
     bool swing_moves;
-  } scenes[] = {{"dig.yaml", false}, {"free_motion.yaml", true}, {"clay_slope.yaml", false}, {"sand_skim.yaml", false}};
+  } scenes[] = {{"dig.yaml", false},        {"free_motion.yaml", true},   {"clay_slope.yaml", false},
+                {"sand_skim.yaml", false},  {"loam_noisy_late.yaml", false}, {"truck_loading.yaml", true},
+                {"truck_clay_slope.yaml", true}};
   for (const auto& sc : scenes) {
     const sim::SceneBundle b = sim::load_scene_bundle(std::string(EXC_SOURCE_DIR "/scenes/") + sc.scene);
     for (const control::ControllerKind law : kLaws) {
