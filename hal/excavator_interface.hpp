@@ -36,6 +36,9 @@ struct SensorState {
   bool motion_valid = false;      // firmware side: every value belongs to `cycle`
   bool plant_emergency = false;       // firmware side: the plant latched an emergency stop
   std::uint16_t plant_fault_code = 0;
+  // Firmware side: SUPERVISOR commands received and not yet taken, bit 1 << SupervisorCommand
+  // (start, stop, acknowledge); the taker clears them.
+  std::uint8_t supervisor_pending = 0;
 };
 
 // The three exclusive command sets (DBC ExcCommandSet): efforts, signed valve openings, or pilot

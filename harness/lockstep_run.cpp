@@ -141,6 +141,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   BurstBus plant_end(*plant_bus, burst);
   hal::FirmwareCanPort firmware_port(firmware_end);
   hal::PlantCanPort plant_port(plant_end);
+  // The operator station is outside the burst: its frames are what the fault campaign never damages.
+  hal::MemoryBusNode* operator_bus = options.supervisor.empty() ? nullptr : hub.attach();
+  hal::OperatorCanPort operator_port(operator_bus != nullptr ? *operator_bus : *firmware_bus);
+  std::size_t next_supervisor = 0;
 
   std::unique_ptr<telemetry::TelemetryPublisher> publisher;
   if (options.telemetry) {
@@ -161,6 +165,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   fc.site_map = firmware.terrain;
   fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
   fc.theta_true = theta_of(scene.soil);
+  fc.wait_for_start = options.wait_for_start;
   const Model firmware_model = build_model(firmware.machine);
   app::FirmwareNode node(firmware_model, firmware.task, fc, firmware_port, publisher.get());
   app::PlantNode plant_node(plant, plant_port, publisher.get());
@@ -216,6 +221,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         control_last_begin = node.control_timing();
         plant_last_begin = plant_node.step_timing();
         last_taken = true;
+      }
+      while (next_supervisor < options.supervisor.size() && options.supervisor[next_supervisor].time <= now + 1e-9) {
+        if (!operator_port.send(options.supervisor[next_supervisor].command))
+          throw std::runtime_error("lockstep: the operator station's SUPERVISOR frame did not go out");
+        ++next_supervisor;
       }
       node.begin_cycle();
       if (!plant_node.poll()) plant_node.coast();  // a SYNC lost in a burst: the machine moves on

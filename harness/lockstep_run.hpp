@@ -14,6 +14,7 @@
 #include "app/float_environment.hpp"
 #include "harness/scene_source.hpp"
 #include "control/controller_config.hpp"
+#include "hal/can_protocol.hpp"
 #include "settings/enum_table.hpp"
 #include "sim_plant/scene.hpp"
 
@@ -142,6 +143,13 @@ inline const char* to_string(FaultSchedule::Kind kind) {
 // machine's pumps. run_lockstep refuses such a run, a sweep such a spec before any run.
 std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene);
 
+// An operator's command, sent as a SUPERVISOR frame by a third node on the bus (an operator station)
+// just before the first cycle at or after `time` (s).
+struct SupervisorFrameAt {
+  double time = 0;
+  hal::SupervisorCommand command = hal::SupervisorCommand::none;
+};
+
 struct LockstepOptions {
   control::ControllerKind controller = control::ControllerKind::adaptive;
   double duration = 0;  // s; 0: the scene's
@@ -153,6 +161,9 @@ struct LockstepOptions {
   bool progress = false;            // one line per tenth of the run on stderr
   bool stop_at_safe_state = false;  // end the run at the firmware's first safe stop (maps, sweeps)
   FaultSchedule fault;
+  // Operator commands, in time order; and whether the firmware waits for a start before tracking.
+  std::vector<SupervisorFrameAt> supervisor;
+  bool wait_for_start = false;
   // Called after every cycle (e.g. to sample the tip for a chart). Must not allocate in the loop.
   std::function<void(std::int64_t cycle, const plant::Plant&, const app::FirmwareNode&)> observer;
   // Called after every cycle with both nodes (e.g. to scan their state). Must not allocate in the loop.

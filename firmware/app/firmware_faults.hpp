@@ -21,6 +21,7 @@ enum class FirmwareFault : std::uint16_t {
   velocity_implausible = 10,  // a function moves unlike its valve's command (stuck or runaway spool)
   exited = 11,         // the program leaves (end of run, a signal): its last command centres the valves
   fatal_error = 12,    // the program leaves on an error: the same, with the emergency stop
+  operator_stop = 13,  // an operator's stop (SUPERVISOR Command = stop): latched until acknowledged
 };
 
 // The stop a fault takes. controlled: valves centred, EmergencyStop = 0 (the valves still obey).
@@ -36,7 +37,8 @@ constexpr StopKind stop_of(FirmwareFault fault) {
     case FirmwareFault::tracking_error:
     case FirmwareFault::no_pressures:
     case FirmwareFault::deadline_overrun:
-    case FirmwareFault::exited: return StopKind::controlled;
+    case FirmwareFault::exited:
+    case FirmwareFault::operator_stop: return StopKind::controlled;
     case FirmwareFault::sensor_timeout:
     case FirmwareFault::plant_emergency:
     case FirmwareFault::plant_fault:

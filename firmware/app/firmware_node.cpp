@@ -32,6 +32,9 @@ Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]
 
 bool finite(const Vec4& v) { return v.allFinite(); }
 
+// SensorState::supervisor_pending's bit of a command.
+std::uint8_t supervisor_bit(hal::SupervisorCommand c) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(c)); }
+
 }  // namespace
 
 const char* to_string(FirmwareFault fault) {
@@ -49,6 +52,7 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::velocity_implausible: return "velocity implausible";
     case FirmwareFault::exited: return "firmware exited";
     case FirmwareFault::fatal_error: return "firmware fatal error";
+    case FirmwareFault::operator_stop: return "operator stop";
   }
   return "unknown";
 }
@@ -219,6 +223,27 @@ void FirmwareNode::check_plant_signals(bool complete) {
   }
 }
 
+void FirmwareNode::take_supervisor_commands() {
+  const std::uint8_t pending = sensors_.supervisor_pending;
+  sensors_.supervisor_pending = 0;
+  if ((pending & supervisor_bit(hal::SupervisorCommand::start)) != 0) start_received_ = true;
+  const bool stop_now = (pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0;
+  if (stop_now) {
+    operator_stop_pending_ = true;
+    start_received_ = false;  // a stop withdraws a start: the next begin needs a new one
+  }
+  const control::Mode mode = machine_.mode();
+  if (mode == control::Mode::safe_stop && !stop_now) {
+    operator_stop_pending_ = false;  // stopped already: the stop has latched
+  } else if (operator_stop_pending_ && (mode == control::Mode::hold || mode == control::Mode::track) && !fault_) {
+    // Not yet commanding (start-up): raised on the first cycle the node commands the machine.
+    operator_stop_pending_ = false;
+    raise(FirmwareFault::operator_stop);
+    std::snprintf(pending_text_, sizeof pending_text_, "operator stop: SUPERVISOR stop in %s at t = %.3f s",
+                  control::to_string(mode), time());
+  }
+}
+
 bool FirmwareNode::receive() {
   if (port_.read(sensors_) && sensors_.motion_valid && sensors_.cycle == cycle_) complete_ = true;
   return complete_;
@@ -234,13 +259,17 @@ void FirmwareNode::end_cycle() {
   }
   // An acknowledge is spent on this cycle: it clears the latched faults of the safe state, and the
   // monitors that watch standing conditions (the plant's signals below, the watchdog) raise again
-  // if theirs still stands.
-  const bool acknowledged = acknowledge_requested_ && machine_.mode() == control::Mode::safe_stop;
+  // if theirs still stands. A stop in the same cycle is raised after it, so it stands.
+  const std::uint8_t supervisor = sensors_.supervisor_pending;
+  if ((supervisor & supervisor_bit(hal::SupervisorCommand::acknowledge)) != 0) acknowledge_requested_ = true;
+  const bool acknowledged = acknowledge_requested_ && machine_.mode() == control::Mode::safe_stop &&
+                            (supervisor & supervisor_bit(hal::SupervisorCommand::stop)) == 0;
   acknowledge_requested_ = false;
   if (acknowledged) {
     fault_ = false;
     pending_fault_ = FirmwareFault::none;
   }
+  take_supervisor_commands();
   check_plant_signals(complete);
   const std::int64_t read_ns = hal::monotonic_now_ns();
   read_timing_.record_ns(read_ns - start_ns);
@@ -251,7 +280,7 @@ void FirmwareNode::end_cycle() {
   in.last_valid_frame_time = last_valid_time_;
   // The task starts once. After a safe stop the machine holds where it is when the sensors are back:
   // resuming would restart the path from its first point, a step command nobody asked for.
-  in.track_requested = t >= config_.track_delay && safe_stops_ == 0;
+  in.track_requested = t >= config_.track_delay && safe_stops_ == 0 && (start_received_ || !config_.wait_for_start);
   in.stop_requested = stop_requested_;
   // Once the task has ended it stays ended: hold must not re-enter track and restart the path.
   in.trajectory_finished =

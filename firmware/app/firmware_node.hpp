@@ -38,6 +38,9 @@ struct FirmwareNodeConfig {
   control::ControllerConfig controller;
   Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
   double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
+  // Hold until an operator's start (SUPERVISOR Command = start) before tracking; false: the task
+  // starts by itself after track_delay (the default: runs without an operator station).
+  bool wait_for_start = false;
   // Simulation only: the plant's true soil parameters, for telemetry and the Lyapunov value.
   bool theta_known = false;
   Vec6 theta_true = Vec6::Zero();
@@ -68,8 +71,11 @@ class FirmwareNode {
   bool receive();
   // Completes the cycle once the plant had its chance to answer.
   void end_cycle();
-  // A stop from outside (operator, supervisor, signal): the next cycle leaves track for hold at the
-  // desired pose of that moment, and the node stays in hold. Real-time safe (sets a flag).
+  // A stop from outside the control loop (a signal, the caller): the next cycle leaves track for
+  // hold at the desired pose of that moment, and the node stays in hold. Real-time safe (sets a
+  // flag). An operator's SUPERVISOR stop is stronger: a controlled stop that latches
+  // (FirmwareFault::operator_stop) until acknowledged.
+
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const { return stop_requested_; }
   // An operator acknowledges the latched stop (the SUPERVISOR frame's acknowledge, or a caller on
@@ -77,6 +83,8 @@ class FirmwareNode {
   // the machine is when the sensors are fresh and no fault stands; an acknowledge while a condition
   // stands is spent (a person acknowledges what they see gone). Real-time safe (sets a flag).
   void acknowledge() { acknowledge_requested_ = true; }
+  // An operator's start arrived (SUPERVISOR Command = start): a node set to wait_for_start may track.
+  bool start_received() const { return start_received_; }
   // The last frames of a program that leaves (end of run, a signal, an error): valves centred
   // (CMD_VALVE of zeros, this cycle's counter) and FW_EMERGENCY with `why` (exited: controlled stop;
   // fatal_error: emergency stop) unless a safe state already stands, whose fault it repeats. The
@@ -175,6 +183,9 @@ class FirmwareNode {
   // The machine's own signals (PLANT_EMERGENCY, SENS_MACHINE's PlantFaults and PlantState, the plant
   // heartbeat's state): raised as faults with their names (docs/safety.md, H6).
   void check_plant_signals(bool complete);
+  // Takes the SUPERVISOR commands the port received: acknowledge, start, and stop (raised as
+  // FirmwareFault::operator_stop once the node commands the machine).
+  void take_supervisor_commands();
   // The velocity plausibility monitor on this cycle's valve command (valve interface).
   void check_plausibility(bool restarted);
   // Sends FW_EMERGENCY for the current safe state: EmergencyStop set when its fault takes the
@@ -230,6 +241,8 @@ class FirmwareNode {
   double finish_time_ = 0;
   bool stop_requested_ = false;
   bool acknowledge_requested_ = false;
+  bool start_received_ = false;
+  bool operator_stop_pending_ = false;  // a SUPERVISOR stop not yet raised (the node did not command yet)
   bool emergency_sent_ = false;
   bool safe_command_sent_ = false;
   bool escalated_ = false;  // the controlled stop became an emergency stop (standstill monitor)

@@ -519,6 +519,62 @@ TEST_CASE("firmware/node: the last command of a program that leaves centres the 
   }
 }
 
+TEST_CASE("firmware/node: a node set to wait for the operator holds until a SUPERVISOR start frame, then tracks, and without the setting it starts by itself") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  SUBCASE("waits for start") {
+    cfg.wait_for_start = true;
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    hal::OperatorCanPort station(*loop.hub.attach());
+    while (loop.node.time() < 1.0) {
+      loop.cycle();
+      REQUIRE(loop.node.mode() != Mode::track);
+    }
+    CHECK(loop.node.mode() == Mode::hold);
+    // A stop before the start withdraws nothing yet given, and an acknowledge outside a stop does nothing.
+    REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
+    for (int k = 0; k < 10; ++k) loop.cycle();
+    CHECK(loop.node.mode() == Mode::hold);
+    REQUIRE(station.send(hal::SupervisorCommand::start));
+    loop.cycle();
+    CHECK(loop.node.start_received());
+    CHECK(loop.node.mode() == Mode::track);
+  }
+  SUBCASE("starts by itself") {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    while (loop.node.time() < 0.2) loop.cycle();
+    CHECK(loop.node.mode() == Mode::track);
+    CHECK_FALSE(loop.node.start_received());
+  }
+}
+
+TEST_CASE("firmware/node: SUPERVISOR stop and acknowledge in one cycle: the stop stands until an acknowledge of its own") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  hal::MemoryBusNode* station_bus = loop.hub.attach();
+  hal::OperatorCanPort station(*station_bus);
+  while (loop.node.time() < 1.0) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::track);
+  REQUIRE(station.send(hal::SupervisorCommand::stop));
+  loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::safe_stop);
+  CHECK(loop.node.last_fault() == app::FirmwareFault::operator_stop);
+  CHECK(loop.node.last_stop() == app::StopKind::controlled);
+  loop.cycle();
+  CHECK_FALSE(loop.command.emergency_stop);
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::operator_stop));
+  REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
+  REQUIRE(station.send(hal::SupervisorCommand::stop));
+  for (int k = 0; k < 20; ++k) loop.cycle();
+  CHECK(loop.node.mode() == Mode::safe_stop);
+  REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
+  loop.cycle();
+  CHECK(loop.node.mode() == Mode::hold);
+}
+
 TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or sensors cannot be trusted in take the emergency stop") {
   using app::FirmwareFault;
   using app::StopKind;
@@ -528,7 +584,7 @@ TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or
                           FirmwareFault::plant_holding, FirmwareFault::velocity_implausible, FirmwareFault::fatal_error})
     CHECK(app::stop_of(f) == StopKind::emergency);
   for (FirmwareFault f : {FirmwareFault::model, FirmwareFault::tracking_error, FirmwareFault::no_pressures,
-                          FirmwareFault::deadline_overrun, FirmwareFault::exited})
+                          FirmwareFault::deadline_overrun, FirmwareFault::exited, FirmwareFault::operator_stop})
     CHECK(app::stop_of(f) == StopKind::controlled);
-  for (int code = 0; code <= 12; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
+  for (int code = 0; code <= 13; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
 }

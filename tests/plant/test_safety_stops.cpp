@@ -14,6 +14,7 @@
 #include "app/firmware_node.hpp"
 #include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
+#include "sim_plant/plant.hpp"
 
 using namespace exc;
 
@@ -115,4 +116,111 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor never tri
       CHECK(r.safe_stops == 0);
     }
   }
+}
+
+namespace {
+
+// What a run with operator frames looked like, cycle by cycle, from the firmware's mode and the
+// plant's truth (the machine at rest: cylinders under 1 mm/s, swing under 1 mrad/s).
+struct SupervisedRun {
+  sim::RunRecord record;
+  double first_stop = -1;           // s, the first cycle in the safe state
+  double left_stop = -1;            // s, the first cycle out of it (-1: never)
+  double last_moving_stopped = -1;  // s, the last cycle the machine moved while the firmware was stopped
+  int stopped_cycles = 0;
+  bool estop = false;               // FW_EMERGENCY with EmergencyStop = 1 sent
+  app::FirmwareFault fault = app::FirmwareFault::none;
+  std::string fault_text, leave_reason;
+};
+
+SupervisedRun run_supervised(const sim::SceneBundle& b, sim::LockstepOptions o) {
+  SupervisedRun run;
+  o.observer = [&run](std::int64_t, const plant::Plant& plant, const app::FirmwareNode& node) {
+    const bool stopped = node.mode() == control::Mode::safe_stop;
+    const double t = node.time();
+    if (stopped) {
+      ++run.stopped_cycles;
+      if (run.first_stop < 0) {
+        run.first_stop = t;
+        run.fault = node.last_fault();
+        run.fault_text = node.last_fault_text();
+      }
+      const auto& qd = plant.state().qd_a;
+      bool moving = std::abs(qd[0]) >= sim::kRestSwingRate;
+      for (int j = 1; j < 4; ++j) moving = moving || std::abs(qd[j]) >= sim::kRestCylinderRate;
+      if (moving) run.last_moving_stopped = t;
+    } else if (run.first_stop >= 0 && run.left_stop < 0) {
+      run.left_stop = t;
+      run.leave_reason = node.last_transition().reason;
+    }
+    run.estop = run.estop || node.emergency_sent();
+  };
+  run.record = sim::run_lockstep(b.scene, b.firmware, o);
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the machine at rest until a SUPERVISOR acknowledge frame arrives on the bus") {
+  // The arm's spool sticks at 0.4 for 0.5 s from 3 s (then frees): the velocity monitor stops the
+  // firmware with the emergency stop. The operator station acknowledges at 7 s; without that frame
+  // the same run stays stopped to its end.
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  sim::LockstepOptions o;
+  o.controller = control::ControllerKind::pid;
+  o.duration = 8.0;
+  o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
+  o.fault.start = 3.0;
+  o.fault.duration = 0.5;
+  o.fault.joint = 2;
+  o.fault.magnitude = 0.4;
+  const double t_ack = 7.0;
+  SUBCASE("acknowledged by the frame") {
+    o.supervisor = {{t_ack, hal::SupervisorCommand::acknowledge}};
+    const SupervisedRun run = run_supervised(b, o);
+    INFO(run.record.failure << " " << run.fault_text);
+    REQUIRE(run.first_stop > 3.0);
+    CHECK(run.fault == app::FirmwareFault::velocity_implausible);
+    CHECK(run.estop);
+    // Stopped from the fault to the acknowledge's cycle, and not a cycle less (a frame sent before
+    // the harness's cycle at t is read in the firmware's cycle t + 1 ms).
+    CHECK(run.left_stop == doctest::Approx(t_ack + 1e-3).epsilon(1e-9));
+    CHECK(run.leave_reason == "acknowledged, sensor frames fresh, no fault");
+    // The machine came to rest while stopped, long before the acknowledge, and stayed there.
+    CHECK(run.last_moving_stopped >= 0);
+    CHECK(run.last_moving_stopped < t_ack - 1.0);
+    MESSAGE("stuck arm spool: stopped at " << run.first_stop << " s (" << run.fault_text << "), machine at rest from "
+                                           << run.last_moving_stopped << " s, released by the acknowledge frame at " << run.left_stop << " s");
+    // Released into hold, not back into the task.
+    CHECK(run.record.safe_stops == 1);
+  }
+  SUBCASE("no acknowledge frame: stopped to the run's end") {
+    const SupervisedRun run = run_supervised(b, o);
+    REQUIRE(run.first_stop > 3.0);
+    CHECK(run.left_stop < 0);
+    CHECK(run.last_moving_stopped < t_ack - 1.0);
+  }
+}
+
+TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machine (controlled, named, at rest), latched until acknowledged") {
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  sim::LockstepOptions o;
+  o.controller = control::ControllerKind::adaptive;
+  o.duration = 7.0;
+  o.supervisor = {{3.0, hal::SupervisorCommand::stop},
+                  {4.0, hal::SupervisorCommand::start},  // a start does not end a stop
+                  {6.0, hal::SupervisorCommand::acknowledge}};
+  const SupervisedRun run = run_supervised(b, o);
+  INFO(run.record.failure << " " << run.fault_text);
+  // Taken on the cycle the frame arrives (the firmware's cycle 3.001 s).
+  CHECK(run.first_stop == doctest::Approx(3.0 + 1e-3).epsilon(1e-9));
+  CHECK(run.fault == app::FirmwareFault::operator_stop);
+  CHECK(run.fault_text.find("operator stop: SUPERVISOR stop in track") != std::string::npos);
+  CHECK(app::stop_of(run.fault) == app::StopKind::controlled);
+  // Controlled; the standstill monitor may escalate it (printed): in the dig it does.
+  CHECK(run.last_moving_stopped < 4.5);
+  CHECK(run.left_stop == doctest::Approx(6.0 + 1e-3).epsilon(1e-9));
+  CHECK_FALSE(run.record.task_finished);
+  MESSAGE("operator stop at 3 s: machine at rest from " << run.last_moving_stopped << " s, released at " << run.left_stop
+                                                      << " s; escalated to the emergency stop: " << std::string(run.estop ? "yes" : "no"));
 }

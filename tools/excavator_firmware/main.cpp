@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
   std::string iface, scene_path, controller, json_path, lcm_url;
   double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;
-  bool realtime = false, print_config = false;
+  bool realtime = false, print_config = false, wait_for_start = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config)");
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
   app.add_option("--controller", controller, exc::control::kControllerKinds.names() + " (default: the scene's controller.type, else adaptive)")
@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
                  "real time: the run fails when its late wake-ups and skipped periods together exceed this "
                  "fraction of its cycles (default 0.01)")
       ->check(exc::cli::number_in({0, 1}, ""));
+  app.add_flag("--wait-for-start", wait_for_start, "hold until an operator's start (SUPERVISOR frame, excavator-operator start)");
   app.add_flag("--print-config", print_config,
                "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
@@ -133,6 +134,7 @@ int main(int argc, char** argv) {
     }
     fc.controller = settings.controller;
     fc.site_map = settings.terrain;
+    fc.wait_for_start = wait_for_start;
     const char* const kind_name = exc::control::to_string(fc.kind);
 
     const double period_s = settings.controller.period;
