@@ -21,6 +21,7 @@ enum class FirmwareFault : std::uint16_t {
   velocity_implausible = 10,  // a function moves unlike its valve's command (stuck or runaway spool)
   exited = 11,         // the program leaves (end of run, a signal): its last command centres the valves
   fatal_error = 12,    // the program leaves on an error: the same, with the emergency stop
+  pressure_implausible = 13,  // a chamber pressure out of range, jumping or stuck (pressure_plausibility.hpp)
 };
 
 // The stop a fault takes. controlled: valves centred, EmergencyStop = 0 (the valves still obey).
@@ -36,6 +37,9 @@ constexpr StopKind stop_of(FirmwareFault fault) {
     case FirmwareFault::tracking_error:
     case FirmwareFault::no_pressures:
     case FirmwareFault::deadline_overrun:
+    // The valves still obey and centring them needs no pressure; the position sensors, which the
+    // standstill monitor watches, are not in doubt (docs/safety.md, H4).
+    case FirmwareFault::pressure_implausible:
     case FirmwareFault::exited: return StopKind::controlled;
     case FirmwareFault::sensor_timeout:
     case FirmwareFault::plant_emergency:
