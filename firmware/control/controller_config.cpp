@@ -148,8 +148,7 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.number("watchdog_timeout", c.watchdog_timeout, {1e-4, 10}, "s", "without a valid sensor frame -> safe stop");
   r.whole("max_missed_deadlines", c.max_missed_deadlines, 1, 100000, "",
           "real time: wake-ups in a row after their deadline that are a fault (controlled stop)");
-  r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "",
-            "rad (swing), m: above it the firmware faults (default: kTrackingErrorMultiple x top speed / sqrt(kp of the defaults))");
+  r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "", "rad (swing), m: above it the firmware faults");
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
   r.flag("integral_action", c.integral_action, "integral action in the adaptive law (beyond the paper)");
   r.numbers("lyapunov_q_integral", c.lyapunov_q_integral, kWeight, "", "Q of the integral states");
@@ -169,13 +168,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   check_cross_fields(r, c);
 }
 
-Vec4 reachable_tracking_error(const Machine& nominal, const PidGains& gains) {
-  return nominal.speed_max().cwiseQuotient(gains.kp.cwiseSqrt());
-}
-
 ControllerConfig controller_defaults(const Machine& nominal) {
   ControllerConfig c;
-  c.tracking_error_limit = kTrackingErrorMultiple * reachable_tracking_error(nominal, c.gains);
   c.valves.force_time_constant = std::max(nominal.hydraulics.valve_time_constant, 0.005);
   c.valves.spool_lag_target = nominal.hydraulics.valve_time_constant / 3;
   c.plausibility.velocity_floor = kPlausibilityVelocityShare * nominal.speed_max();

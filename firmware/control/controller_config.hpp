@@ -117,9 +117,8 @@ struct ControllerConfig {
   // H4); its limits come from the machine file's hydraulics section (pressure_plausibility.hpp).
   PressurePlausibilitySettings pressure_plausibility;
   // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
-  // machine far from where it was told to go must stop. rad (swing), m (cylinders). From a machine
-  // (controller_defaults): kTrackingErrorMultiple x reachable_tracking_error; this fixed value only
-  // serves a configuration built without one.
+  // machine far from where it was told to go must stop. About twice the worst error of the PID
+  // baseline in the dig scene (bucket 0.12 m), 0.5-1 m at the tip: rad (swing), m (cylinders).
   Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();
   double blend_time = 0.2;          // s, bumpless switch fade
 
@@ -142,13 +141,6 @@ struct ControllerConfig {
 // firmware/plausibility prints the margins).
 inline constexpr double kPlausibilityVelocityShare = 0.25;
 inline constexpr double kPlausibilityEffortShare = 0.3;
-// What the machine reaches, per joint: the error a position loop at the control bandwidth lags by
-// when its function runs at top speed, v_max / omega_c, with omega_c = sqrt(kp) of the given gains
-// (the defaults': 8 rad/s, below the oil columns' 1.5-6 Hz, hydraulics.md). The tracking-error
-// limit's default is kTrackingErrorMultiple times it: an error twice what the loop lags at full speed
-// is a machine that no longer follows (docs/safety.md, H2).
-inline constexpr double kTrackingErrorMultiple = 2;
-Vec4 reachable_tracking_error(const Machine& nominal, const PidGains& gains);
 ControllerConfig controller_defaults(const Machine& nominal);
 // Reads the `controller:` section into c (a field the section does not give keeps c's value, which
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,

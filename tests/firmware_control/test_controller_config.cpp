@@ -1,6 +1,5 @@
 #include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>
-#include <cmath>
 
 #include "control/controller_config.hpp"
 #include "model/machine.hpp"
@@ -98,27 +97,4 @@ TEST_CASE("firmware/controller config errors name the field, its line and column
   check_error("controller: {regressor_acceleration: measured}", "controller.regressor_acceleration", "measured",
               "is 'measured'; allowed values: filtered, desired");
   check_error("controller: [1, 2]", "controller", "[1, 2]", "must be a mapping");
-}
-
-TEST_CASE("firmware/controller config: the tracking-error limit defaults to twice each function's top speed over the control bandwidth, a scene's value overrides it within its range") {
-  // The machine file's top speeds (machines/reference-20t.yaml: swing 1.3 rad/s, boom 0.32, arm 0.5,
-  // bucket 0.7 m/s) over sqrt(kp) of the default gains (64 1/s^2: 8 rad/s), twice.
-  const Machine m = reference_machine();
-  const ControllerConfig d;
-  const ControllerConfig c = read_controller_config(settings::Document::parse("name: x", "scene.yaml"), m);
-  for (int j = 0; j < 4; ++j) {
-    CAPTURE(j);
-    CHECK(c.tracking_error_limit[j] == doctest::Approx(2.0 * m.speed_max()[j] / std::sqrt(d.gains.kp[j])));
-  }
-  CHECK(c.tracking_error_limit[1] == doctest::Approx(2 * 0.32 / 8));
-  // A slower machine reaches less, so its limit is tighter (the figure follows the machine file).
-  Machine slow = m;
-  slow.arm.max_speed = 0.25;
-  CHECK(read_controller_config(settings::Document::parse("name: x", "scene.yaml"), slow).tracking_error_limit[2] ==
-        doctest::Approx(2 * 0.25 / 8));
-  const ControllerConfig o =
-      read_controller_config(settings::Document::parse("controller: {tracking_error_limit: [0.2, 0.1, 0.1, 0.1]}", "scene.yaml"), m);
-  CHECK(o.tracking_error_limit == Vec4(0.2, 0.1, 0.1, 0.1));
-  check_error("controller: {tracking_error_limit: [0.2, 0, 0.1, 0.1]}", "controller.tracking_error_limit[1]", "0, 0.1, 0.1]",
-              "is 0; allowed range [0.0001, 10]");
 }

@@ -533,36 +533,3 @@ TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or
     CHECK(app::stop_of(f) == StopKind::controlled);
   for (int code = 0; code <= 13; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
 }
-
-TEST_CASE("firmware/node: with the derived tracking-error limits, an error just beyond a joint's limit trips the fault naming that joint on the next cycle, one well within it does not") {
-  const Model model = build_model(reference_machine());
-  app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
-  cfg.controller = control::controller_defaults(model.machine);
-  const Vec4 limit = cfg.controller.tracking_error_limit;
-  const Vec4 mid = 0.5 * (model.machine.q_min() + model.machine.q_max());
-  for (int j = 0; j < 4; ++j) {
-    for (const double share : {1.05, 0.6}) {
-      Loop loop(model, sim::kFreeMotionTask, cfg);
-      while (loop.node.time() < 0.5) loop.cycle();
-      REQUIRE(loop.node.mode() == Mode::track);
-      // The machine displaced from its path (towards the middle of its stroke), as a slip would.
-      Vec4 q = loop.plant.q();
-      const double towards_middle = j == 0 || q[j] < mid[j] ? 1.0 : -1.0;
-      q[j] = loop.node.q_desired()[j] + towards_middle * share * limit[j];
-      loop.plant.reset(q, loop.plant.qd());
-      loop.cycle();  // the displaced machine is measured: detected on this cycle
-      loop.cycle();  // the safe state
-      const std::string what = std::string(kActiveNames[static_cast<std::size_t>(j)]) + " at " + std::to_string(share) + " of " +
-                               std::to_string(limit[j]);
-      INFO(what << ": " << loop.node.last_fault_text());
-      if (share > 1) {
-        CHECK(loop.node.mode() == Mode::safe_stop);
-        CHECK(loop.node.last_fault() == app::FirmwareFault::tracking_error);
-        CHECK(std::string(loop.node.last_fault_text()).rfind(std::string("tracking error: ") + kActiveNames[static_cast<std::size_t>(j)], 0) == 0);
-      } else {
-        CHECK(loop.node.mode() == Mode::track);
-      }
-    }
-  }
-}
