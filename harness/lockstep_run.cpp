@@ -95,12 +95,16 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
   app::InjectedFault p;
   p.joint = f.joint;
   p.magnitude = f.magnitude;
+  p.chamber = f.chamber;
   switch (f.kind) {
     case FaultSchedule::Kind::sensor_freeze: p.kind = app::InjectedFault::Kind::sensor_freeze; break;
     case FaultSchedule::Kind::sensor_jump: p.kind = app::InjectedFault::Kind::sensor_jump; break;
     case FaultSchedule::Kind::actuator_loss: p.kind = app::InjectedFault::Kind::actuator_loss; break;
     case FaultSchedule::Kind::actuator_jam: p.kind = app::InjectedFault::Kind::actuator_jam; break;
     case FaultSchedule::Kind::spool_stuck: p.kind = app::InjectedFault::Kind::valve_stuck; break;
+    case FaultSchedule::Kind::pressure_stuck: p.kind = app::InjectedFault::Kind::pressure_stuck; break;
+    case FaultSchedule::Kind::pressure_jump: p.kind = app::InjectedFault::Kind::pressure_jump; break;
+    case FaultSchedule::Kind::pressure_drift: p.kind = app::InjectedFault::Kind::pressure_drift; break;
     default: break;
   }
   return p;
@@ -109,7 +113,9 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
 }  // namespace
 
 std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
-  const bool needs_hydraulics = kind == FaultSchedule::Kind::pump_loss || kind == FaultSchedule::Kind::spool_stuck;
+  const bool needs_hydraulics = kind == FaultSchedule::Kind::pump_loss || kind == FaultSchedule::Kind::spool_stuck ||
+                                kind == FaultSchedule::Kind::pressure_stuck || kind == FaultSchedule::Kind::pressure_jump ||
+                                kind == FaultSchedule::Kind::pressure_drift;
   if (!needs_hydraulics || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
   return std::string(to_string(kind)) + " needs the hydraulic machine; " + scene.file + " has actuators " +
          plant::to_string(scene.actuators.fidelity);

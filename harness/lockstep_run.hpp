@@ -113,19 +113,24 @@ struct RunRecord {
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
 struct FaultSchedule {
-  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck };
+  enum class Kind : std::uint8_t {
+    none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck,
+    pressure_stuck, pressure_jump, pressure_drift
+  };
   Kind kind = Kind::none;
   double start = 0, duration = 0;  // s
   int joint = 1;                   // sensor and actuator faults: 0 swing .. 3 bucket
+  int chamber = 0;                 // pressure faults: 0 side A (bore, port A), 1 side B
   // bus_burst: fraction of frames damaged (split evenly into dropped, corrupted, delayed);
   // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x;
   // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only); spool_stuck: the
-  // spool position (-1..1) the joint's main-valve spool sticks at (the hydraulic machine only).
+  // spool position (-1..1) the joint's main-valve spool sticks at (the hydraulic machine only);
+  // pressure_jump: offset (Pa); pressure_drift: rate (Pa/s); pressure_stuck: none.
   double magnitude = 0;
   std::uint64_t seed = 1;
 };
 // The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 8> kFaultKinds{{{
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 11> kFaultKinds{{{
     {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
     {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
     {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
@@ -134,6 +139,9 @@ inline constexpr settings::EnumTable<FaultSchedule::Kind, 8> kFaultKinds{{{
     {FaultSchedule::Kind::rock, "rock", "the soil 5-50x stiffer"},
     {FaultSchedule::Kind::pump_loss, "pump_loss", "the hydraulic machine's pumps lose a fraction of their flow"},
     {FaultSchedule::Kind::spool_stuck, "spool_stuck", "a main-valve spool sticks at an opening (the hydraulic machine)"},
+    {FaultSchedule::Kind::pressure_stuck, "pressure_stuck", "a chamber pressure sensor holds its reading (the hydraulic machine)"},
+    {FaultSchedule::Kind::pressure_jump, "pressure_jump", "a chamber pressure reading steps by an offset (the hydraulic machine)"},
+    {FaultSchedule::Kind::pressure_drift, "pressure_drift", "a chamber pressure reading drifts out of range (the hydraulic machine)"},
 }}};
 inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);

@@ -276,6 +276,23 @@ void PlantNode::apply_sensor_fault() {
     sensors_.velocity[fault_.joint] = 0;
   } else if (fault_.kind == InjectedFault::Kind::sensor_jump) {
     sensors_.position[fault_.joint] += fault_.magnitude;
+  } else if (fault_.kind == InjectedFault::Kind::pressure_stuck || fault_.kind == InjectedFault::Kind::pressure_jump ||
+             fault_.kind == InjectedFault::Kind::pressure_drift) {
+    if (!fault_started_) {
+      frozen_ = sensors_;
+      fault_cycles_ = 0;
+    }
+    fault_started_ = true;
+    ++fault_cycles_;
+    auto& p = fault_.chamber == 0 ? sensors_.pressure_a : sensors_.pressure_b;
+    const auto& held = fault_.chamber == 0 ? frozen_.pressure_a : frozen_.pressure_b;
+    const std::size_t j = static_cast<std::size_t>(fault_.joint);
+    if (fault_.kind == InjectedFault::Kind::pressure_stuck)
+      p[j] = held[j];
+    else if (fault_.kind == InjectedFault::Kind::pressure_jump)
+      p[j] += fault_.magnitude;
+    else
+      p[j] += fault_.magnitude * static_cast<double>(fault_cycles_) * plant_.scene().cycle;
   }
 }
 

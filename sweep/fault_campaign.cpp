@@ -16,6 +16,8 @@ double fault_magnitude(Kind kind, double x) {
     case Kind::rock: return 5 + 45 * x;              // soil stiffness x
     case Kind::pump_loss: return 0.3 + 0.7 * x;      // fraction of the pumps' flow lost
     case Kind::spool_stuck: return -1 + 2 * x;       // the spool's position, any opening either way
+    case Kind::pressure_jump: return 3e6 + 20e6 * x;   // Pa, up (a reading below zero is not on the bus)
+    case Kind::pressure_drift: return 5e6 + 45e6 * x;  // Pa/s, up
     default: return 0;
   }
 }

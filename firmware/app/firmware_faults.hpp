@@ -22,6 +22,7 @@ enum class FirmwareFault : std::uint16_t {
   exited = 11,         // the program leaves (end of run, a signal): its last command centres the valves
   fatal_error = 12,    // the program leaves on an error: the same, with the emergency stop
   operator_stop = 13,  // an operator's stop (SUPERVISOR Command = stop): latched until acknowledged
+  pressure_implausible = 14,  // a chamber pressure out of range, jumping or stuck (pressure_plausibility.hpp)
 };
 
 // The stop a fault takes. controlled: valves centred, EmergencyStop = 0 (the valves still obey).
@@ -37,6 +38,9 @@ constexpr StopKind stop_of(FirmwareFault fault) {
     case FirmwareFault::tracking_error:
     case FirmwareFault::no_pressures:
     case FirmwareFault::deadline_overrun:
+    // The valves still obey and centring them needs no pressure; the position sensors, which the
+    // standstill monitor watches, are not in doubt (docs/safety.md, H4).
+    case FirmwareFault::pressure_implausible:
     case FirmwareFault::exited:
     case FirmwareFault::operator_stop: return StopKind::controlled;
     case FirmwareFault::sensor_timeout:

@@ -53,6 +53,7 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::exited: return "firmware exited";
     case FirmwareFault::fatal_error: return "firmware fatal error";
     case FirmwareFault::operator_stop: return "operator stop";
+    case FirmwareFault::pressure_implausible: return "pressure implausible";
   }
   return "unknown";
 }
@@ -90,6 +91,7 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
                        config.controller.period, control::effort_limits_of(model.machine)),
       valves_(control::valve_loop_model(model.machine), config.controller.valves, config.controller.period),
       plausibility_(config.controller.plausibility, config.controller.period),
+      pressure_monitor_(model.machine, config.controller.pressure_plausibility, config.controller.period),
       control_timing_("control", 100.0),
       cycle_timing_("cycle", config.controller.period * 1e6),
       read_timing_("read", 100.0),
@@ -463,6 +465,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     command_.value = {0, 0, 0, 0};
     last_sent_.setZero();
     update_pump_warning(false, 0);  // centred valves ask nothing
+    pressure_monitor_.update(false, false, Vec4::Zero(), Vec4::Zero(), Vec4::Zero(), Vec4::Zero());
     return;
   }
   const std::int64_t start_ns = hal::monotonic_now_ns();
@@ -531,6 +534,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))
     blender_.on_switch(t, last_sent_, out_.tau);
   if (valve_interface()) {
+    check_pressures(restarted);
     command_valves(q);
     check_plausibility(restarted);
   } else {
@@ -593,6 +597,21 @@ void FirmwareNode::check_plausibility(bool restarted) {
                 kActiveNames[static_cast<std::size_t>(j)], plausibility_.delivered()[j], unit, window, plausibility_.asked()[j],
                 estimator_.velocity()[j], plausibility_.expected()[j]);
   // Detected when the debounce is complete: the time a fault's start is judged against.
+}
+
+void FirmwareNode::check_pressures(bool restarted) {
+  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  const std::uint8_t found = pressure_monitor_.update(!restarted && sensors_.pressure_valid, complete_, p_a, p_b,
+                                                      to_vec(sensors_.position), to_vec(sensors_.velocity));
+  if (found == 0 || fault_) return;
+  int c = 0;
+  while (((found >> c) & 1) == 0) ++c;
+  raise(FirmwareFault::pressure_implausible);
+  const int j = c / 2;
+  const double p = (c % 2 == 0 ? p_a : p_b)[j];
+  std::snprintf(pending_text_, sizeof pending_text_, "pressure implausible at t = %.3f s: %s %s %.2f MPa %s", time(),
+                kActiveNames[static_cast<std::size_t>(j)], c % 2 == 0 ? "A" : "B", p * 1e-6,
+                control::to_string(pressure_monitor_.test_of(c)));
 }
 
 void FirmwareNode::raise(FirmwareFault fault) {

@@ -16,6 +16,7 @@
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
 #include "control/perf_counter.hpp"
+#include "control/pressure_plausibility.hpp"
 #include "control/state_estimator.hpp"
 #include "control/state_machine.hpp"
 #include "control/task.hpp"
@@ -123,6 +124,8 @@ class FirmwareNode {
   const control::ValveCommand& last_valve_command() const { return valves_.last(); }
   // The velocity plausibility monitor (valve interface): expected velocities, residuals, margins.
   const control::VelocityPlausibility& plausibility() const { return plausibility_; }
+  // The chamber pressures' plausibility monitor (valve interface): margins, longest frozen runs.
+  const control::PressurePlausibility& pressure_plausibility() const { return pressure_monitor_; }
   std::uint64_t pump_limited_cycles() const { return pump_limited_cycles_; }
   // Pump-limited warnings raised so far, and the text of the last one raised or cleared.
   std::uint64_t pump_warnings() const { return pump_warnings_; }
@@ -188,6 +191,8 @@ class FirmwareNode {
   void take_supervisor_commands();
   // The velocity plausibility monitor on this cycle's valve command (valve interface).
   void check_plausibility(bool restarted);
+  // The chamber pressures' plausibility monitor on this cycle's sensor set (valve interface, H4).
+  void check_pressures(bool restarted);
   // Sends FW_EMERGENCY for the current safe state: EmergencyStop set when its fault takes the
   // emergency stop.
   void send_stop_frame();
@@ -207,6 +212,7 @@ class FirmwareNode {
   control::ActuatorLagCompensator lag_compensator_;
   control::ValveInnerLoop valves_;
   control::VelocityPlausibility plausibility_;
+  control::PressurePlausibility pressure_monitor_;
   std::uint64_t pump_limited_cycles_ = 0;
   bool pump_warning_ = false;
   int pump_run_ = 0;  // cycles in a row the pumps' state has differed from the warning's

@@ -89,6 +89,18 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   pl.number("lag", c.plausibility.lag, {0, 1}, "s", "first-order lag the commands are expected through");
   pl.number("debounce", c.plausibility.debounce, {1e-3, 1}, "s", "how long the residual must stay outside the band");
   pl.finish();
+  SectionReader pp = r.section("pressure_plausibility",
+                               "the chamber pressures' range, steps and stuck-at readings, valve interface (docs/safety.md, H4)");
+  pp.flag("enabled", c.pressure_plausibility.enabled, "the monitor runs (a fault, controlled stop, when a chamber pressure is implausible)");
+  pp.number("range_margin", c.pressure_plausibility.range_margin, {0, 10e6}, "Pa",
+            "beyond the circuit's floor and its relief plus override (hydraulics section) a reading is out of range");
+  pp.number("step_factor", c.pressure_plausibility.step_factor, {1, 100}, "",
+            "times the fastest change the oil allows (bulk modulus, chamber volume, port flow): a larger step is a jump");
+  pp.whole("frozen_sets", c.pressure_plausibility.frozen_sets, 2, 1000000, "",
+           "sensor sets in a row with a bit-identical reading while the function moves: a stuck sensor");
+  pp.number("moving_share", c.pressure_plausibility.moving_share, {1e-3, 1}, "", "of the function's top speed: faster counts as moving");
+  pp.whole("debounce", c.pressure_plausibility.debounce, 1, 1000, "", "sensor sets in a row the range or the step test must fail");
+  pp.finish();
   // Derived: eq. 27 reads the tracking error as the soil's doing. Through the valves the effort arrives
   // through the force loop's T_f, whose lag the update would read as soil: the rates are those of the
   // force-commanded machine scaled by period / T_f (docs/control.md).

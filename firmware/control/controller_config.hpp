@@ -10,6 +10,7 @@
 
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
+#include "control/pressure_plausibility.hpp"
 #include "control/soil_contact.hpp"
 #include "control/state_estimator.hpp"
 #include "control/valve_inner_loop.hpp"
@@ -112,6 +113,9 @@ struct ControllerConfig {
   // Commanded against measured velocity per function on the valve interface (docs/safety.md, H1).
   // Its floors default to shares of each function's top speed and effort (controller_defaults).
   PlausibilitySettings plausibility;
+  // The chamber pressures' range, steps and stuck-at readings on the valve interface (docs/safety.md,
+  // H4); its limits come from the machine file's hydraulics section (pressure_plausibility.hpp).
+  PressurePlausibilitySettings pressure_plausibility;
   // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
   // machine far from where it was told to go must stop. About twice the worst error of the PID
   // baseline in the dig scene (bucket 0.12 m), 0.5-1 m at the tip: rad (swing), m (cylinders).

@@ -583,8 +583,10 @@ TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or
   for (FirmwareFault f : {FirmwareFault::sensor_timeout, FirmwareFault::plant_emergency, FirmwareFault::plant_fault,
                           FirmwareFault::plant_holding, FirmwareFault::velocity_implausible, FirmwareFault::fatal_error})
     CHECK(app::stop_of(f) == StopKind::emergency);
+  // A wrong pressure reading: the valves obey and the position sensors watch the stop (docs/safety.md, H4).
   for (FirmwareFault f : {FirmwareFault::model, FirmwareFault::tracking_error, FirmwareFault::no_pressures,
-                          FirmwareFault::deadline_overrun, FirmwareFault::exited, FirmwareFault::operator_stop})
+                          FirmwareFault::deadline_overrun, FirmwareFault::exited, FirmwareFault::operator_stop,
+                          FirmwareFault::pressure_implausible})
     CHECK(app::stop_of(f) == StopKind::controlled);
-  for (int code = 0; code <= 13; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
+  for (int code = 0; code <= 14; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
 }
