@@ -102,6 +102,7 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
     case FaultSchedule::Kind::actuator_loss: p.kind = app::InjectedFault::Kind::actuator_loss; break;
     case FaultSchedule::Kind::actuator_jam: p.kind = app::InjectedFault::Kind::actuator_jam; break;
     case FaultSchedule::Kind::spool_stuck: p.kind = app::InjectedFault::Kind::valve_stuck; break;
+    case FaultSchedule::Kind::machine_fault: p.kind = app::InjectedFault::Kind::machine_fault; break;
     case FaultSchedule::Kind::pressure_stuck: p.kind = app::InjectedFault::Kind::pressure_stuck; break;
     case FaultSchedule::Kind::pressure_jump: p.kind = app::InjectedFault::Kind::pressure_jump; break;
     case FaultSchedule::Kind::pressure_drift: p.kind = app::InjectedFault::Kind::pressure_drift; break;
@@ -148,7 +149,13 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   hal::FirmwareCanPort firmware_port(firmware_end);
   hal::PlantCanPort plant_port(plant_end);
   // The operator station is outside the burst: its frames are what the fault campaign never damages.
-  hal::MemoryBusNode* operator_bus = options.supervisor.empty() ? nullptr : hub.attach();
+  // An operator_stop fault is the operator station's stop frame at the fault's start.
+  std::vector<SupervisorFrameAt> supervisor = options.supervisor;
+  if (options.fault.kind == FaultSchedule::Kind::operator_stop) {
+    supervisor.push_back({options.fault.start, hal::SupervisorCommand::stop});
+    std::stable_sort(supervisor.begin(), supervisor.end(), [](const SupervisorFrameAt& a, const SupervisorFrameAt& b) { return a.time < b.time; });
+  }
+  hal::MemoryBusNode* operator_bus = supervisor.empty() ? nullptr : hub.attach();
   hal::OperatorCanPort operator_port(operator_bus != nullptr ? *operator_bus : *firmware_bus);
   std::size_t next_supervisor = 0;
 
@@ -211,7 +218,14 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     // The machine's truth: the last cycle any function moved faster than "at rest" (docs/safety.md).
     double last_moving = -1;
     bool moving_now = false;
-    for (std::int64_t k = 0; k < cycles; ++k) {
+    // A stopped run may run on past the scene's end, to see the machine come to rest (rest_horizon).
+    const std::int64_t horizon_cycles = options.rest_horizon > 0 ? static_cast<std::int64_t>(std::ceil(options.rest_horizon / scene.cycle)) : 0;
+    for (std::int64_t k = 0; k < cycles + horizon_cycles; ++k) {
+      if (k >= cycles) {
+        const double now_s = static_cast<double>(k) * scene.cycle;
+        if (result.first_safe_stop_time < 0 || now_s >= result.first_safe_stop_time + options.rest_horizon) break;
+        if (!moving_now && now_s - std::max(last_moving, 0.0) >= kRestSettle) break;
+      }
       clock.now_ns = k * period_ns;
       const double now = static_cast<double>(k) * scene.cycle;
       const bool want_fault = fault.kind != FaultSchedule::Kind::none && now >= fault.start && now < fault.start + fault.duration;
@@ -228,8 +242,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         plant_last_begin = plant_node.step_timing();
         last_taken = true;
       }
-      while (next_supervisor < options.supervisor.size() && options.supervisor[next_supervisor].time <= now + 1e-9) {
-        if (!operator_port.send(options.supervisor[next_supervisor].command))
+      while (next_supervisor < supervisor.size() && supervisor[next_supervisor].time <= now + 1e-9) {
+        if (!operator_port.send(supervisor[next_supervisor].command))
           throw std::runtime_error("lockstep: the operator station's SUPERVISOR frame did not go out");
         ++next_supervisor;
       }

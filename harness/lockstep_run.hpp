@@ -58,6 +58,7 @@ struct CycleRecord {
 // "At rest" (issue 32, docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
 inline constexpr double kRestCylinderRate = 1e-3;  // m/s
 inline constexpr double kRestSwingRate = 1e-3;     // rad/s
+inline constexpr double kRestSettle = 1.0;          // s at rest that ends a run past its scene (rest_horizon)
 
 // One closed-loop run, as every report reads it.
 struct RunRecord {
@@ -115,7 +116,7 @@ struct RunRecord {
 struct FaultSchedule {
   enum class Kind : std::uint8_t {
     none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck,
-    pressure_stuck, pressure_jump, pressure_drift
+    pressure_stuck, pressure_jump, pressure_drift, operator_stop, machine_fault
   };
   Kind kind = Kind::none;
   double start = 0, duration = 0;  // s
@@ -130,7 +131,7 @@ struct FaultSchedule {
   std::uint64_t seed = 1;
 };
 // The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 11> kFaultKinds{{{
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 13> kFaultKinds{{{
     {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
     {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
     {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
@@ -142,6 +143,8 @@ inline constexpr settings::EnumTable<FaultSchedule::Kind, 11> kFaultKinds{{{
     {FaultSchedule::Kind::pressure_stuck, "pressure_stuck", "a chamber pressure sensor holds its reading (the hydraulic machine)"},
     {FaultSchedule::Kind::pressure_jump, "pressure_jump", "a chamber pressure reading steps by an offset (the hydraulic machine)"},
     {FaultSchedule::Kind::pressure_drift, "pressure_drift", "a chamber pressure reading drifts out of range (the hydraulic machine)"},
+    {FaultSchedule::Kind::operator_stop, "operator_stop", "the operator station sends a SUPERVISOR stop at the fault's start"},
+    {FaultSchedule::Kind::machine_fault, "machine_fault", "the machine's own controller reports a fault (PlantFaults) and holds"},
 }}};
 inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);
@@ -168,6 +171,10 @@ struct LockstepOptions {
   std::uint32_t log_every = 1;
   bool progress = false;            // one line per tenth of the run on stderr
   bool stop_at_safe_state = false;  // end the run at the firmware's first safe stop (maps, sweeps)
+  // s after the firmware's first safe stop a run may go on past the scene's end while the machine
+  // still moves, so that its time to rest is seen, not cut off (the fault campaign); it ends once
+  // the machine has been at rest kRestSettle. 0: the scene's duration, always.
+  double rest_horizon = 0;
   FaultSchedule fault;
   // Operator commands, in time order; and whether the firmware waits for a start before tracking.
   std::vector<SupervisorFrameAt> supervisor;

@@ -128,7 +128,8 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   bool centred = true;
   for (double v : command_.value) centred = centred && v == 0;
   const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && centred && !hydraulic;
-  const bool hold = timed_out || command_.emergency_stop || firmware_holds;
+  const bool machine_fault = fault_.kind == InjectedFault::Kind::machine_fault;
+  const bool hold = timed_out || command_.emergency_stop || firmware_holds || machine_fault;
   if (hold && !holding_) ++holds_;
   holding_ = hold;
   // The machine's safety controller on the firmware's emergency stop (FW_EMERGENCY EmergencyStop):
@@ -186,7 +187,7 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   sensors_.plant_state = static_cast<std::uint8_t>((hold ? hal::kPlantStateHolding : 0) | (estop ? hal::kPlantStatePilotCut : 0) |
                                                    (estop ? hal::kPlantStateEngineStopped : 0) |
                                                    (hydraulic && h.holding_valves_closed ? hal::kPlantStateHoldingValvesClosed : 0));
-  sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
+  sensors_.plant_faults = static_cast<std::uint8_t>((failed() ? 1 : 0) | (machine_fault ? 2 : 0));
   if (answer && !failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
   if (answer && cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
   if (telemetry_ != nullptr) {

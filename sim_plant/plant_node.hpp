@@ -26,7 +26,10 @@ struct InjectedFault {
     none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, valve_stuck,
     // A chamber's pressure transmitter (the hydraulic machine): stuck at its reading of the fault's
     // start, stepped by an offset, or drifting at a rate (out of range without any step).
-    pressure_stuck, pressure_jump, pressure_drift
+    pressure_stuck, pressure_jump, pressure_drift,
+    // The machine's own controller reports a fault (PlantFaults bit 1) and holds its valves centred
+    // while it lasts: an ECU's pump or oil-temperature fault, a stop the machine takes by itself.
+    machine_fault
   };
   Kind kind = Kind::none;
   int joint = 0;          // 0 swing .. 3 bucket

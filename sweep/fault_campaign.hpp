@@ -16,6 +16,10 @@ namespace exc::sim {
 
 // Draws case c's fault from the case's generator: its kind from `kinds`, its start, length, joint
 // and size (ranges in docs/sweeps.md).
+// s a stopped campaign run may run past its scene to see the machine come to rest (LockstepOptions::
+// rest_horizon): twice the 1.5 s the safety concept asks, and the engine's 1 s run-down, with room.
+inline constexpr double kCampaignRestHorizon = 6.0;
+
 void draw_fault(std::mt19937_64& rng, const std::vector<std::string>& kinds, SweepCase& c);
 // Refuses a fault the scene cannot take (pump_loss without the hydraulic machine), before any run.
 void check_faults_fit(const std::vector<std::string>& kinds, const SceneBundle& scene);
