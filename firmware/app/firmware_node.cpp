@@ -692,9 +692,12 @@ void FirmwareNode::publish_cycle() {
   telemetry_->publish(telemetry::Channel::controller, s);
 }
 
-void FirmwareNode::publish_counters() {
+void FirmwareNode::publish_counters(bool after_exit_command) {
   if (telemetry_ == nullptr) return;
-  const std::int64_t utime = this->utime();
+  // The exit's safe command goes out after the last cycle: its frames' bus time falls in the period
+  // after it, the window EXC_CAN_STATS's load is taken over.
+  const double window_end = time() + (after_exit_command ? period_ : 0.0);
+  const std::int64_t utime = this->utime() + (after_exit_command ? static_cast<std::int64_t>(std::llround(period_ * 1e6)) : 0);
   // Every stage of the loop (timing_t.stage): 0 the whole end_cycle, 1 read, 2 update (estimate,
   // trajectory, law), 3 write, 6 telemetry encode; 5 the wake-up interval of a real-time loop, whose
   // overruns field carries the deadlines missed (the plant publishes 4, its step).
@@ -713,7 +716,7 @@ void FirmwareNode::publish_counters() {
   }
 
   // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
-  const double load = bus_load_.update(port_.tx_stats().bus_ns + port_.rx_bus_ns(), time());
+  const double load = bus_load_.update(port_.tx_stats().bus_ns + port_.rx_bus_ns(), window_end);
   const exlcm::can_stats_t cs = can_stats_message(port_.rx_stats(), port_.tx_stats(), 0, utime, load);
   telemetry_->publish(telemetry::Channel::can_stats, cs);
 }

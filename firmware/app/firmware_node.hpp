@@ -159,8 +159,9 @@ class FirmwareNode {
   // first met (the safe state follows the next cycle), or for a sensor timeout the first cycle
   // without a valid sensor set (the watchdog's timeout later).
   double fault_detected_time() const { return fault_detected_time_; }
-  // Publishes the timing and CAN counters now (also done every 100 cycles).
-  void publish_counters();
+  // Publishes the timing and CAN counters now (also done every 100 cycles); after_exit_command: the
+  // last ones, after the exit's safe command, whose frames take the period after the last cycle.
+  void publish_counters(bool after_exit_command = false);
   // Every value the node carries from one cycle to the next (sensors, command, the law's output and
   // integrator, the estimator's filters, the lead compensators, the desired path), for a look for
   // subnormals (docs/floating-point.md). Not on the loop's path.

@@ -238,7 +238,7 @@ int main(int argc, char** argv) {
     std::printf("excavator-firmware: last command sent: valves centred, FW_EMERGENCY %s stop (%s)\n",
                 exc::app::to_string(node.emergency_sent() ? exc::app::StopKind::emergency : exc::app::StopKind::controlled),
                 node.mode() == exc::control::Mode::safe_stop ? node.last_fault_text() : "firmware exited");
-    node.publish_counters();
+    node.publish_counters(true);
     if (io.publisher) io.publisher->stop();
 
     // The verdict: a run that never tracked, went to its safe state, or missed its deadlines failed.
