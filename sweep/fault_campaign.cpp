@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "app/firmware_faults.hpp"
+
 namespace exc::sim {
 namespace {
 
@@ -130,6 +132,28 @@ void count_campaign_run(nlohmann::json& table, const nlohmann::json& line, const
       keep_worst(k["worst_time_to_rest"], std::max(0.0, r["machine_at_rest_time"].get<double>() - start));
   }
   if (r.value("estop", false)) k["estop"] = k["estop"].get<int>() + 1;
+}
+
+void count_safety_function(nlohmann::json& table, const nlohmann::json& line, const std::string& controller) {
+  const nlohmann::json& r = line[controller];
+  const nlohmann::json& fault = line["fault"];
+  const bool stopped = r.contains("fault_code") && !r["fault_code"].is_null();
+  const std::string name = stopped ? app::to_string(static_cast<app::FirmwareFault>(r["fault_code"].get<int>())) : "none";
+  nlohmann::json& k = table[controller][name];
+  if (k.is_null())
+    k = {{"runs", 0}, {"never_at_rest", 0}, {"estop", 0}, {"kinds", nlohmann::json::object()},
+         {"worst_detection", nullptr}, {"worst_time_to_rest", nullptr}};
+  k["runs"] = k["runs"].get<int>() + 1;
+  const std::string kind = fault["kind"].get<std::string>();
+  k["kinds"][kind] = k["kinds"].value(kind, 0) + 1;
+  if (r.value("estop", false)) k["estop"] = k["estop"].get<int>() + 1;
+  if (!stopped) return;
+  const double start = fault["start"].get<double>();
+  if (r.contains("fault_detected_time")) keep_worst(k["worst_detection"], std::max(0.0, r["fault_detected_time"].get<double>() - start));
+  if (r.contains("machine_at_rest_time") && !r["machine_at_rest_time"].is_null())
+    keep_worst(k["worst_time_to_rest"], std::max(0.0, r["machine_at_rest_time"].get<double>() - start));
+  else
+    k["never_at_rest"] = k["never_at_rest"].get<int>() + 1;
 }
 
 }  // namespace exc::sim

@@ -38,5 +38,10 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
 // campaign's rows by controller and fault kind: runs, outcomes, the worst times to the safe state
 // from the fault's start and from its detection, the cases that ended neither way, and per scene.
 void count_campaign_run(nlohmann::json& table, const nlohmann::json& line, const std::string& controller);
+// The same runs per safety function (docs/safety.md): keyed by the firmware fault that took the
+// first stop (the monitor that found it), each row the runs, the fault kinds behind them, the worst
+// detection and the worst time to rest from the fault's start, the runs never at rest, the
+// emergency stops; runs without a stop under "none".
+void count_safety_function(nlohmann::json& table, const nlohmann::json& line, const std::string& controller);
 
 }  // namespace exc::sim

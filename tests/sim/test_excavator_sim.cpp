@@ -889,6 +889,18 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
       ++kinds;
     }
     CHECK(per_scene == std::map<std::string, int>{{"dig", 12}, {"free_motion", 12}});  // cases 0-11 on the dig, 12-23 on the free motion
+    // The same runs per safety function (the fault that took the stop): they add up to the runs,
+    // and each row's kinds to its runs.
+    REQUIRE(j["safety_functions"].contains(c));
+    int by_function = 0;
+    for (const auto& [name, f] : j["safety_functions"][c].items()) {
+      INFO(c << " " << name << ": " << f.dump());
+      int by_kind = 0;
+      for (const auto& [kind, n] : f["kinds"].items()) by_kind += n.get<int>();
+      CHECK(by_kind == f["runs"].get<int>());
+      by_function += f["runs"].get<int>();
+    }
+    CHECK(by_function == 24);
   }
   CHECK(runs == 2 * 24);
   CHECK(kinds == 2 * 7);
