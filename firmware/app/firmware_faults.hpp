@@ -63,13 +63,16 @@ constexpr StopKind stop_of(FirmwareFault fault) {
 // cylinder whose mean velocity (with pressures, of its motion plus its oil's compression) over a
 // kStandstillWindow exceeds its standstill rate and has not fallen by kStandstillSlowing against
 // the window before: a creep below the flow test's floor (ringing averages out; a function braking
-// slows from window to window). The rate is twice the campaign's "at rest" (1 mm/s). The swing is
-// left to the flow test: its motor's cross-port leakage moves a swing trapped on its oil spring for
-// seconds.
+// slows from window to window). The rate is twice the campaign's "at rest" (1 mm/s). The swing's
+// motor leaks across its ports (5 % of its flow at relief), so its oil's compression does not hold
+// still: its creep test is on its motion alone, over windows as long as its oil spring's period
+// (kStandstillSwingWindow, about 2.5 s on the reference machine), which its ringing averages out of.
 inline constexpr double kStandstillDelay = 0.3;            // s
 inline constexpr double kStandstillSlowing = 0.2;          // share the mean speed must fall per window
 inline constexpr double kStandstillWindow = 0.5;           // s
 inline constexpr double kStandstillCylinderRate = 0.002;  // m/s
+inline constexpr double kStandstillSwingWindow = 2.5;      // s
+inline constexpr double kStandstillSwingRate = 0.002;     // rad/s
 
 const char* to_string(FirmwareFault fault);
 const char* to_string(StopKind stop);

@@ -121,6 +121,7 @@ void FirmwareNode::check_standstill(bool complete) {
   if (escalated_ || stop_of(fault_code_) != StopKind::controlled || !complete) {
     plausibility_.update(false);
     standstill_origin_set_ = false;
+    swing_origin_set_ = false;
     return;
   }
   const Vec4 q = to_vec(sensors_.position);
@@ -165,6 +166,25 @@ void FirmwareNode::check_standstill(bool complete) {
       ++standstill_windows_;
       standstill_origin_ = taken;
       standstill_origin_cycle_ = cycle_;
+    }
+    // The swing on its motion alone, over windows as long as its oil spring's period, which its
+    // ringing averages out of: a spool stuck just past its dead zone creeps on, not slowing.
+    if (!swing_origin_set_) {
+      swing_origin_ = q[0];
+      swing_origin_cycle_ = cycle_;
+      swing_origin_set_ = true;
+      swing_windows_ = 0;
+    }
+    const double swing_window = static_cast<double>(cycle_ - swing_origin_cycle_) * period_;
+    if (swing_origin_set_ && swing_window >= kStandstillSwingWindow) {
+      const double mean = (q[0] - swing_origin_) / swing_window;
+      if (why[0] == 0 && swing_windows_ > 0 && std::abs(mean) > kStandstillSwingRate &&
+          std::abs(mean) > (1 - kStandstillSlowing) * std::abs(swing_mean_))
+        std::snprintf(why, sizeof why, "swing moves %.4f rad/s on average over %.1f s, not slowing", mean, swing_window);
+      swing_mean_ = mean;
+      ++swing_windows_;
+      swing_origin_ = q[0];
+      swing_origin_cycle_ = cycle_;
     }
   }
   if (why[0] == 0) return;

@@ -256,6 +256,10 @@ class FirmwareNode {
   Vec4 standstill_origin_ = Vec4::Zero();  // position at the start of the standstill window
   Vec4 standstill_mean_ = Vec4::Zero();    // the window before's mean velocity
   int standstill_windows_ = 0;
+  double swing_origin_ = 0, swing_mean_ = 0;  // the swing's own windows (kStandstillSwingWindow)
+  std::uint64_t swing_origin_cycle_ = 0;
+  bool swing_origin_set_ = false;
+  int swing_windows_ = 0;
   std::uint64_t standstill_origin_cycle_ = 0;
   bool standstill_origin_set_ = false;
   int plant_hold_run_ = 0;        // consecutive sensor sets saying the plant holds while commanded
