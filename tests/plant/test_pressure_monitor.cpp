@@ -14,6 +14,7 @@
 #include "sim_plant/plant_node.hpp"
 #include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
+#include "plant_scenes.hpp"
 
 using namespace exc;
 
@@ -144,13 +145,7 @@ TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting cha
 }
 
 TEST_CASE("firmware/pressure plausibility: without a fault the pressure monitor never trips on the shipped hydraulic scenes under every law they run, its margins printed") {
-  const struct {
-    const char* scene;
-    bool swing_moves;
-  } scenes[] = {{"dig.yaml", false},      {"free_motion.yaml", true},   {"clay_slope.yaml", false},
-                {"sand_skim.yaml", false}, {"loam_noisy_late.yaml", false}, {"truck_loading.yaml", true},
-                {"truck_clay_slope.yaml", true}};
-  for (const auto& sc : scenes) {
+  for (const auto& sc : plant::test::kShippedHydraulicScenes) {
     const sim::SceneBundle b = sim::load_scene_bundle(std::string(EXC_SOURCE_DIR "/scenes/") + sc.scene);
     REQUIRE(b.firmware.controller.command_interface == control::CommandInterface::valve);
     for (const control::ControllerKind law : kLaws) {

@@ -11,20 +11,12 @@
 using namespace exc;
 using namespace exc::plant;
 
+using plant::test::hydraulic_scene;
+using plant::test::valve;
+
 namespace {
 
-ActuatorCommand valve(const Vec4& opening) {
-  ActuatorCommand c;
-  c.mode = ActuatorCommand::valve;
-  c.value = opening;
-  return c;
-}
 
-Scene hydraulic_scene() {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  return t.scene();
-}
 
 }  // namespace
 

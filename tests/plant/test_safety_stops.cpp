@@ -14,6 +14,7 @@
 #include "app/firmware_node.hpp"
 #include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
+#include "plant_scenes.hpp"
 #include "sim_plant/plant.hpp"
 
 using namespace exc;
@@ -89,13 +90,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
 TEST_CASE("firmware/plausibility: without a fault the velocity monitor never trips on the shipped hydraulic scenes under every law they run, its margins printed") {
   // The shipped scenes that drive the hydraulic machine through its valves, the laws each runs
   // without faulting (flow-based control lags a moving swing past its tracking limit: not run there).
-  const struct {
-    const char* scene;
-    bool swing_moves;
-  } scenes[] = {{"dig.yaml", false},        {"free_motion.yaml", true},   {"clay_slope.yaml", false},
-                {"sand_skim.yaml", false},  {"loam_noisy_late.yaml", false}, {"truck_loading.yaml", true},
-                {"truck_clay_slope.yaml", true}};
-  for (const auto& sc : scenes) {
+  for (const auto& sc : plant::test::kShippedHydraulicScenes) {
     const sim::SceneBundle b = sim::load_scene_bundle(std::string(EXC_SOURCE_DIR "/scenes/") + sc.scene);
     for (const control::ControllerKind law : kLaws) {
       if (law == control::ControllerKind::flow && sc.swing_moves) continue;
