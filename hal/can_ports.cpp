@@ -28,7 +28,9 @@ std::uint8_t nibble(std::uint64_t cycle) { return static_cast<std::uint8_t>(cycl
 std::size_t receive_ids(Node receiver, std::uint32_t* out, std::size_t capacity) {
   std::size_t n = 0;
   for (const MessageSpec& m : protocol_messages()) {
-    if (m.sender != receiver && n < capacity) out[n++] = m.id;
+    // SUPERVISOR's one receiver is the firmware (the DBC): the plant's kernel filter keeps it out.
+    const bool for_receiver = m.sender != receiver && (m.sender != Node::operator_station || receiver == Node::firmware);
+    if (for_receiver && n < capacity) out[n++] = m.id;
   }
   return n;
 }
@@ -135,6 +137,12 @@ void FirmwareCanPort::apply(const MessageSpec& message, const CanFrame& frame, S
       state.plant_emergency = v[0] != 0.0;
       state.plant_fault_code = static_cast<std::uint16_t>(v[1]);
       break;
+    case can_id::supervisor: {
+      // Kept until the node takes it; a value outside the DBC's range is no command.
+      const auto command = static_cast<unsigned>(v[0]);
+      if (command >= 1 && command <= 3) state.supervisor_pending |= static_cast<std::uint8_t>(1u << command);
+      break;
+    }
     default:
       break;
   }
@@ -147,6 +155,21 @@ bool FirmwareCanPort::read(SensorState& state) {
   if (have_sensors_) state.cycle = cycle_;
   state.motion_valid = have_sensors_;
   return have_sensors_;
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Operator station
+
+OperatorCanPort::OperatorCanPort(CanBus& bus, std::uint8_t first_counter)
+    : bus_(bus), spec_(spec_of(can_id::supervisor)), counter_(first_counter) {}
+
+bool OperatorCanPort::send(SupervisorCommand command) {
+  const double values[] = {static_cast<double>(command)};
+  CanFrame frame;
+  encode_message(spec_, counter_, values, frame);
+  if (!bus_.send(frame)) return false;
+  counter_ = static_cast<std::uint8_t>((counter_ + 1) & 0x0F);
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------------

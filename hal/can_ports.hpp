@@ -79,6 +79,21 @@ class FirmwareCanPort : public CanPortEnd {
   bool have_sensors_ = false;  // SENS_MACHINE of cycle_ arrived
 };
 
+// An operator station (or remote e-stop kit) on the bus: sends SUPERVISOR frames, one per command,
+// counting its own sends. A program that sends one command and exits starts a new sequence each
+// run, which the firmware's codec accepts as a sender that paused (more than 5 ms since its last).
+class OperatorCanPort {
+ public:
+  explicit OperatorCanPort(CanBus& bus, std::uint8_t first_counter = 0);
+  bool send(SupervisorCommand command);
+  std::uint8_t next_counter() const { return counter_; }
+
+ private:
+  CanBus& bus_;
+  const MessageSpec& spec_;
+  std::uint8_t counter_;
+};
+
 class PlantCanPort : public CanPortEnd {
  public:
   explicit PlantCanPort(CanBus& bus, CanFrameCodec::Config config = {});

@@ -17,6 +17,9 @@ constexpr SignalSpec plant_emergency[] = {
     {"EmergencyStop", 4, 1, false, 1, 0, 0, 1, ""},
     {"FaultCode", 8, 16, false, 1, 0, 0, 65535, ""},
     crc_at(4)};
+// An operator's command (SupervisorCommand); ranked just below the two emergency frames.
+constexpr SignalSpec supervisor[] = {
+    counter_signal, {"Command", 4, 4, false, 1, 0, 0, 3, ""}, crc_at(2)};
 constexpr SignalSpec sync[] = {
     counter_signal,
     {"Cycle", 4, 20, false, 1, 0, 0, 1048575, ""},
@@ -93,6 +96,7 @@ constexpr std::uint8_t count_of(const SignalSpec (&)[N]) {
 const std::array<MessageSpec, kMessageCount> kMessages{{
     {"FW_EMERGENCY", can_id::fw_emergency, 4, true, true, Node::firmware, 0, CommandSet::none, fw_emergency, count_of(fw_emergency)},
     {"PLANT_EMERGENCY", can_id::plant_emergency, 4, true, true, Node::plant, 0, CommandSet::none, plant_emergency, count_of(plant_emergency)},
+    {"SUPERVISOR", can_id::supervisor, 2, true, true, Node::operator_station, 0, CommandSet::none, supervisor, count_of(supervisor)},
     {"SYNC", can_id::sync, 4, true, true, Node::firmware, 1, CommandSet::none, sync, count_of(sync)},
     {"CMD_EFFORT", can_id::cmd_effort, 12, true, true, Node::firmware, 1, CommandSet::effort, cmd_effort, count_of(cmd_effort)},
     {"CMD_VALVE", can_id::cmd_valve, 8, true, true, Node::firmware, 1, CommandSet::valve, cmd_valve, count_of(cmd_valve)},
@@ -105,6 +109,25 @@ const std::array<MessageSpec, kMessageCount> kMessages{{
 }  // namespace
 
 const std::array<MessageSpec, kMessageCount>& protocol_messages() { return kMessages; }
+
+const char* to_string(Node node) {
+  switch (node) {
+    case Node::firmware: return "Firmware";
+    case Node::plant: return "Plant";
+    case Node::operator_station: return "Operator";
+  }
+  return "?";
+}
+
+const char* to_string(SupervisorCommand command) {
+  switch (command) {
+    case SupervisorCommand::none: return "none";
+    case SupervisorCommand::start: return "start";
+    case SupervisorCommand::stop: return "stop";
+    case SupervisorCommand::acknowledge: return "acknowledge";
+  }
+  return "?";
+}
 
 int message_index(std::uint32_t id) {
   for (std::size_t i = 0; i < kMessages.size(); ++i) {

@@ -8,7 +8,10 @@
 
 namespace exc::hal {
 
-enum class Node : std::uint8_t { firmware, plant };
+// operator_station: an operator station or remote e-stop kit; it only sends (SUPERVISOR).
+enum class Node : std::uint8_t { firmware, plant, operator_station };
+// The DBC's node name (BU_): "Firmware", "Plant", "Operator".
+const char* to_string(Node node);
 
 // One DBC signal, Intel byte order: `start` is the bit number of the least significant bit, bit k of
 // the frame being bit k % 8 of byte k / 8. physical = raw * factor + offset, allowed in [min, max].
@@ -48,6 +51,7 @@ struct MessageSpec {
 namespace can_id {
 inline constexpr std::uint32_t fw_emergency = 0x010;
 inline constexpr std::uint32_t plant_emergency = 0x011;
+inline constexpr std::uint32_t supervisor = 0x012;
 inline constexpr std::uint32_t sync = 0x080;
 inline constexpr std::uint32_t cmd_effort = 0x100;
 inline constexpr std::uint32_t cmd_valve = 0x102;
@@ -57,7 +61,11 @@ inline constexpr std::uint32_t fw_heartbeat = 0x701;
 inline constexpr std::uint32_t plant_heartbeat = 0x702;
 }  // namespace can_id
 
-inline constexpr std::size_t kMessageCount = 9;
+// SUPERVISOR's Command signal.
+enum class SupervisorCommand : std::uint8_t { none = 0, start = 1, stop = 2, acknowledge = 3 };
+const char* to_string(SupervisorCommand command);
+
+inline constexpr std::size_t kMessageCount = 10;
 // The most data signals of any message (SENS_MACHINE): a buffer of this size holds any decoded frame.
 inline constexpr std::size_t kMaxDataSignals = 21;
 inline constexpr std::int64_t kCyclePeriodNs = 1'000'000;  // one SYNC per millisecond

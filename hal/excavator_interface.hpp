@@ -11,6 +11,14 @@ inline constexpr int kAxisCount = 4;
 inline constexpr int kPumpCount = 2;
 enum Axis : int { kSwing = 0, kBoom = 1, kArm = 2, kBucket = 3 };
 
+// SENS_MACHINE's and PLANT_HEARTBEAT's PlantState, bit by bit (the machine's safety controller's
+// feedback, docs/safety.md): holding (valves centred or braked, commands ignored), pilot supply cut,
+// engine stopped (its run-down begun), load-holding valves closed.
+inline constexpr std::uint8_t kPlantStateHolding = 1;
+inline constexpr std::uint8_t kPlantStatePilotCut = 2;
+inline constexpr std::uint8_t kPlantStateEngineStopped = 4;
+inline constexpr std::uint8_t kPlantStateHoldingValvesClosed = 8;
+
 struct SensorState {
   std::array<double, kAxisCount> position{};  // swing angle (rad); cylinder pin-to-pin lengths (m)
   std::array<double, kAxisCount> velocity{};  // swing rate (rad/s); cylinder stroke rates (m/s)
@@ -21,13 +29,16 @@ struct SensorState {
   // The pressures are measured (the hydraulic plant); false for the force-commanded fidelities.
   // Plant: what it sends; firmware: what the last sensor frame said.
   bool pressure_valid = false;
-  std::uint8_t plant_state = 0;   // plant state machine, 0..15 (meaning owned by the plant)
+  std::uint8_t plant_state = 0;   // kPlantState* bits
   std::uint8_t plant_faults = 0;  // plant fault bits
   std::uint8_t plant_heartbeat_state = 0;  // firmware side: PlantState of the last plant heartbeat
   std::uint64_t cycle = 0;        // plant: the SYNC cycle this answers; firmware: cycle of the last complete set
   bool motion_valid = false;      // firmware side: every value belongs to `cycle`
   bool plant_emergency = false;       // firmware side: the plant latched an emergency stop
   std::uint16_t plant_fault_code = 0;
+  // Firmware side: SUPERVISOR commands received and not yet taken, bit 1 << SupervisorCommand
+  // (start, stop, acknowledge); the taker clears them.
+  std::uint8_t supervisor_pending = 0;
 };
 
 // The three exclusive command sets (DBC ExcCommandSet): efforts, signed valve openings, or pilot

@@ -95,11 +95,17 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
   app::InjectedFault p;
   p.joint = f.joint;
   p.magnitude = f.magnitude;
+  p.chamber = f.chamber;
   switch (f.kind) {
     case FaultSchedule::Kind::sensor_freeze: p.kind = app::InjectedFault::Kind::sensor_freeze; break;
     case FaultSchedule::Kind::sensor_jump: p.kind = app::InjectedFault::Kind::sensor_jump; break;
     case FaultSchedule::Kind::actuator_loss: p.kind = app::InjectedFault::Kind::actuator_loss; break;
     case FaultSchedule::Kind::actuator_jam: p.kind = app::InjectedFault::Kind::actuator_jam; break;
+    case FaultSchedule::Kind::spool_stuck: p.kind = app::InjectedFault::Kind::valve_stuck; break;
+    case FaultSchedule::Kind::machine_fault: p.kind = app::InjectedFault::Kind::machine_fault; break;
+    case FaultSchedule::Kind::pressure_stuck: p.kind = app::InjectedFault::Kind::pressure_stuck; break;
+    case FaultSchedule::Kind::pressure_jump: p.kind = app::InjectedFault::Kind::pressure_jump; break;
+    case FaultSchedule::Kind::pressure_drift: p.kind = app::InjectedFault::Kind::pressure_drift; break;
     default: break;
   }
   return p;
@@ -108,8 +114,11 @@ app::InjectedFault plant_fault_of(const FaultSchedule& f) {
 }  // namespace
 
 std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
-  if (kind != FaultSchedule::Kind::pump_loss || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
-  return "pump_loss needs the hydraulic machine; " + scene.file + " has actuators " +
+  const bool needs_hydraulics = kind == FaultSchedule::Kind::pump_loss || kind == FaultSchedule::Kind::spool_stuck ||
+                                kind == FaultSchedule::Kind::pressure_stuck || kind == FaultSchedule::Kind::pressure_jump ||
+                                kind == FaultSchedule::Kind::pressure_drift;
+  if (!needs_hydraulics || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
+  return std::string(to_string(kind)) + " needs the hydraulic machine; " + scene.file + " has actuators " +
          plant::to_string(scene.actuators.fidelity);
 }
 
@@ -139,6 +148,16 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   BurstBus plant_end(*plant_bus, burst);
   hal::FirmwareCanPort firmware_port(firmware_end);
   hal::PlantCanPort plant_port(plant_end);
+  // The operator station is outside the burst: its frames are what the fault campaign never damages.
+  // An operator_stop fault is the operator station's stop frame at the fault's start.
+  std::vector<SupervisorFrameAt> supervisor = options.supervisor;
+  if (options.fault.kind == FaultSchedule::Kind::operator_stop) {
+    supervisor.push_back({options.fault.start, hal::SupervisorCommand::stop});
+    std::stable_sort(supervisor.begin(), supervisor.end(), [](const SupervisorFrameAt& a, const SupervisorFrameAt& b) { return a.time < b.time; });
+  }
+  hal::MemoryBusNode* operator_bus = supervisor.empty() ? nullptr : hub.attach();
+  hal::OperatorCanPort operator_port(operator_bus != nullptr ? *operator_bus : *firmware_bus);
+  std::size_t next_supervisor = 0;
 
   std::unique_ptr<telemetry::TelemetryPublisher> publisher;
   if (options.telemetry) {
@@ -159,6 +178,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   fc.site_map = firmware.terrain;
   fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
   fc.theta_true = theta_of(scene.soil);
+  fc.wait_for_start = options.wait_for_start;
   const Model firmware_model = build_model(firmware.machine);
   app::FirmwareNode node(firmware_model, firmware.task, fc, firmware_port, publisher.get());
   app::PlantNode plant_node(plant, plant_port, publisher.get());
@@ -195,7 +215,17 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     app::AllocationCounter counter;
     const FaultSchedule& fault = options.fault;
     bool fault_on = false;
-    for (std::int64_t k = 0; k < cycles; ++k) {
+    // The machine's truth: the last cycle any function moved faster than "at rest" (docs/safety.md).
+    double last_moving = -1;
+    bool moving_now = false;
+    // A stopped run may run on past the scene's end, to see the machine come to rest (rest_horizon).
+    const std::int64_t horizon_cycles = options.rest_horizon > 0 ? static_cast<std::int64_t>(std::ceil(options.rest_horizon / scene.cycle)) : 0;
+    for (std::int64_t k = 0; k < cycles + horizon_cycles; ++k) {
+      if (k >= cycles) {
+        const double now_s = static_cast<double>(k) * scene.cycle;
+        if (result.first_safe_stop_time < 0 || now_s >= result.first_safe_stop_time + options.rest_horizon) break;
+        if (!moving_now && now_s - std::max(last_moving, 0.0) >= kRestSettle) break;
+      }
       clock.now_ns = k * period_ns;
       const double now = static_cast<double>(k) * scene.cycle;
       const bool want_fault = fault.kind != FaultSchedule::Kind::none && now >= fault.start && now < fault.start + fault.duration;
@@ -212,6 +242,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         plant_last_begin = plant_node.step_timing();
         last_taken = true;
       }
+      while (next_supervisor < supervisor.size() && supervisor[next_supervisor].time <= now + 1e-9) {
+        if (!operator_port.send(supervisor[next_supervisor].command))
+          throw std::runtime_error("lockstep: the operator station's SUPERVISOR frame did not go out");
+        ++next_supervisor;
+      }
       node.begin_cycle();
       if (!plant_node.poll()) plant_node.coast();  // a SYNC lost in a burst: the machine moves on
       node.end_cycle();
@@ -222,6 +257,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         first_taken = true;
       }
       const plant::PlantState& s = plant.state();
+      moving_now = std::abs(s.qd_a[0]) >= kRestSwingRate;
+      for (int j = 1; j < 4; ++j) moving_now = moving_now || std::abs(s.qd_a[j]) >= kRestCylinderRate;
+      if (moving_now) last_moving = s.time;
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
       if (hydraulic) {
         result.peak_pressure = std::max(result.peak_pressure, s.hydraulics.max_pressure);
@@ -248,6 +286,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         // The firmware's clock (the schedule's): the plant's lags it by every SYNC a burst dropped.
         result.first_safe_stop_time = node.time();
         result.first_fault_detected_time = node.fault_detected_time();
+        result.first_fault_code = static_cast<int>(node.last_fault());
       }
       if (options.observer) options.observer(k, plant, node);
       if (options.node_observer) options.node_observer(k, plant_node, node);
@@ -261,7 +300,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
       }
     }
     allocations = counter.count();
+    // At rest from the first sample after the last that moved; never, if the last one moved.
+    if (!moving_now) result.machine_at_rest_time = last_moving < 0 ? 0.0 : last_moving + scene.cycle;
   }
+  result.estop = node.emergency_sent();
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   if (options.progress && interactive) std::fprintf(stderr, "\n");
   node.publish_counters();

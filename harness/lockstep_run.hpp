@@ -14,6 +14,7 @@
 #include "app/float_environment.hpp"
 #include "harness/scene_source.hpp"
 #include "control/controller_config.hpp"
+#include "hal/can_protocol.hpp"
 #include "settings/enum_table.hpp"
 #include "sim_plant/scene.hpp"
 
@@ -54,6 +55,11 @@ struct CycleRecord {
   double theta_hat[6] = {0, 0, 0, 0, 0, 0};  // the soil estimates at the cycle's end
 };
 
+// "At rest" (issue 32, docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
+inline constexpr double kRestCylinderRate = 1e-3;  // m/s
+inline constexpr double kRestSwingRate = 1e-3;     // rad/s
+inline constexpr double kRestSettle = 1.0;          // s at rest that ends a run past its scene (rest_horizon)
+
 // One closed-loop run, as every report reads it.
 struct RunRecord {
   std::string controller;
@@ -87,6 +93,12 @@ struct RunRecord {
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
   double first_fault_detected_time = -1;  // s its fault was detected (FirmwareNode::fault_detected_time)
+  int first_fault_code = 0;               // app::FirmwareFault of the first safe state
+  // Judged by the machine (docs/safety.md), from the plant's truth: the first time after which every
+  // cylinder stays under 1 mm/s and the swing under 1 mrad/s to the run's end (-1: it never does,
+  // i.e. it still moves at the end), and whether the firmware sent the emergency stop.
+  double machine_at_rest_time = -1;
+  bool estop = false;
   // The hydraulic machine (zeros for force-commanded fidelities), from the plant's true circuit and
   // the firmware's valve stage.
   bool hydraulic = false;
@@ -102,18 +114,24 @@ struct RunRecord {
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
 struct FaultSchedule {
-  enum class Kind : std::uint8_t { none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss };
+  enum class Kind : std::uint8_t {
+    none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck,
+    pressure_stuck, pressure_jump, pressure_drift, operator_stop, machine_fault
+  };
   Kind kind = Kind::none;
   double start = 0, duration = 0;  // s
   int joint = 1;                   // sensor and actuator faults: 0 swing .. 3 bucket
+  int chamber = 0;                 // pressure faults: 0 side A (bore, port A), 1 side B
   // bus_burst: fraction of frames damaged (split evenly into dropped, corrupted, delayed);
   // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x;
-  // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only).
+  // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only); spool_stuck: the
+  // spool position (-1..1) the joint's main-valve spool sticks at (the hydraulic machine only);
+  // pressure_jump: offset (Pa); pressure_drift: rate (Pa/s); pressure_stuck: none.
   double magnitude = 0;
   std::uint64_t seed = 1;
 };
 // The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 7> kFaultKinds{{{
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 13> kFaultKinds{{{
     {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
     {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
     {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
@@ -121,6 +139,12 @@ inline constexpr settings::EnumTable<FaultSchedule::Kind, 7> kFaultKinds{{{
     {FaultSchedule::Kind::actuator_jam, "actuator_jam", "an actuator jams"},
     {FaultSchedule::Kind::rock, "rock", "the soil 5-50x stiffer"},
     {FaultSchedule::Kind::pump_loss, "pump_loss", "the hydraulic machine's pumps lose a fraction of their flow"},
+    {FaultSchedule::Kind::spool_stuck, "spool_stuck", "a main-valve spool sticks at an opening (the hydraulic machine)"},
+    {FaultSchedule::Kind::pressure_stuck, "pressure_stuck", "a chamber pressure sensor holds its reading (the hydraulic machine)"},
+    {FaultSchedule::Kind::pressure_jump, "pressure_jump", "a chamber pressure reading steps by an offset (the hydraulic machine)"},
+    {FaultSchedule::Kind::pressure_drift, "pressure_drift", "a chamber pressure reading drifts out of range (the hydraulic machine)"},
+    {FaultSchedule::Kind::operator_stop, "operator_stop", "the operator station sends a SUPERVISOR stop at the fault's start"},
+    {FaultSchedule::Kind::machine_fault, "machine_fault", "the machine's own controller reports a fault (PlantFaults) and holds"},
 }}};
 inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);
@@ -129,6 +153,13 @@ inline const char* to_string(FaultSchedule::Kind kind) {
 // Why a fault of `kind` cannot run on `scene` ("" when it can): pump_loss needs the hydraulic
 // machine's pumps. run_lockstep refuses such a run, a sweep such a spec before any run.
 std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene);
+
+// An operator's command, sent as a SUPERVISOR frame by a third node on the bus (an operator station)
+// just before the first cycle at or after `time` (s).
+struct SupervisorFrameAt {
+  double time = 0;
+  hal::SupervisorCommand command = hal::SupervisorCommand::none;
+};
 
 struct LockstepOptions {
   control::ControllerKind controller = control::ControllerKind::adaptive;
@@ -140,7 +171,14 @@ struct LockstepOptions {
   std::uint32_t log_every = 1;
   bool progress = false;            // one line per tenth of the run on stderr
   bool stop_at_safe_state = false;  // end the run at the firmware's first safe stop (maps, sweeps)
+  // s after the firmware's first safe stop a run may go on past the scene's end while the machine
+  // still moves, so that its time to rest is seen, not cut off (the fault campaign); it ends once
+  // the machine has been at rest kRestSettle. 0: the scene's duration, always.
+  double rest_horizon = 0;
   FaultSchedule fault;
+  // Operator commands, in time order; and whether the firmware waits for a start before tracking.
+  std::vector<SupervisorFrameAt> supervisor;
+  bool wait_for_start = false;
   // Called after every cycle (e.g. to sample the tip for a chart). Must not allocate in the loop.
   std::function<void(std::int64_t cycle, const plant::Plant&, const app::FirmwareNode&)> observer;
   // Called after every cycle with both nodes (e.g. to scan their state). Must not allocate in the loop.

@@ -50,6 +50,8 @@ void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
   target_.setZero();
   spool_.setZero();
   stuck_ = -1;
+  pilot_on_ = engine_on_ = true;
+  pilot_ = engine_ = 1;
   const double low = 2.0 * hp_.tank_pressure;
   for (int i = 0; i < kNumActive; ++i) {
     const double f = hold[i];
@@ -117,10 +119,18 @@ double HydraulicCircuit::piston_leakage_flow(double coefficient, double dp, doub
 void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   HydraulicReport& r = report_;
   HydraulicEnergy& e = r.energy;
-  // Spools: lag toward the target, then the dead zone of the direction they moved in.
+  // The safety hardware: the pilot supply (first order) and the engine's flow (linear run-down).
+  pilot_ += ((pilot_on_ ? 1.0 : 0.0) - pilot_) * spool_lag_gain(hp_.pilot_cutoff_time, dt);
+  engine_ = std::clamp(engine_ + (engine_on_ ? dt : -dt) / hp_.engine_rundown_time, 0.0, 1.0);
+  const bool holding_closed = holding_valves_closed();
+  r.pilot_supply = pilot_;
+  r.engine_flow = engine_;
+  r.holding_valves_closed = holding_closed;
+  // Spools: lag toward the target (what the pilots push, as far as the supply gives them), then the
+  // dead zone of the direction they moved in.
   const double lag_gain = spool_lag_gain(hp_.valve_time_constant, dt);
   for (int i = 0; i < kNumActive; ++i) {
-    spool_[i] = i == stuck_ ? stuck_spool_ : spool_lag(spool_[i], target_[i], lag_gain);
+    spool_[i] = i == stuck_ ? stuck_spool_ : spool_lag(spool_[i], target_[i] * pilot_, lag_gain);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);
     r.opening[i] = spool_[i] >= 0 ? a : -a;
   }
@@ -128,7 +138,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // relief), summed per pump; the flow-sharing factor follows (flow_sharing.hpp). It is taken from
   // the pressures at the start of the substep.
   const int pumps = hp_.pumps_merged ? 1 : kNumPumps;
-  const double pump_limit = hp_.pump_flow * pump_flow_scale_ / pumps;
+  const double pump_limit = hp_.pump_flow * pump_flow_scale_ * engine_ / pumps;
   double demand[kNumPumps] = {0, 0};
   for (int i = 0; i < kNumActive; ++i) {
     const double a = r.opening[i];
@@ -175,6 +185,10 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
       vb.meter_in_gain = scale[g] * g_.meter_in_b[i] * -a;
       va.meter_out_gain = g_.meter_out_a[i] * -a;
     }
+    // A closed load-holding valve blocks every way out of its chamber but the port relief: the boom's
+    // cap side, the arm's rod side (in-flow, through its check, stays open).
+    if (holding_closed && i == 1) va.meter_out_gain = va.leakage_gain = 0;
+    if (holding_closed && i == 2) vb.meter_out_gain = vb.leakage_gain = 0;
     const double swept_a = g_.area_a[i] * qd_a[i] * dt, swept_b = -g_.area_b[i] * qd_a[i] * dt;
     const ChamberStep sa = step(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
     const ChamberStep sb = step(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);

@@ -69,6 +69,9 @@ struct HydraulicReport {
   std::int64_t cavitation_substeps = 0; // substeps with a chamber held at the vapour floor
   double min_pressure = 0, max_pressure = 0;  // Pa, over all chambers now
   int solver_iterations = 0;            // of the eight chamber solves in the last substep
+  // The safety hardware: pilot supply and engine flow (0..1), the load-holding valves closed.
+  double pilot_supply = 1, engine_flow = 1;
+  bool holding_valves_closed = false;
   HydraulicEnergy energy;
 };
 
@@ -93,6 +96,17 @@ class HydraulicCircuit {
   int stuck_function() const { return stuck_; }  // -1: none
   // Fault injection (the fault campaign): the pumps deliver `scale` of pump_flow from now on.
   void set_pump_flow_scale(double scale) { pump_flow_scale_ = scale; }
+  // The machine's safety hardware (docs/safety.md). Pilot cut-off: with the supply off, the pilot
+  // supply decays with hydraulics.pilot_cutoff_time and every spool's target with it (they spring to
+  // centre; a stuck spool keeps its opening); back on, it recovers likewise. Engine stop: the pumps'
+  // flow falls linearly to zero over hydraulics.engine_rundown_time (and rises so on a restart).
+  // Load-holding valves (hydraulics.load_holding_valves): closed while the supply is below half.
+  void set_pilot_supply(bool on) { pilot_on_ = on; }
+  void set_engine_running(bool on) { engine_on_ = on; }
+  double pilot_supply() const { return pilot_; }   // 0..1 of the pilot pressure
+  double engine_flow() const { return engine_; }   // 0..1 of the pumps' rated flow
+  bool holding_valves_closed() const { return hp_.load_holding_valves && pilot_ < 0.5; }
+  bool swing_brake_applied() const { return hp_.swing_brake_torque > 0 && pilot_ < 0.5; }
 
   // Advance spools, pumps and chambers over dt; q_a is the position at the end, qd_a the velocity
   // over the substep (the piston sweeps A qd_a dt).
@@ -131,6 +145,8 @@ class HydraulicCircuit {
   Vec4 relief_setting_ = Vec4::Zero();
   double k_relief_ = 0, k_makeup_ = 0;
   double pump_flow_scale_ = 1;
+  bool pilot_on_ = true, engine_on_ = true;
+  double pilot_ = 1, engine_ = 1;
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();
   Vec4 v_a_ = Vec4::Zero(), v_b_ = Vec4::Zero();  // chamber volumes at the end of the last substep
   HydraulicReport report_;

@@ -192,6 +192,9 @@ Vec4 Plant::apply_dry_friction(const MechanicalState& before) {
   const Vec4 fc = coulomb_level(friction_, actuators_.pressure_a(), actuators_.pressure_b());
   Vec4 bound;
   for (int i = 0; i < kNumActive; ++i) bound[i] = h * dry_friction(friction_, i, fc[i], before.qd_a[i]);
+  // The swing parking brake, applied while the pilot supply is cut (HydraulicParameters).
+  const HydraulicCircuit& circuit = actuators_.hydraulics();
+  if (circuit.swing_brake_applied()) bound[0] += h * circuit.parameters().swing_brake_torque;
   const bool independent = scene_.integrator.formulation == Formulation::independent;
   Mat4 inverse_mass;
   if (independent) {

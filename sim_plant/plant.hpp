@@ -62,6 +62,10 @@ class Plant {
   void release_spool() { actuators_.release_spool(); }
   // The hydraulic machine's pumps deliver `scale` of their flow from now on (1: the machine's).
   void set_pump_flow_scale(double scale) { actuators_.set_pump_flow_scale(scale); }
+  // The machine's safety hardware (hydraulic fidelity; HydraulicCircuit): the pilot cut-off and the
+  // engine stop. Their state: hydraulics() of actuators(), or PlantNode's PlantState bits.
+  void set_pilot_supply(bool on) { actuators_.set_pilot_supply(on); }
+  void set_engine_running(bool on) { actuators_.set_engine_running(on); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.

@@ -128,9 +128,17 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   bool centred = true;
   for (double v : command_.value) centred = centred && v == 0;
   const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && centred && !hydraulic;
-  const bool hold = timed_out || command_.emergency_stop || firmware_holds;
+  const bool machine_fault = fault_.kind == InjectedFault::Kind::machine_fault;
+  const bool hold = timed_out || command_.emergency_stop || firmware_holds || machine_fault;
   if (hold && !holding_) ++holds_;
   holding_ = hold;
+  // The machine's safety controller on the firmware's emergency stop (FW_EMERGENCY EmergencyStop):
+  // pilot supply cut (every spool springs to centre), engine stopped (the pumps run down), and so
+  // the load-holding valves closed; all back when the stop is released (docs/safety.md).
+  if (hydraulic) {
+    plant_.set_pilot_supply(!command_.emergency_stop);
+    plant_.set_engine_running(!command_.emergency_stop);
+  }
 
   // Any other command goes to the plant as the kind it is: a kind the actuators cannot use (efforts
   // for valves, openings or pilots for force actuators) stops the plant with its message, so a
@@ -174,8 +182,12 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   for (int p = 0; p < hal::kPumpCount; ++p) sensors_.pump_pressure[p] = r.pump_pressure[p];
   sensors_.pressure_valid = hydraulic;
   apply_sensor_fault();
-  sensors_.plant_state = static_cast<std::uint8_t>(hold ? 1 : 0);
-  sensors_.plant_faults = static_cast<std::uint8_t>(failed() ? 1 : 0);
+  const plant::HydraulicReport& h = plant_.state().hydraulics;
+  const bool estop = hydraulic && command_.emergency_stop;
+  sensors_.plant_state = static_cast<std::uint8_t>((hold ? hal::kPlantStateHolding : 0) | (estop ? hal::kPlantStatePilotCut : 0) |
+                                                   (estop ? hal::kPlantStateEngineStopped : 0) |
+                                                   (hydraulic && h.holding_valves_closed ? hal::kPlantStateHoldingValvesClosed : 0));
+  sensors_.plant_faults = static_cast<std::uint8_t>((failed() ? 1 : 0) | (machine_fault ? 2 : 0));
   if (answer && !failed()) port_.write(sensors_);  // a failed plant goes silent: the firmware's watchdog acts
   if (answer && cycle % 100 == 50) port_.send_heartbeat(sensors_.plant_state);
   if (telemetry_ != nullptr) {
@@ -265,6 +277,23 @@ void PlantNode::apply_sensor_fault() {
     sensors_.velocity[fault_.joint] = 0;
   } else if (fault_.kind == InjectedFault::Kind::sensor_jump) {
     sensors_.position[fault_.joint] += fault_.magnitude;
+  } else if (fault_.kind == InjectedFault::Kind::pressure_stuck || fault_.kind == InjectedFault::Kind::pressure_jump ||
+             fault_.kind == InjectedFault::Kind::pressure_drift) {
+    if (!fault_started_) {
+      frozen_ = sensors_;
+      fault_cycles_ = 0;
+    }
+    fault_started_ = true;
+    ++fault_cycles_;
+    auto& p = fault_.chamber == 0 ? sensors_.pressure_a : sensors_.pressure_b;
+    const auto& held = fault_.chamber == 0 ? frozen_.pressure_a : frozen_.pressure_b;
+    const std::size_t j = static_cast<std::size_t>(fault_.joint);
+    if (fault_.kind == InjectedFault::Kind::pressure_stuck)
+      p[j] = held[j];
+    else if (fault_.kind == InjectedFault::Kind::pressure_jump)
+      p[j] += fault_.magnitude;
+    else
+      p[j] += fault_.magnitude * static_cast<double>(fault_cycles_) * plant_.scene().cycle;
   }
 }
 

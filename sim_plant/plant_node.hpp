@@ -22,11 +22,21 @@ namespace exc::app {
 // A fault injected into the simulated machine (the fault campaign): what a real machine's sensor or
 // actuator can do while the firmware cannot tell from the frames alone.
 struct InjectedFault {
-  enum class Kind : std::uint8_t { none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, valve_stuck };
+  enum class Kind : std::uint8_t {
+    none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, valve_stuck,
+    // A chamber's pressure transmitter (the hydraulic machine): stuck at its reading of the fault's
+    // start, stepped by an offset, or drifting at a rate (out of range without any step).
+    pressure_stuck, pressure_jump, pressure_drift,
+    // The machine's own controller reports a fault (PlantFaults bit 1) and holds its valves centred
+    // while it lasts: an ECU's pump or oil-temperature fault, a stop the machine takes by itself.
+    machine_fault
+  };
   Kind kind = Kind::none;
   int joint = 0;          // 0 swing .. 3 bucket
+  int chamber = 0;        // pressure faults: 0 side A (bore, port A), 1 side B
   // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; valve_stuck: the spool
-  // position (-1..1) it sticks at, whatever is commanded (the hydraulic plant's circuit holds it).
+  // position (-1..1) it sticks at, whatever is commanded (the hydraulic plant's circuit holds it);
+  // pressure_jump: offset (Pa); pressure_drift: rate (Pa/s).
   double magnitude = 0;
 };
 
@@ -92,7 +102,8 @@ class PlantNode {
   std::uint64_t steps_ = 0;
   InjectedFault fault_;
   bool fault_started_ = false;
-  hal::SensorState frozen_;       // sensor_freeze: what the stuck sensor keeps reporting
+  hal::SensorState frozen_;       // sensor_freeze, pressure_stuck: what the stuck sensor keeps reporting
+  std::uint64_t fault_cycles_ = 0;  // pressure_drift: sensor sets since the fault's start
   double jammed_effort_ = 0;      // actuator_jam: the effort the stuck actuator keeps applying
   control::PerfCounter step_timing_{"plant_step", 1000.0};
 };

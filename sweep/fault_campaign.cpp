@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "app/firmware_faults.hpp"
+
 namespace exc::sim {
 namespace {
 
@@ -15,9 +17,14 @@ double fault_magnitude(Kind kind, double x) {
     case Kind::actuator_loss: return 0.3 + 0.7 * x;  // fraction of the effort lost
     case Kind::rock: return 5 + 45 * x;              // soil stiffness x
     case Kind::pump_loss: return 0.3 + 0.7 * x;      // fraction of the pumps' flow lost
+    case Kind::spool_stuck: return -1 + 2 * x;       // the spool's position, any opening either way
+    case Kind::pressure_jump: return 3e6 + 20e6 * x;   // Pa, up (a reading below zero is not on the bus)
+    case Kind::pressure_drift: return 5e6 + 45e6 * x;  // Pa/s, up
     default: return 0;
   }
 }
+
+constexpr double kToRunEnd = 1e6;  // s: a fault that lasts to the run's end
 
 // Keeps the larger of a table's time and t (null: none yet).
 void keep_worst(nlohmann::json& worst, double t) {
@@ -40,6 +47,12 @@ void draw_fault(std::mt19937_64& rng, const std::vector<std::string>& kinds, Swe
   c.fault_duration = 0.05 + 0.95 * u(rng);
   c.fault_joint = 1 + static_cast<int>(std::uniform_int_distribution<int>(0, 2)(rng));
   c.fault_magnitude = fault_magnitude(*kFaultKinds.named(c.fault), u(rng));
+  if (c.fault == "spool_stuck") {
+    // Any of the four functions, swing included, from its start to the run's end (drawn after the
+    // others, so the other kinds' draws are those of before).
+    c.fault_joint = std::uniform_int_distribution<int>(0, 3)(rng);
+    c.fault_duration = kToRunEnd;
+  }
 }
 
 void check_faults_fit(const std::vector<std::string>& kinds, const SceneBundle& scene) {
@@ -66,13 +79,19 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
   if (r.first_safe_stop_time >= 0) {
     o["safe_state_time"] = r.first_safe_stop_time;
     o["fault_detected_time"] = r.first_fault_detected_time;
+    o["fault_code"] = r.first_fault_code;
   }
+  // Judged by the machine (issue 32): when it came to rest for good (plant truth), and whether the
+  // emergency stop was sent.
+  o["machine_at_rest_time"] = r.machine_at_rest_time >= 0 ? nlohmann::json(r.machine_at_rest_time) : nlohmann::json(nullptr);
+  o["estop"] = r.estop;
   std::string why;
   if (r.failure.rfind("plant stopped", 0) == 0) {
     why = r.failure;
   } else if (r.first_safe_stop_time >= 0) {
     const double late = r.first_safe_stop_time - r.first_fault_detected_time - watchdog;
     if (late > 1e-9) why = "the safe state " + std::to_string(late * 1e3) + " ms later than the watchdog time after detection";
+    else if (r.machine_at_rest_time < 0) why = "the firmware stopped but the machine still moved at the run's end";
   } else if (r.tracking_samples == 0) {
     why = r.failure;
   } else {
@@ -99,11 +118,42 @@ void count_campaign_run(nlohmann::json& table, const nlohmann::json& line, const
   }
   if (outcome == "neither") k["neither_cases"].push_back(line["case"]);
   if (!k.contains("worst_time_to_safe_state")) k["worst_time_to_safe_state"] = k["worst_time_from_detection"] = nullptr;
+  if (!k.contains("worst_detection")) k["worst_detection"] = k["worst_time_to_rest"] = nullptr;
+  if (!k.contains("estop")) k["estop"] = 0;
   if (outcome == "safe_state" && r.contains("safe_state_time")) {
     const double stop = r["safe_state_time"].get<double>();
-    keep_worst(k["worst_time_to_safe_state"], stop - fault["start"].get<double>());
-    if (r.contains("fault_detected_time")) keep_worst(k["worst_time_from_detection"], stop - r["fault_detected_time"].get<double>());
+    const double start = fault["start"].get<double>();
+    keep_worst(k["worst_time_to_safe_state"], stop - start);
+    if (r.contains("fault_detected_time")) {
+      keep_worst(k["worst_time_from_detection"], stop - r["fault_detected_time"].get<double>());
+      keep_worst(k["worst_detection"], r["fault_detected_time"].get<double>() - start);
+    }
+    if (r.contains("machine_at_rest_time") && !r["machine_at_rest_time"].is_null())
+      keep_worst(k["worst_time_to_rest"], std::max(0.0, r["machine_at_rest_time"].get<double>() - start));
   }
+  if (r.value("estop", false)) k["estop"] = k["estop"].get<int>() + 1;
+}
+
+void count_safety_function(nlohmann::json& table, const nlohmann::json& line, const std::string& controller) {
+  const nlohmann::json& r = line[controller];
+  const nlohmann::json& fault = line["fault"];
+  const bool stopped = r.contains("fault_code") && !r["fault_code"].is_null();
+  const std::string name = stopped ? app::to_string(static_cast<app::FirmwareFault>(r["fault_code"].get<int>())) : "none";
+  nlohmann::json& k = table[controller][name];
+  if (k.is_null())
+    k = {{"runs", 0}, {"never_at_rest", 0}, {"estop", 0}, {"kinds", nlohmann::json::object()},
+         {"worst_detection", nullptr}, {"worst_time_to_rest", nullptr}};
+  k["runs"] = k["runs"].get<int>() + 1;
+  const std::string kind = fault["kind"].get<std::string>();
+  k["kinds"][kind] = k["kinds"].value(kind, 0) + 1;
+  if (r.value("estop", false)) k["estop"] = k["estop"].get<int>() + 1;
+  if (!stopped) return;
+  const double start = fault["start"].get<double>();
+  if (r.contains("fault_detected_time")) keep_worst(k["worst_detection"], std::max(0.0, r["fault_detected_time"].get<double>() - start));
+  if (r.contains("machine_at_rest_time") && !r["machine_at_rest_time"].is_null())
+    keep_worst(k["worst_time_to_rest"], std::max(0.0, r["machine_at_rest_time"].get<double>() - start));
+  else
+    k["never_at_rest"] = k["never_at_rest"].get<int>() + 1;
 }
 
 }  // namespace exc::sim

@@ -16,6 +16,10 @@ namespace exc::sim {
 
 // Draws case c's fault from the case's generator: its kind from `kinds`, its start, length, joint
 // and size (ranges in docs/sweeps.md).
+// s a stopped campaign run may run past its scene to see the machine come to rest (LockstepOptions::
+// rest_horizon): twice the 1.5 s the safety concept asks, and the engine's 1 s run-down, with room.
+inline constexpr double kCampaignRestHorizon = 6.0;
+
 void draw_fault(std::mt19937_64& rng, const std::vector<std::string>& kinds, SweepCase& c);
 // Refuses a fault the scene cannot take (pump_loss without the hydraulic machine), before any run.
 void check_faults_fit(const std::vector<std::string>& kinds, const SceneBundle& scene);
@@ -34,5 +38,10 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
 // campaign's rows by controller and fault kind: runs, outcomes, the worst times to the safe state
 // from the fault's start and from its detection, the cases that ended neither way, and per scene.
 void count_campaign_run(nlohmann::json& table, const nlohmann::json& line, const std::string& controller);
+// The same runs per safety function (docs/safety.md): keyed by the firmware fault that took the
+// first stop (the monitor that found it), each row the runs, the fault kinds behind them, the worst
+// detection and the worst time to rest from the fault's start, the runs never at rest, the
+// emergency stops; runs without a stop under "none".
+void count_safety_function(nlohmann::json& table, const nlohmann::json& line, const std::string& controller);
 
 }  // namespace exc::sim

@@ -208,6 +208,7 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   std::map<std::string, std::map<std::string, int>> failures, kinds;  // controller -> region / kind -> count
   json by_value = json::object();                                      // controller -> knob -> value -> counts
   json campaign = json::object();                                      // controller -> fault kind -> outcomes
+  json safety_functions = json::object();  // per controller, per stop's fault (count_safety_function)
   // The Monte-Carlo regions need the three draws they are made of.
   const bool all_draws = spec.draws("model_mass") && spec.draws("soil_stiffness") && spec.draws("delay_cycles");
   for (int id = 0; id < spec.total_cases(); ++id) {
@@ -238,7 +239,10 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
         csv << ',' << (v.is_string() ? v.get<std::string>() : cell(v));
       }
       csv << ',' << quoted(r.value("failure", ""));
-      if (j.contains("fault")) count_campaign_run(campaign, j, name);
+      if (j.contains("fault")) {
+        count_campaign_run(campaign, j, name);
+        count_safety_function(safety_functions, j, name);
+      }
       for (const SweepSetting& s : c.set) {
         json& v = by_value[name][s.first][s.second.text()];
         if (v.is_null()) v = {{"runs", 0}, {"failed", 0}};
@@ -254,7 +258,7 @@ MergeOutcome merge_sweep(const SweepSpec& spec, const std::vector<fs::path>& sha
   }
   json summary = {{"spec", spec.file}, {"cases", spec.total_cases()}, {"merged", cases.size()}, {"missing", missing},
                   {"missing_shard_files", absent_files}, {"ignored_lines", ignored}, {"conflicting_records", conflicts},
-                  {"campaign", campaign}};
+                  {"campaign", campaign}, {"safety_functions", safety_functions}};
   if (spec.records("failures")) {
     summary["failures"] = failures;
     summary["failure_kinds"] = kinds;

@@ -22,6 +22,9 @@ RunRecord run_bundle(const SceneBundle& b, const SweepSpec& spec, const SweepCas
   o.duration = spec.duration;
   o.stop_at_safe_state = spec.stop_at_safe_state;
   o.fault = fault_schedule(c, spec.seed);
+  // A faulted run that stopped is judged by the machine coming to rest: it runs on past the scene's
+  // end for up to kCampaignRestHorizon after the stop, so a late rest is measured, not cut off.
+  if (o.fault.kind != FaultSchedule::Kind::none) o.rest_horizon = kCampaignRestHorizon;
   return run_lockstep(b.scene, b.firmware, o);
 }
 

@@ -23,10 +23,17 @@ namespace exc::app {
 namespace {
 
 constexpr int kHeartbeatPeriod = hal::kHeartbeatPeriodCycles;
+// Sensor sets in a row that say the plant holds while the firmware commands motion before that is a
+// fault: the plant applies a command one cycle after it is sent, so a hold it reports on entering
+// hold/track lasts one or two sets; five is a machine that does not obey.
+constexpr int kPlantHoldCycles = 5;
 
 Vec4 to_vec(const std::array<double, 4>& a) { return Vec4(a[0], a[1], a[2], a[3]); }
 
 bool finite(const Vec4& v) { return v.allFinite(); }
+
+// SensorState::supervisor_pending's bit of a command.
+std::uint8_t supervisor_bit(hal::SupervisorCommand c) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(c)); }
 
 }  // namespace
 
@@ -38,6 +45,24 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::tracking_error: return "tracking error";
     case FirmwareFault::no_pressures: return "no pressures";
     case FirmwareFault::pump_limited: return "pumps short of flow";
+    case FirmwareFault::plant_emergency: return "plant emergency";
+    case FirmwareFault::plant_fault: return "plant fault";
+    case FirmwareFault::plant_holding: return "plant holding";
+    case FirmwareFault::deadline_overrun: return "missed deadlines";
+    case FirmwareFault::velocity_implausible: return "velocity implausible";
+    case FirmwareFault::exited: return "firmware exited";
+    case FirmwareFault::fatal_error: return "firmware fatal error";
+    case FirmwareFault::operator_stop: return "operator stop";
+    case FirmwareFault::pressure_implausible: return "pressure implausible";
+  }
+  return "unknown";
+}
+
+const char* to_string(StopKind stop) {
+  switch (stop) {
+    case StopKind::none: return "none";
+    case StopKind::controlled: return "controlled";
+    case StopKind::emergency: return "emergency";
   }
   return "unknown";
 }
@@ -65,6 +90,8 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       lag_compensator_(config.controller.actuator_lag, config.controller.actuator_lag_target,
                        config.controller.period, control::effort_limits_of(model.machine)),
       valves_(control::valve_loop_model(model.machine), config.controller.valves, config.controller.period),
+      plausibility_(config.controller.plausibility, config.controller.period),
+      pressure_monitor_(model.machine, config.controller.pressure_plausibility, config.controller.period),
       control_timing_("control", 100.0),
       cycle_timing_("cycle", config.controller.period * 1e6),
       read_timing_("read", 100.0),
@@ -86,7 +113,157 @@ void FirmwareNode::begin_cycle() {
   // every 10 ms while it lasts, so a node that missed the first frame still learns of the stop.
   if (machine_.mode() == control::Mode::safe_stop && cycle_ > safe_stop_cycle_ &&
       (cycle_ - safe_stop_cycle_) % hal::kEmergencyRepeatCycles == 0)
-    port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
+    send_stop_frame();
+}
+
+void FirmwareNode::check_standstill(bool complete) {
+  if (machine_.mode() != control::Mode::safe_stop) return;  // tracking: check_plausibility runs the monitor
+  if (escalated_ || stop_of(fault_code_) != StopKind::controlled || !complete) {
+    plausibility_.update(false);
+    standstill_origin_set_ = false;
+    swing_origin_set_ = false;
+    return;
+  }
+  const Vec4 q = to_vec(sensors_.position);
+  char why[120] = "";
+  // What a function took: its motion plus, with pressures, its oil columns' compression (a load
+  // that changes, as a braking swing's pull on the front, moves a held cylinder as much as it
+  // compresses its oil; no oil arrives).
+  Vec4 taken = q;
+  if (valve_interface() && sensors_.pressure_valid) {
+    // The valves are centred: every bit of oil that arrives is unasked for.
+    const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+    const Vec4 compression = valves_.measured_force(p_a, p_b).cwiseQuotient(valves_.hydraulic_stiffness(q));
+    taken += compression;
+    plausibility_.update(true, Vec4::Zero(), q, compression, valves_.at_relief(p_a, p_b));
+    const std::uint8_t found = plausibility_.implausible();
+    for (int j = 0; j < 4 && why[0] == 0; ++j)
+      if ((found >> j) & 1)
+        std::snprintf(why, sizeof why, "%s took %.4f %s with its valve centred", kActiveNames[static_cast<std::size_t>(j)],
+                      plausibility_.delivered()[j], j == 0 ? "rad" : "m");
+  } else {
+    plausibility_.update(false);
+  }
+  const double since = static_cast<double>(cycle_ - safe_stop_cycle_) * period_;
+  if (why[0] == 0 && since >= kStandstillDelay) {
+    if (!standstill_origin_set_) {
+      standstill_origin_ = taken;
+      standstill_origin_cycle_ = cycle_;
+      standstill_origin_set_ = true;
+      standstill_windows_ = 0;
+    }
+    const double window = static_cast<double>(cycle_ - standstill_origin_cycle_) * period_;
+    if (window >= kStandstillWindow) {
+      const Vec4 mean = (taken - standstill_origin_) / window;
+      // Cylinders only: the swing motor's cross-port leakage (5 % of its flow at relief) lets a
+      // swing trapped on its oil spring move on for seconds; the flow test watches it.
+      for (int j = 1; j < 4 && why[0] == 0 && standstill_windows_ > 0; ++j)
+        if (std::abs(mean[j]) > kStandstillCylinderRate &&
+            std::abs(mean[j]) > (1 - kStandstillSlowing) * std::abs(standstill_mean_[j]))
+          std::snprintf(why, sizeof why, "%s takes %.4f %s/s on average over %.1f s, not slowing", kActiveNames[static_cast<std::size_t>(j)],
+                        mean[j], "m", window);
+      standstill_mean_ = mean;
+      ++standstill_windows_;
+      standstill_origin_ = taken;
+      standstill_origin_cycle_ = cycle_;
+    }
+    // The swing on its motion alone, over windows as long as its oil spring's period, which its
+    // ringing averages out of: a spool stuck just past its dead zone creeps on, not slowing.
+    if (!swing_origin_set_) {
+      swing_origin_ = q[0];
+      swing_origin_cycle_ = cycle_;
+      swing_origin_set_ = true;
+      swing_windows_ = 0;
+    }
+    const double swing_window = static_cast<double>(cycle_ - swing_origin_cycle_) * period_;
+    if (swing_origin_set_ && swing_window >= kStandstillSwingWindow) {
+      const double mean = (q[0] - swing_origin_) / swing_window;
+      if (why[0] == 0 && swing_windows_ > 0 && std::abs(mean) > kStandstillSwingRate &&
+          std::abs(mean) > (1 - kStandstillSlowing) * std::abs(swing_mean_))
+        std::snprintf(why, sizeof why, "swing moves %.4f rad/s on average over %.1f s, not slowing", mean, swing_window);
+      swing_mean_ = mean;
+      ++swing_windows_;
+      swing_origin_ = q[0];
+      swing_origin_cycle_ = cycle_;
+    }
+  }
+  if (why[0] == 0) return;
+  escalated_ = true;
+  send_stop_frame();
+  char text[sizeof(exlcm::fault_t::text)];
+  std::snprintf(text, sizeof text, "controlled stop escalated to the emergency stop %.2f s after it: %s (%s)", since, why, fault_text_);
+  publish_fault(fault_code_, 2, true, text);
+}
+
+void FirmwareNode::send_stop_frame() {
+  const bool emergency = escalated_ || stop_of(fault_code_) == StopKind::emergency;
+  emergency_sent_ = emergency_sent_ || emergency;
+  port_.send_fault(emergency, static_cast<std::uint16_t>(fault_code_));
+}
+
+void FirmwareNode::send_safe_command(FirmwareFault why) {
+  command_.mode = hal::CommandMode::valve;
+  command_.value = {0, 0, 0, 0};
+  command_.cycle = cycle_;
+  command_.firmware_mode = static_cast<std::uint8_t>(control::Mode::safe_stop);
+  port_.write(command_);
+  // A standing safe state keeps its own fault (and its stop); otherwise the reason of leaving.
+  const FirmwareFault code = machine_.mode() == control::Mode::safe_stop ? fault_code_ : why;
+  const bool emergency = (machine_.mode() == control::Mode::safe_stop && escalated_) ||
+                         stop_of(code) == StopKind::emergency || stop_of(why) == StopKind::emergency;
+  emergency_sent_ = emergency_sent_ || emergency;
+  port_.send_fault(emergency, static_cast<std::uint16_t>(code));
+  safe_command_sent_ = true;
+}
+
+void FirmwareNode::check_plant_signals(bool complete) {
+  // PLANT_EMERGENCY is an event the plant repeats every 10 ms while it lasts: taken once per frame.
+  if (sensors_.plant_emergency) {
+    sensors_.plant_emergency = false;
+    if (!fault_) {
+      raise(FirmwareFault::plant_emergency);
+      std::snprintf(pending_text_, sizeof pending_text_,
+                    "plant emergency: PLANT_EMERGENCY code %u, plant heartbeat state %u, at t = %.3f s",
+                    static_cast<unsigned>(sensors_.plant_fault_code), static_cast<unsigned>(sensors_.plant_heartbeat_state),
+                    time());
+    }
+  }
+  if (!complete) return;
+  if (sensors_.plant_faults != 0 && !fault_) {
+    raise(FirmwareFault::plant_fault);
+    std::snprintf(pending_text_, sizeof pending_text_, "plant fault: SENS_MACHINE PlantFaults 0x%02x at t = %.3f s",
+                  static_cast<unsigned>(sensors_.plant_faults), time());
+  }
+  const bool commanding = machine_.mode() == control::Mode::hold || machine_.mode() == control::Mode::track;
+  plant_hold_run_ = commanding && (sensors_.plant_state & hal::kPlantStateHolding) != 0 ? plant_hold_run_ + 1 : 0;
+  if (plant_hold_run_ >= kPlantHoldCycles && !fault_) {
+    raise(FirmwareFault::plant_holding);
+    std::snprintf(pending_text_, sizeof pending_text_,
+                  "plant holding: PlantState %u for %d sensor sets while commanded (heartbeat state %u) at t = %.3f s",
+                  static_cast<unsigned>(sensors_.plant_state), plant_hold_run_,
+                  static_cast<unsigned>(sensors_.plant_heartbeat_state), time());
+  }
+}
+
+void FirmwareNode::take_supervisor_commands() {
+  const std::uint8_t pending = sensors_.supervisor_pending;
+  sensors_.supervisor_pending = 0;
+  if ((pending & supervisor_bit(hal::SupervisorCommand::start)) != 0) start_received_ = true;
+  const bool stop_now = (pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0;
+  if (stop_now) {
+    operator_stop_pending_ = true;
+    start_received_ = false;  // a stop withdraws a start: the next begin needs a new one
+  }
+  const control::Mode mode = machine_.mode();
+  if (mode == control::Mode::safe_stop && !stop_now) {
+    operator_stop_pending_ = false;  // stopped already: the stop has latched
+  } else if (operator_stop_pending_ && (mode == control::Mode::hold || mode == control::Mode::track) && !fault_) {
+    // Not yet commanding (start-up): raised on the first cycle the node commands the machine.
+    operator_stop_pending_ = false;
+    raise(FirmwareFault::operator_stop);
+    std::snprintf(pending_text_, sizeof pending_text_, "operator stop: SUPERVISOR stop in %s at t = %.3f s",
+                  control::to_string(mode), time());
+  }
 }
 
 bool FirmwareNode::receive() {
@@ -97,10 +274,25 @@ bool FirmwareNode::receive() {
 void FirmwareNode::end_cycle() {
   const std::int64_t start_ns = hal::monotonic_now_ns();
   const double t = time();
-  if (receive()) {
+  const bool complete = receive();
+  if (complete) {
     have_valid_ = true;
     last_valid_time_ = t;
   }
+  // An acknowledge is spent on this cycle: it clears the latched faults of the safe state, and the
+  // monitors that watch standing conditions (the plant's signals below, the watchdog) raise again
+  // if theirs still stands. A stop in the same cycle is raised after it, so it stands.
+  const std::uint8_t supervisor = sensors_.supervisor_pending;
+  if ((supervisor & supervisor_bit(hal::SupervisorCommand::acknowledge)) != 0) acknowledge_requested_ = true;
+  const bool acknowledged = acknowledge_requested_ && machine_.mode() == control::Mode::safe_stop &&
+                            (supervisor & supervisor_bit(hal::SupervisorCommand::stop)) == 0;
+  acknowledge_requested_ = false;
+  if (acknowledged) {
+    fault_ = false;
+    pending_fault_ = FirmwareFault::none;
+  }
+  take_supervisor_commands();
+  check_plant_signals(complete);
   const std::int64_t read_ns = hal::monotonic_now_ns();
   read_timing_.record_ns(read_ns - start_ns);
 
@@ -110,12 +302,13 @@ void FirmwareNode::end_cycle() {
   in.last_valid_frame_time = last_valid_time_;
   // The task starts once. After a safe stop the machine holds where it is when the sensors are back:
   // resuming would restart the path from its first point, a step command nobody asked for.
-  in.track_requested = t >= config_.track_delay && safe_stops_ == 0;
+  in.track_requested = t >= config_.track_delay && safe_stops_ == 0 && (start_received_ || !config_.wait_for_start);
   in.stop_requested = stop_requested_;
   // Once the task has ended it stays ended: hold must not re-enter track and restart the path.
   in.trajectory_finished =
       finished_ || (machine_.mode() == control::Mode::track && t - track_start_ + task_.start_time() >= task_.end_time());
   in.fault = fault_;
+  in.acknowledged = acknowledged;
   const control::Transition transition = machine_.step(in);
   transition_ = transition;
   if (transition.changed) {
@@ -131,6 +324,10 @@ void FirmwareNode::end_cycle() {
       }
       fault_ = false;
       pending_fault_ = FirmwareFault::none;
+      // Leaving an acknowledged stop: the machine's emergency latch is released (EmergencyStop = 0,
+      // no fault) so it obeys the commands again.
+      if (transition.from == control::Mode::safe_stop) port_.send_fault(false, 0);
+      escalated_ = false;
     }
     if (transition.to == control::Mode::track) track_start_ = t;
     if (transition.to == control::Mode::safe_stop) {
@@ -144,10 +341,11 @@ void FirmwareNode::end_cycle() {
                       (t - last_valid_time_) * 1e3, t);
       else
         std::memcpy(fault_text_, pending_text_, sizeof fault_text_);
-      port_.send_fault(false, static_cast<std::uint16_t>(fault_code_));
+      send_stop_frame();
     }
   }
 
+  check_standstill(complete);
   compute_command(transition);
   const std::int64_t write_start_ns = hal::monotonic_now_ns();
   port_.write(command_);
@@ -262,8 +460,18 @@ void FirmwareNode::update_pump_warning(bool limited, double demanded_flow) {
 
 void FirmwareNode::record_wakeup(std::int64_t interval_ns, std::uint64_t overruns, std::uint64_t skipped) {
   interval_timing_.record_ns(interval_ns);
+  const bool missed = overruns > deadline_overruns_ || skipped > skipped_deadlines_;
+  missed_in_a_row_ = missed ? missed_in_a_row_ + 1 : 0;
   deadline_overruns_ = overruns;
   skipped_deadlines_ = skipped;
+  const bool commanding = machine_.mode() == control::Mode::hold || machine_.mode() == control::Mode::track;
+  if (missed_in_a_row_ >= config_.controller.max_missed_deadlines && commanding && !fault_) {
+    raise(FirmwareFault::deadline_overrun);
+    pending_time_ = time() + period_;  // the cycle about to start
+    std::snprintf(pending_text_, sizeof pending_text_,
+                  "missed deadlines: %d wake-ups in a row after their deadline (limit %d) at t = %.3f s", missed_in_a_row_,
+                  config_.controller.max_missed_deadlines, pending_time_);
+  }
 }
 
 void FirmwareNode::compute_command(const control::Transition& transition) {
@@ -277,6 +485,7 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     command_.value = {0, 0, 0, 0};
     last_sent_.setZero();
     update_pump_warning(false, 0);  // centred valves ask nothing
+    pressure_monitor_.update(false, false, Vec4::Zero(), Vec4::Zero(), Vec4::Zero(), Vec4::Zero());
     return;
   }
   const std::int64_t start_ns = hal::monotonic_now_ns();
@@ -345,7 +554,9 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   if (transition.changed && (transition.from == control::Mode::hold || transition.from == control::Mode::track))
     blender_.on_switch(t, last_sent_, out_.tau);
   if (valve_interface()) {
+    check_pressures(restarted);
     command_valves(q);
+    check_plausibility(restarted);
   } else {
     const Vec4 tau = blender_.apply(t, out_.tau);
     // After a restart the actuator is taken to deliver what the law asks for first (the plant's
@@ -382,6 +593,45 @@ control::AppliedEffort FirmwareNode::applied_effort() const {
   a.valid = true;
   a.suspect = static_cast<std::uint8_t>(lag_compensator_.clamped() | out_.saturated);
   return a;
+}
+
+void FirmwareNode::check_plausibility(bool restarted) {
+  // The command just computed is what the valves are told from now on; the motion and pressures
+  // measured now answer the commands before it, which the monitor's lag stands for.
+  const control::ValveCommand& v = valves_.last();
+  const Vec4 q = to_vec(sensors_.position);
+  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  // Without pressures the compression is unknown: the monitor then sees the motion alone.
+  const Vec4 compression = sensors_.pressure_valid ? Vec4(v.force.cwiseQuotient(valves_.hydraulic_stiffness(q))) : Vec4::Zero();
+  const std::uint8_t at_relief = sensors_.pressure_valid ? valves_.at_relief(p_a, p_b) : 0;
+  const std::uint8_t found = plausibility_.update(!restarted, v.velocity, q, compression, at_relief);
+  if (found == 0 || fault_ || !plausibility_.settings().enabled) return;
+  int j = 0;
+  while (((found >> j) & 1) == 0) ++j;
+  raise(FirmwareFault::velocity_implausible);
+  const char* const unit = j == 0 ? "rad" : "m";
+  const double window = plausibility_.settings().window;
+  // (fits pending_text_: the times first, the figures after)
+  std::snprintf(pending_text_, sizeof pending_text_,
+                "flow implausible at t = %.3f s: %s took %.4f %s over %.2f s, asked %.4f (velocity %.3f, flow asked %.3f)", time(),
+                kActiveNames[static_cast<std::size_t>(j)], plausibility_.delivered()[j], unit, window, plausibility_.asked()[j],
+                estimator_.velocity()[j], plausibility_.expected()[j]);
+  // Detected when the debounce is complete: the time a fault's start is judged against.
+}
+
+void FirmwareNode::check_pressures(bool restarted) {
+  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  const std::uint8_t found = pressure_monitor_.update(!restarted && sensors_.pressure_valid, complete_, p_a, p_b,
+                                                      to_vec(sensors_.position), to_vec(sensors_.velocity));
+  if (found == 0 || fault_) return;
+  int c = 0;
+  while (((found >> c) & 1) == 0) ++c;
+  raise(FirmwareFault::pressure_implausible);
+  const int j = c / 2;
+  const double p = (c % 2 == 0 ? p_a : p_b)[j];
+  std::snprintf(pending_text_, sizeof pending_text_, "pressure implausible at t = %.3f s: %s %s %.2f MPa %s", time(),
+                kActiveNames[static_cast<std::size_t>(j)], c % 2 == 0 ? "A" : "B", p * 1e-6,
+                control::to_string(pressure_monitor_.test_of(c)));
 }
 
 void FirmwareNode::raise(FirmwareFault fault) {
@@ -462,9 +712,12 @@ void FirmwareNode::publish_cycle() {
   telemetry_->publish(telemetry::Channel::controller, s);
 }
 
-void FirmwareNode::publish_counters() {
+void FirmwareNode::publish_counters(bool after_exit_command) {
   if (telemetry_ == nullptr) return;
-  const std::int64_t utime = this->utime();
+  // The exit's safe command goes out after the last cycle: its frames' bus time falls in the period
+  // after it, the window EXC_CAN_STATS's load is taken over.
+  const double window_end = time() + (after_exit_command ? period_ : 0.0);
+  const std::int64_t utime = this->utime() + (after_exit_command ? static_cast<std::int64_t>(std::llround(period_ * 1e6)) : 0);
   // Every stage of the loop (timing_t.stage): 0 the whole end_cycle, 1 read, 2 update (estimate,
   // trajectory, law), 3 write, 6 telemetry encode; 5 the wake-up interval of a real-time loop, whose
   // overruns field carries the deadlines missed (the plant publishes 4, its step).
@@ -483,7 +736,7 @@ void FirmwareNode::publish_counters() {
   }
 
   // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
-  const double load = bus_load_.update(port_.tx_stats().bus_ns + port_.rx_bus_ns(), time());
+  const double load = bus_load_.update(port_.tx_stats().bus_ns + port_.rx_bus_ns(), window_end);
   const exlcm::can_stats_t cs = can_stats_message(port_.rx_stats(), port_.tx_stats(), 0, utime, load);
   telemetry_->publish(telemetry::Channel::can_stats, cs);
 }

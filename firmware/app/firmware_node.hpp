@@ -16,12 +16,14 @@
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
 #include "control/perf_counter.hpp"
+#include "control/pressure_plausibility.hpp"
 #include "control/state_estimator.hpp"
 #include "control/state_machine.hpp"
 #include "control/task.hpp"
 #include "control/valve_inner_loop.hpp"
 #include "hal/can_ports.hpp"
 #include "app/can_stats_message.hpp"
+#include "app/firmware_faults.hpp"
 #include "app/subnormal_scan.hpp"
 #include "app/tracking_metrics.hpp"
 #include "model/model.hpp"
@@ -37,6 +39,9 @@ struct FirmwareNodeConfig {
   control::ControllerConfig controller;
   Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
   double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
+  // Hold until an operator's start (SUPERVISOR Command = start) before tracking; false: the task
+  // starts by itself after track_delay (the default: runs without an operator station).
+  bool wait_for_start = false;
   // Simulation only: the plant's true soil parameters, for telemetry and the Lyapunov value.
   bool theta_known = false;
   Vec6 theta_true = Vec6::Zero();
@@ -46,25 +51,12 @@ struct FirmwareNodeConfig {
 // start-up check, throws std::invalid_argument naming both.
 void check_controller_interface(control::ControllerKind kind, const control::ControllerConfig& config);
 
-// Firmware fault codes (fault_t.code and the CAN fault frame).
-enum class FirmwareFault : std::uint16_t {
-  none = 0,
-  sensor_timeout = 1,  // watchdog: no valid sensor set within the timeout
-  model = 2,           // the closed-chain model refused the state (no assembly, toggle)
-  tracking_error = 3,  // a joint's |q_a - q_d| exceeded controller.tracking_error_limit
-  no_pressures = 4,    // the valve stage's force loop needs chamber pressures the sensor frame lacks
-  // A warning (EXC_FAULT severity 1, no safe stop): the valves ask the pumps for more than their flow
-  // for kPumpWarningCycles in a row, so every function slows; cleared after as many within it.
-  pump_limited = 5,
-};
 inline constexpr int kPumpWarningCycles = 20;
 // Cycles between the node's counter messages (EXC_TIMING per stage, EXC_CAN_STATS).
 inline constexpr int kCounterPeriod = 100;
 // The stages the node publishes on EXC_TIMING each time (publish_counters): whole cycle, read, update,
 // write, telemetry encode; a real-time loop adds its wake-up interval.
 inline constexpr int kTimingStages = 5;
-const char* to_string(FirmwareFault fault);
-
 class FirmwareNode {
  public:
   FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
@@ -80,10 +72,26 @@ class FirmwareNode {
   bool receive();
   // Completes the cycle once the plant had its chance to answer.
   void end_cycle();
-  // A stop from outside (operator, supervisor, signal): the next cycle leaves track for hold at the
-  // desired pose of that moment, and the node stays in hold. Real-time safe (sets a flag).
+  // A stop from outside the control loop (a signal, the caller): the next cycle leaves track for
+  // hold at the desired pose of that moment, and the node stays in hold. Real-time safe (sets a
+  // flag). An operator's SUPERVISOR stop is stronger: a controlled stop that latches
+  // (FirmwareFault::operator_stop) until acknowledged.
+
   void request_stop() { stop_requested_ = true; }
   bool stop_requested() const { return stop_requested_; }
+  // An operator acknowledges the latched stop (the SUPERVISOR frame's acknowledge, or a caller on
+  // the operator's behalf). Taken on the next cycle: the node leaves its safe state for hold where
+  // the machine is when the sensors are fresh and no fault stands; an acknowledge while a condition
+  // stands is spent (a person acknowledges what they see gone). Real-time safe (sets a flag).
+  void acknowledge() { acknowledge_requested_ = true; }
+  // An operator's start arrived (SUPERVISOR Command = start): a node set to wait_for_start may track.
+  bool start_received() const { return start_received_; }
+  // The last frames of a program that leaves (end of run, a signal, an error): valves centred
+  // (CMD_VALVE of zeros, this cycle's counter) and FW_EMERGENCY with `why` (exited: controlled stop;
+  // fatal_error: emergency stop) unless a safe state already stands, whose fault it repeats. The
+  // machine keeps the centred valves until its own command watchdog holds it. Idempotent per cycle.
+  void send_safe_command(FirmwareFault why);
+  bool safe_command_sent() const { return safe_command_sent_; }
   // The last mode transition (changed == false when the last cycle kept its mode).
   const control::Transition& last_transition() const { return transition_; }
   // Tracking figures as the firmware measures them (sensed q_a against q_d, while tracking).
@@ -114,6 +122,10 @@ class FirmwareNode {
   // The valve stage's last command (valve interface; zeros otherwise), and how many cycles its
   // openings asked the pumps for more flow than they give.
   const control::ValveCommand& last_valve_command() const { return valves_.last(); }
+  // The velocity plausibility monitor (valve interface): expected velocities, residuals, margins.
+  const control::VelocityPlausibility& plausibility() const { return plausibility_; }
+  // The chamber pressures' plausibility monitor (valve interface): margins, longest frozen runs.
+  const control::PressurePlausibility& pressure_plausibility() const { return pressure_monitor_; }
   std::uint64_t pump_limited_cycles() const { return pump_limited_cycles_; }
   // Pump-limited warnings raised so far, and the text of the last one raised or cleared.
   std::uint64_t pump_warnings() const { return pump_warnings_; }
@@ -130,6 +142,15 @@ class FirmwareNode {
   // deadline counters (published on EXC_TIMING, stage 5).
   void record_wakeup(std::int64_t interval_ns, std::uint64_t overruns, std::uint64_t skipped);
   std::uint64_t safe_stops() const { return safe_stops_; }
+  // The stop the last safe state took (none before any), and whether any FW_EMERGENCY went out with
+  // EmergencyStop = 1 (the campaign's `estop`).
+  // A controlled stop escalates to the emergency stop when the machine does not come to a standstill
+  // with its valves centred (kStandstill*: a stuck spool the velocity monitor could not tell).
+  StopKind last_stop() const { return escalated_ ? StopKind::emergency : stop_of(fault_code_); }
+  bool stop_escalated() const { return escalated_; }
+  bool emergency_sent() const { return emergency_sent_; }
+  // Consecutive real-time wake-ups after their deadline, as record_wakeup() last counted them.
+  int missed_deadlines_in_a_row() const { return missed_in_a_row_; }
   // The fault of the last safe stop (none before any), and its description ("tracking error: swing
   // 0.1013 rad > limit 0.1 rad at t = 1.234 s").
   FirmwareFault last_fault() const { return fault_code_; }
@@ -138,8 +159,9 @@ class FirmwareNode {
   // first met (the safe state follows the next cycle), or for a sensor timeout the first cycle
   // without a valid sensor set (the watchdog's timeout later).
   double fault_detected_time() const { return fault_detected_time_; }
-  // Publishes the timing and CAN counters now (also done every 100 cycles).
-  void publish_counters();
+  // Publishes the timing and CAN counters now (also done every 100 cycles); after_exit_command: the
+  // last ones, after the exit's safe command, whose frames take the period after the last cycle.
+  void publish_counters(bool after_exit_command = false);
   // Every value the node carries from one cycle to the next (sensors, command, the law's output and
   // integrator, the estimator's filters, the lead compensators, the desired path), for a look for
   // subnormals (docs/floating-point.md). Not on the loop's path.
@@ -162,6 +184,21 @@ class FirmwareNode {
   void publish_fault(FirmwareFault code, std::int8_t severity, bool active, const char* text);
   // A fault condition met this cycle: the state machine takes the safe state next cycle.
   void raise(FirmwareFault fault);
+  // The machine's own signals (PLANT_EMERGENCY, SENS_MACHINE's PlantFaults and PlantState, the plant
+  // heartbeat's state): raised as faults with their names (docs/safety.md, H6).
+  void check_plant_signals(bool complete);
+  // Takes the SUPERVISOR commands the port received: acknowledge, start, and stop (raised as
+  // FirmwareFault::operator_stop once the node commands the machine).
+  void take_supervisor_commands();
+  // The velocity plausibility monitor on this cycle's valve command (valve interface).
+  void check_plausibility(bool restarted);
+  // The chamber pressures' plausibility monitor on this cycle's sensor set (valve interface, H4).
+  void check_pressures(bool restarted);
+  // Sends FW_EMERGENCY for the current safe state: EmergencyStop set when its fault takes the
+  // emergency stop.
+  void send_stop_frame();
+  // The standstill monitor of a controlled stop (docs/safety.md, H1/H2).
+  void check_standstill(bool complete);
 
   const Model& model_;
   ActuatorFriction friction_;  // the nominal machine's (start-up)
@@ -175,6 +212,8 @@ class FirmwareNode {
   control::CommandBlender blender_;
   control::ActuatorLagCompensator lag_compensator_;
   control::ValveInnerLoop valves_;
+  control::VelocityPlausibility plausibility_;
+  control::PressurePlausibility pressure_monitor_;
   std::uint64_t pump_limited_cycles_ = 0;
   bool pump_warning_ = false;
   int pump_run_ = 0;  // cycles in a row the pumps' state has differed from the warning's
@@ -208,6 +247,23 @@ class FirmwareNode {
   bool finished_ = false;
   double finish_time_ = 0;
   bool stop_requested_ = false;
+  bool acknowledge_requested_ = false;
+  bool start_received_ = false;
+  bool operator_stop_pending_ = false;  // a SUPERVISOR stop not yet raised (the node did not command yet)
+  bool emergency_sent_ = false;
+  bool safe_command_sent_ = false;
+  bool escalated_ = false;  // the controlled stop became an emergency stop (standstill monitor)
+  Vec4 standstill_origin_ = Vec4::Zero();  // position at the start of the standstill window
+  Vec4 standstill_mean_ = Vec4::Zero();    // the window before's mean velocity
+  int standstill_windows_ = 0;
+  double swing_origin_ = 0, swing_mean_ = 0;  // the swing's own windows (kStandstillSwingWindow)
+  std::uint64_t swing_origin_cycle_ = 0;
+  bool swing_origin_set_ = false;
+  int swing_windows_ = 0;
+  std::uint64_t standstill_origin_cycle_ = 0;
+  bool standstill_origin_set_ = false;
+  int plant_hold_run_ = 0;        // consecutive sensor sets saying the plant holds while commanded
+  int missed_in_a_row_ = 0;
   std::uint64_t safe_stops_ = 0;
   std::uint64_t safe_stop_cycle_ = 0;  // cycle the last safe state began
   hal::SensorState sensors_;

@@ -80,6 +80,27 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   v.numbers("hold_window", c.valves.hold_window, {0, 0.1}, "",
             "holding a pose: |e| (rad swing, m) inside which a function's valve stays centred");
   v.finish();
+  SectionReader pl = r.section("plausibility", "commanded against measured velocity per function, valve interface (docs/safety.md)");
+  pl.flag("enabled", c.plausibility.enabled, "the monitor runs (a fault, emergency stop, when a function moves unlike its command)");
+  pl.numbers("velocity_floor", c.plausibility.velocity_floor, {1e-4, 10}, "",
+             "rad/s (swing), m/s: how much more flow per piston area than commanded may arrive, averaged over the window (default: kPlausibilityVelocityShare of its top speed)");
+  pl.number("velocity_fraction", c.plausibility.velocity_fraction, {0, 10}, "", "the command's own allowance, of the commanded displacement");
+  pl.number("window", c.plausibility.window, {1e-3, 10}, "s", "high-pass time constant of the delivered and commanded displacements");
+  pl.number("lag", c.plausibility.lag, {0, 1}, "s", "first-order lag the commands are expected through");
+  pl.number("debounce", c.plausibility.debounce, {1e-3, 1}, "s", "how long the residual must stay outside the band");
+  pl.finish();
+  SectionReader pp = r.section("pressure_plausibility",
+                               "the chamber pressures' range, steps and stuck-at readings, valve interface (docs/safety.md, H4)");
+  pp.flag("enabled", c.pressure_plausibility.enabled, "the monitor runs (a fault, controlled stop, when a chamber pressure is implausible)");
+  pp.number("range_margin", c.pressure_plausibility.range_margin, {0, 10e6}, "Pa",
+            "beyond the circuit's floor and its relief plus override (hydraulics section) a reading is out of range");
+  pp.number("step_factor", c.pressure_plausibility.step_factor, {1, 100}, "",
+            "times the fastest change the oil allows (bulk modulus, chamber volume, port flow): a larger step is a jump");
+  pp.whole("frozen_sets", c.pressure_plausibility.frozen_sets, 2, 1000000, "",
+           "sensor sets in a row with a bit-identical reading while the function moves: a stuck sensor");
+  pp.number("moving_share", c.pressure_plausibility.moving_share, {1e-3, 1}, "", "of the function's top speed: faster counts as moving");
+  pp.whole("debounce", c.pressure_plausibility.debounce, 1, 1000, "", "sensor sets in a row the range or the step test must fail");
+  pp.finish();
   // Derived: eq. 27 reads the tracking error as the soil's doing. Through the valves the effort arrives
   // through the force loop's T_f, whose lag the update would read as soil: the rates are those of the
   // force-commanded machine scaled by period / T_f (docs/control.md).
@@ -124,6 +145,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
             "without a map: the estimated tip force that tells contact (left below half of it)");
   sc.finish();
   r.number("watchdog_timeout", c.watchdog_timeout, {1e-4, 10}, "s", "without a valid sensor frame -> safe stop");
+  r.whole("max_missed_deadlines", c.max_missed_deadlines, 1, 100000, "",
+          "real time: wake-ups in a row after their deadline that are a fault (controlled stop)");
   r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "", "rad (swing), m: above it the firmware faults");
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
   r.flag("integral_action", c.integral_action, "integral action in the adaptive law (beyond the paper)");
@@ -148,6 +171,7 @@ ControllerConfig controller_defaults(const Machine& nominal) {
   ControllerConfig c;
   c.valves.force_time_constant = std::max(nominal.hydraulics.valve_time_constant, 0.005);
   c.valves.spool_lag_target = nominal.hydraulics.valve_time_constant / 3;
+  c.plausibility.velocity_floor = kPlausibilityVelocityShare * nominal.speed_max();
   return c;
 }
 

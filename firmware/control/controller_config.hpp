@@ -10,9 +10,11 @@
 
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
+#include "control/pressure_plausibility.hpp"
 #include "control/soil_contact.hpp"
 #include "control/state_estimator.hpp"
 #include "control/valve_inner_loop.hpp"
+#include "control/velocity_plausibility.hpp"
 #include "model/machine.hpp"
 #include "settings/section_reader.hpp"
 
@@ -105,6 +107,15 @@ struct ControllerConfig {
 
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop
+  // Real time: this many wake-ups in a row after their deadline are a fault (docs/safety.md, H7):
+  // one late cycle costs a cycle of latency, five in a row is a loop that lost its period.
+  int max_missed_deadlines = 5;
+  // Commanded against measured velocity per function on the valve interface (docs/safety.md, H1).
+  // Its floors default to shares of each function's top speed and effort (controller_defaults).
+  PlausibilitySettings plausibility;
+  // The chamber pressures' range, steps and stuck-at readings on the valve interface (docs/safety.md,
+  // H4); its limits come from the machine file's hydraulics section (pressure_plausibility.hpp).
+  PressurePlausibilitySettings pressure_plausibility;
   // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
   // machine far from where it was told to go must stop. About twice the worst error of the PID
   // baseline in the dig scene (bucket 0.12 m), 0.5-1 m at the tip: rad (swing), m (cylinders).
@@ -125,6 +136,10 @@ struct ControllerConfig {
 
 // The defaults a nominal machine implies (before the scene's section is read): the force loop's T_f
 // is its spools' time constant (at least 5 ms), the spool lead aims at a third of it.
+// The flow plausibility floor as a share of each function's top speed (Machine::speed_max): the
+// shipped hydraulic scenes' fault-free figures stay inside it (test firmware/plausibility prints the
+// margins), and a spool stuck at a share s of its opening is found after about share / s windows.
+inline constexpr double kPlausibilityVelocityShare = 0.1;
 ControllerConfig controller_defaults(const Machine& nominal);
 // Reads the `controller:` section into c (a field the section does not give keeps c's value, which
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,

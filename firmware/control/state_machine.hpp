@@ -6,8 +6,9 @@
 //   track -> hold                 stop requested, or the trajectory finished
 //   hold/track -> safe_stop       watchdog: no valid sensor frame for longer than the timeout, or a
 //                                 fault (model, non-finite command); command: zero flow / brake
-//   safe_stop -> hold             frames are back (fresh) and no fault: hold where the machine is
-//                                 (FirmwareNode does not request tracking again after a safe stop)
+//   safe_stop -> hold             latched (docs/safety.md): only when an operator acknowledged the
+//                                 stop, the frames are fresh and no fault stands; hold where the
+//                                 machine is (FirmwareNode does not request tracking again after it)
 // Each transition carries a reason. Pure logic on the inputs; no allocation, no clock of its own.
 #include <cstdint>
 
@@ -26,6 +27,7 @@ struct StateMachineInputs {
   bool stop_requested = false;
   bool trajectory_finished = false;
   bool fault = false;                    // e.g. model status not ok, non-finite command
+  bool acknowledged = false;             // an operator acknowledged the stop (SUPERVISOR frame)
 };
 
 struct Transition {
@@ -60,7 +62,8 @@ class ControlStateMachine {
         if (mode_ == Mode::track && in.trajectory_finished) return go(Mode::hold, "trajectory finished");
         break;
       case Mode::safe_stop:
-        if (fresh && !in.fault) return go(Mode::hold, "sensor frames back, no fault");
+        // A stop latches: frames coming back are not a person having seen it.
+        if (in.acknowledged && fresh && !in.fault) return go(Mode::hold, "acknowledged, sensor frames fresh, no fault");
         break;
     }
     return Transition{false, mode_, mode_, ""};

@@ -58,15 +58,21 @@ Vec4 ValveInnerLoop::measured_force(const Vec4& p_a, const Vec4& p_b) const {
   return model_.geometry.area_a.cwiseProduct(p_a) - model_.geometry.area_b.cwiseProduct(p_b);
 }
 
-std::uint8_t ValveInnerLoop::off_map(const Vec4& p_a, const Vec4& p_b) const {
+std::uint8_t ValveInnerLoop::at_relief(const Vec4& p_a, const Vec4& p_b) const {
   const HydraulicParameters& h = model_.hydraulics;
   std::uint8_t bits = 0;
   for (int i = 0; i < kNumActive; ++i) {
     const double relief = i == 0 ? h.swing_relief_pressure : h.port_relief_pressure;
     const double high = std::min(model_.main_relief() - h.load_sensing_margin, relief);
-    if (std::max(p_a[i], p_b[i]) > high || std::min(p_a[i], p_b[i]) < h.tank_pressure)
-      bits |= static_cast<std::uint8_t>(1u << i);
+    if (std::max(p_a[i], p_b[i]) > high) bits |= static_cast<std::uint8_t>(1u << i);
   }
+  return bits;
+}
+
+std::uint8_t ValveInnerLoop::off_map(const Vec4& p_a, const Vec4& p_b) const {
+  std::uint8_t bits = at_relief(p_a, p_b);
+  for (int i = 0; i < kNumActive; ++i)
+    if (std::min(p_a[i], p_b[i]) < model_.hydraulics.tank_pressure) bits |= static_cast<std::uint8_t>(1u << i);
   return bits;
 }
 

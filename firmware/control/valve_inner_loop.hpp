@@ -105,6 +105,8 @@ class ValveInnerLoop {
   // within the load-sensing margin of the supply limit or at its port relief (the meter-in stalls,
   // the relief passes flow), or a chamber below tank pressure (the make-up valve feeds it).
   std::uint8_t off_map(const Vec4& p_a, const Vec4& p_b) const;
+  // Functions with a chamber at or near its relief (bit i): oil may leave by the relief, unmetered.
+  std::uint8_t at_relief(const Vec4& p_a, const Vec4& p_b) const;
   // K_h(q) of each function (N/m per m/s of flow mismatch, i.e. N/m; swing N m/rad).
   Vec4 hydraulic_stiffness(const Vec4& q) const;
   // The opening that passes the velocity u at these pressures (before the dead zone), unclamped.

@@ -172,6 +172,14 @@ void read_hydraulics(SectionReader& h, HydraulicParameters& p, double relief_pre
             "laminar leakage from each chamber to tank through its centred spool");
   h.number("swing_drain_leakage", p.swing_drain_leakage, {0, 1e-9}, "m^3/(s Pa)",
            "laminar leakage from each swing-motor port to its case drain");
+  h.number("pilot_cutoff_time", p.pilot_cutoff_time, {1e-3, 1}, "s",
+           "time constant of the pilot supply after the pilot cut-off (spools spring to centre)");
+  h.number("engine_rundown_time", p.engine_rundown_time, {0.05, 10}, "s",
+           "after an engine stop the pumps' flow falls linearly to zero over this time");
+  h.flag("load_holding_valves", p.load_holding_valves,
+         "load-holding valves on the boom's cap and the arm's rod side, closed while the pilot supply is cut");
+  h.number("swing_brake_torque", p.swing_brake_torque, {0, 1e7}, "N m",
+           "the swing parking brake, applied while the pilot supply is cut (0: none)");
   h.finish();
 }
 

@@ -140,6 +140,26 @@ struct HydraulicParameters {
   // Each swing-motor port to the motor's case drain (tank), m^3/(s Pa) (docs/plant.md: with the
   // cross-port leakage, a volumetric efficiency of 95 % at 34.3 MPa and full swing speed). Range [0, 1e-9].
   double swing_drain_leakage = 1.9e-12;
+
+  // The machine's safety hardware (safety.md, "The machine's safety hardware"; docs/safety.md).
+  // s, time constant of the pilot supply once the pilot cut-off (gate-lock) solenoid drops: the
+  // solenoid's switching and the pilot line's bleed-down (safety.md: tens of ms; no figure found,
+  // stated). The spools' targets scale with the supply, so they spring to centre. Range [1e-3, 1].
+  double pilot_cutoff_time = 0.05;
+  // s, the engine's run-down after an engine stop: the pumps' flow falls linearly to zero over it
+  // (safety.md: not found; a diesel from rated speed stops in about a second). Range [0.05, 10].
+  double engine_rundown_time = 1.0;
+  // Load-holding (hose-burst) valves on the boom's cap side and the arm's rod side (ISO 8643;
+  // safety.md: on those sides of 20 t machines). Modelled as closed, blocking every outflow of their
+  // chamber (meter-out and spool leakage), while the pilot supply is cut (below half): with the
+  // supply on, the calibrated spool leakage stands for the drift past them (the drift test lumps it).
+  bool load_holding_valves = true;
+  // N m at the swing axis: the swing parking brake, spring-applied and released by the pilot
+  // supply, so applied while the supply is below half (safety.md: applied some seconds after the
+  // levers return to neutral in normal work; on a pilot cut at once). No figure found: stated as the
+  // swing motor's own torque (machine file's swing.max_torque, 65 kN m), a brake that holds what the
+  // motor can drive. 0: none. Range [0, 1e7].
+  double swing_brake_torque = 65e3;
 };
 
 struct Machine {

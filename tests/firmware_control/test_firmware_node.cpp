@@ -44,6 +44,7 @@ struct Loop {
   app::FirmwareNode node;
   hal::CommandState command;
   bool answer = true;  // false: the plant goes silent (sensor loss)
+  std::uint8_t plant_state = 0, plant_faults = 0;  // what SENS_MACHINE says of the machine
 
   Loop(const Model& m, const char* task_yaml, app::FirmwareNodeConfig cfg)
       : model(m),
@@ -77,6 +78,8 @@ struct Loop {
         hal::SensorState s;
         s.cycle = k;
         s.motion_valid = true;
+        s.plant_state = plant_state;
+        s.plant_faults = plant_faults;
         for (int j = 0; j < 4; ++j) {
           s.position[j] = plant.q()[j];
           s.velocity[j] = plant.qd()[j];
@@ -226,6 +229,7 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
   const int silent_from = 2000, silent_to = 2500, cycles = 4000;
   for (int k = 1; k <= cycles; ++k) {
     loop.answer = k < silent_from || k >= silent_to;
+    if (k == silent_to) loop.node.acknowledge();  // the stop latches until an operator acknowledges it
     loop.cycle();
     hal::CanFrame f;
     while (listener->receive(f)) seen[f.id].push_back(k);
@@ -236,15 +240,16 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
     const std::vector<int>& at = seen[m.id];
     INFO(m.name);
     if (m.if_active) {
-      // Active from the watchdog's trip (21 cycles into the silence) to the first answered cycle.
+      // Active from the watchdog's trip (21 cycles into the silence) to the acknowledge, on the first
+      // answered cycle, which sends one more frame: the release (EmergencyStop = 0, no fault).
       REQUIRE(m.cycle_fast_ms == hal::kEmergencyRepeatCycles);
-      REQUIRE(at.size() >= 2);
+      REQUIRE(at.size() >= 3);
       const int first = silent_from + static_cast<int>(std::lround(cfg.controller.watchdog_timeout / 1e-3));
       CHECK(at.front() == first);
-      for (std::size_t i = 1; i < at.size(); ++i) CHECK(at[i] - at[i - 1] == m.cycle_fast_ms);
-      CHECK(at.back() < silent_to + 1);
-      // The last repeat can fall on the first answered cycle: its SYNC goes out before the answer.
-      CHECK(at.size() == static_cast<std::size_t>((silent_to - first) / m.cycle_fast_ms + 1));
+      for (std::size_t i = 1; i + 1 < at.size(); ++i) CHECK(at[i] - at[i - 1] == m.cycle_fast_ms);
+      CHECK(at.back() == silent_to);
+      // The last repeat falls on the acknowledged cycle: its SYNC goes out before the answer.
+      CHECK(at.size() == static_cast<std::size_t>((silent_to - first) / m.cycle_fast_ms + 2));
       ++checked;
     } else if (m.cycle_ms > 0 && m.command_set <= 1) {
       // The effort set is sent; valves only in the safe state, pilots not yet (the valve inner loop).
@@ -342,4 +347,246 @@ TEST_CASE("firmware/node: the port counts every frame on the bus once, at its ex
   CHECK(load < 0.26);
   app::BusLoadWindow window;
   CHECK(window.update(counted, cycles * 1e-3) == doctest::Approx(load));
+}
+
+TEST_CASE("firmware/node: a sensor timeout takes the emergency stop (EmergencyStop = 1) and the stop latches until acknowledged") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  while (loop.node.time() < 1.0) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::track);
+  CHECK_FALSE(loop.node.emergency_sent());
+  loop.answer = false;
+  for (int k = 0; k < 50; ++k) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::safe_stop);
+  CHECK(loop.node.last_fault() == app::FirmwareFault::sensor_timeout);
+  CHECK(loop.node.last_stop() == app::StopKind::emergency);
+  CHECK(loop.node.emergency_sent());
+  // The frames come back; for 2 s nobody acknowledges: the firmware stays stopped, the machine's
+  // end keeps reading the emergency stop with its code.
+  loop.answer = true;
+  for (int k = 0; k < 2000; ++k) {
+    loop.cycle();
+    REQUIRE(loop.node.mode() == Mode::safe_stop);
+  }
+  CHECK(loop.command.emergency_stop);
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::sensor_timeout));
+  CHECK(loop.command.mode == hal::CommandMode::valve);
+  CHECK(loop.node.safe_stops() == 1);
+  // Acknowledged: hold where the machine is, the machine's latch released, the task not restarted.
+  loop.node.acknowledge();
+  loop.cycle();
+  CHECK(loop.node.mode() == Mode::hold);
+  CHECK(std::string(loop.node.last_transition().reason) == "acknowledged, sensor frames fresh, no fault");
+  loop.cycle();
+  CHECK_FALSE(loop.command.emergency_stop);
+  CHECK(loop.command.fault_code == 0);
+  for (int k = 0; k < 1000; ++k) {
+    loop.cycle();
+    REQUIRE(loop.node.mode() == Mode::hold);
+  }
+}
+
+TEST_CASE("firmware/node: an acknowledge while the frames are still missing is spent, the stop stays") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  while (loop.node.time() < 1.0) loop.cycle();
+  loop.answer = false;
+  for (int k = 0; k < 50; ++k) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::safe_stop);
+  loop.node.acknowledge();
+  loop.cycle();
+  CHECK(loop.node.mode() == Mode::safe_stop);
+  loop.answer = true;  // back, but the acknowledge came before: still stopped
+  for (int k = 0; k < 100; ++k) loop.cycle();
+  CHECK(loop.node.mode() == Mode::safe_stop);
+}
+
+TEST_CASE("firmware/node: the machine's own signals are heard and named: PLANT_EMERGENCY, PlantFaults, PlantState hold") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  SUBCASE("PLANT_EMERGENCY") {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    while (loop.node.time() < 1.0) loop.cycle();
+    REQUIRE(loop.node.mode() == Mode::track);
+    loop.plant_port.send_fault(true, 3);
+    loop.cycle();  // read in this cycle, before the state machine steps: the safe state at once
+    CHECK(loop.node.mode() == Mode::safe_stop);
+    CHECK(loop.node.last_fault() == app::FirmwareFault::plant_emergency);
+    CHECK(std::string(loop.node.last_fault_text()).find("PLANT_EMERGENCY code 3") != std::string::npos);
+    CHECK(loop.node.last_stop() == app::StopKind::emergency);
+    loop.cycle();
+    CHECK(loop.command.emergency_stop);
+  }
+  SUBCASE("PlantFaults") {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    while (loop.node.time() < 1.0) loop.cycle();
+    loop.plant_faults = 0x02;
+    loop.cycle();
+    loop.cycle();
+    CHECK(loop.node.mode() == Mode::safe_stop);
+    CHECK(loop.node.last_fault() == app::FirmwareFault::plant_fault);
+    CHECK(std::string(loop.node.last_fault_text()).find("PlantFaults 0x02") != std::string::npos);
+    // Latched: the plant's fault bits clear, the firmware stays stopped until acknowledged; an
+    // acknowledge while the bits stand is refused.
+    loop.plant_faults = 0x02;
+    loop.node.acknowledge();
+    for (int k = 0; k < 10; ++k) loop.cycle();
+    CHECK(loop.node.mode() == Mode::safe_stop);
+    loop.plant_faults = 0;
+    for (int k = 0; k < 10; ++k) loop.cycle();
+    CHECK(loop.node.mode() == Mode::safe_stop);
+    loop.node.acknowledge();
+    loop.cycle();
+    CHECK(loop.node.mode() == Mode::hold);
+  }
+  SUBCASE("PlantState hold while commanded") {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    while (loop.node.time() < 1.0) loop.cycle();
+    // Four sets saying hold are what entering hold/track looks like: no fault.
+    loop.plant_state = 1;
+    for (int k = 0; k < 4; ++k) loop.cycle();
+    loop.plant_state = 0;
+    for (int k = 0; k < 10; ++k) loop.cycle();
+    REQUIRE(loop.node.mode() == Mode::track);
+    loop.plant_state = 1;
+    int cycles = 0;
+    while (loop.node.mode() == Mode::track && cycles < 100) {
+      loop.cycle();
+      ++cycles;
+    }
+    CHECK(cycles == 5);  // the fifth set; the plant's signals are read before the state machine steps
+    CHECK(loop.node.last_fault() == app::FirmwareFault::plant_holding);
+    CHECK(loop.node.last_stop() == app::StopKind::emergency);
+  }
+}
+
+TEST_CASE("firmware/node: consecutive missed deadlines in real time are a fault (controlled stop), scattered ones are not") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  while (loop.node.time() < 1.0) loop.cycle();
+  const int limit = cfg.controller.max_missed_deadlines;
+  REQUIRE(limit == 5);
+  std::uint64_t overruns = 0;
+  // limit - 1 late wake-ups, one on time, again: never limit in a row.
+  for (int round = 0; round < 20; ++round) {
+    for (int k = 0; k < limit - 1; ++k) {
+      loop.node.record_wakeup(1'500'000, ++overruns, 0);
+      loop.cycle();
+    }
+    loop.node.record_wakeup(1'000'000, overruns, 0);
+    loop.cycle();
+  }
+  REQUIRE(loop.node.mode() == Mode::track);
+  for (int k = 0; k < limit; ++k) {
+    loop.node.record_wakeup(1'500'000, ++overruns, 0);
+    loop.cycle();
+  }
+  loop.cycle();
+  CHECK(loop.node.mode() == Mode::safe_stop);
+  CHECK(loop.node.last_fault() == app::FirmwareFault::deadline_overrun);
+  CHECK(loop.node.last_stop() == app::StopKind::controlled);
+  loop.cycle();
+  CHECK_FALSE(loop.command.emergency_stop);
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::deadline_overrun));
+}
+
+TEST_CASE("firmware/node: the last command of a program that leaves centres the valves and says why, an error takes the emergency stop") {
+  const Model model = build_model(reference_machine());
+  for (const app::FirmwareFault why : {app::FirmwareFault::exited, app::FirmwareFault::fatal_error}) {
+    app::FirmwareNodeConfig cfg;
+    cfg.kind = ControllerKind::pid;
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    while (loop.node.time() < 1.0) loop.cycle();
+    REQUIRE(loop.node.mode() == Mode::track);
+    REQUIRE(loop.command.mode == hal::CommandMode::effort);
+    loop.node.send_safe_command(why);
+    std::uint64_t k = 0;
+    loop.plant_port.poll_sync(k);  // no SYNC follows: the frames are latched as they come
+    loop.plant_port.read(loop.command);
+    INFO(app::to_string(why));
+    CHECK(loop.command.mode == hal::CommandMode::valve);
+    for (int j = 0; j < 4; ++j) CHECK(loop.command.value[j] == 0.0);
+    CHECK(loop.command.fault_code == static_cast<std::uint16_t>(why));
+    CHECK(loop.command.emergency_stop == (why == app::FirmwareFault::fatal_error));
+    CHECK(loop.node.safe_command_sent());
+  }
+}
+
+TEST_CASE("firmware/node: a node set to wait for the operator holds until a SUPERVISOR start frame, then tracks, and without the setting it starts by itself") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  SUBCASE("waits for start") {
+    cfg.wait_for_start = true;
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    hal::OperatorCanPort station(*loop.hub.attach());
+    while (loop.node.time() < 1.0) {
+      loop.cycle();
+      REQUIRE(loop.node.mode() != Mode::track);
+    }
+    CHECK(loop.node.mode() == Mode::hold);
+    // A stop before the start withdraws nothing yet given, and an acknowledge outside a stop does nothing.
+    REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
+    for (int k = 0; k < 10; ++k) loop.cycle();
+    CHECK(loop.node.mode() == Mode::hold);
+    REQUIRE(station.send(hal::SupervisorCommand::start));
+    loop.cycle();
+    CHECK(loop.node.start_received());
+    CHECK(loop.node.mode() == Mode::track);
+  }
+  SUBCASE("starts by itself") {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    while (loop.node.time() < 0.2) loop.cycle();
+    CHECK(loop.node.mode() == Mode::track);
+    CHECK_FALSE(loop.node.start_received());
+  }
+}
+
+TEST_CASE("firmware/node: SUPERVISOR stop and acknowledge in one cycle: the stop stands until an acknowledge of its own") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  hal::MemoryBusNode* station_bus = loop.hub.attach();
+  hal::OperatorCanPort station(*station_bus);
+  while (loop.node.time() < 1.0) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::track);
+  REQUIRE(station.send(hal::SupervisorCommand::stop));
+  loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::safe_stop);
+  CHECK(loop.node.last_fault() == app::FirmwareFault::operator_stop);
+  CHECK(loop.node.last_stop() == app::StopKind::controlled);
+  loop.cycle();
+  CHECK_FALSE(loop.command.emergency_stop);
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::operator_stop));
+  REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
+  REQUIRE(station.send(hal::SupervisorCommand::stop));
+  for (int k = 0; k < 20; ++k) loop.cycle();
+  CHECK(loop.node.mode() == Mode::safe_stop);
+  REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
+  loop.cycle();
+  CHECK(loop.node.mode() == Mode::hold);
+}
+
+TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or sensors cannot be trusted in take the emergency stop") {
+  using app::FirmwareFault;
+  using app::StopKind;
+  CHECK(app::stop_of(FirmwareFault::none) == StopKind::none);
+  CHECK(app::stop_of(FirmwareFault::pump_limited) == StopKind::none);
+  for (FirmwareFault f : {FirmwareFault::sensor_timeout, FirmwareFault::plant_emergency, FirmwareFault::plant_fault,
+                          FirmwareFault::plant_holding, FirmwareFault::velocity_implausible, FirmwareFault::fatal_error})
+    CHECK(app::stop_of(f) == StopKind::emergency);
+  // A wrong pressure reading: the valves obey and the position sensors watch the stop (docs/safety.md, H4).
+  for (FirmwareFault f : {FirmwareFault::model, FirmwareFault::tracking_error, FirmwareFault::no_pressures,
+                          FirmwareFault::deadline_overrun, FirmwareFault::exited, FirmwareFault::operator_stop,
+                          FirmwareFault::pressure_implausible})
+    CHECK(app::stop_of(f) == StopKind::controlled);
+  for (int code = 0; code <= 14; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
 }

@@ -34,7 +34,7 @@ TEST_CASE("firmware/state machine: init, wait for sensors, hold, track, finish")
   CHECK(std::strcmp(sm.last_reason(), "trajectory finished") == 0);
 }
 
-TEST_CASE("firmware/state machine watchdog: lost frames stop safely, returning frames recover to hold") {
+TEST_CASE("firmware/state machine watchdog: lost frames stop safely, the stop latches until acknowledged, then hold") {
   ControlStateMachine sm(0.02);
   StateMachineInputs in;
   in.have_valid_frame = true;
@@ -55,11 +55,28 @@ TEST_CASE("firmware/state machine watchdog: lost frames stop safely, returning f
   in.t = 0.5;
   CHECK(!sm.step(in).changed);  // stays stopped without frames
   in.last_valid_frame_time = 0.5;
-  CHECK(sm.step(in).to == Mode::hold);  // frames back: hold, not straight back to track
+  for (int k = 0; k < 1000; ++k) {  // frames back, no fault: still stopped, nobody acknowledged
+    in.t = 0.5 + k * 1e-3;
+    in.last_valid_frame_time = in.t;
+    REQUIRE(!sm.step(in).changed);
+  }
+  in.acknowledged = true;
+  in.fault = true;
+  CHECK(!sm.step(in).changed);  // an acknowledge while a fault stands does not leave the stop
+  in.fault = false;
+  in.last_valid_frame_time = in.t - 0.5;
+  CHECK(!sm.step(in).changed);  // nor while the frames are stale
+  in.last_valid_frame_time = in.t;
+  const Transition back = sm.step(in);
+  CHECK(back.to == Mode::hold);  // acknowledged, fresh, no fault: hold, not straight back to track
+  CHECK(std::strcmp(back.reason, "acknowledged, sensor frames fresh, no fault") == 0);
+  in.acknowledged = false;
   CHECK(sm.step(in).to == Mode::track);
   in.fault = true;
   CHECK(sm.step(in).to == Mode::safe_stop);
   CHECK(!sm.step(in).changed);  // a standing fault keeps it stopped
+  in.fault = false;
+  CHECK(!sm.step(in).changed);  // and a fault that went away too, without an acknowledge
 }
 
 TEST_CASE("firmware/bumpless switch: the command is continuous at the switch and converges to the new law") {

@@ -67,7 +67,7 @@ TEST_CASE("hal/codec tables match excavator.dbc message by message and signal by
     CHECK(d->brs == message.brs);
     CHECK(message.fd);  // every frame of the protocol is CAN FD with bit-rate switch
     CHECK(message.brs);
-    CHECK(d->sender == (message.sender == Node::firmware ? "Firmware" : "Plant"));
+    CHECK(d->sender == to_string(message.sender));
     CHECK(d->cycle_ms == message.cycle_ms);
     CHECK(d->command_set == static_cast<int>(message.command_set));
     REQUIRE(d->signals.size() == message.signal_count);
@@ -347,4 +347,48 @@ TEST_CASE("hal/codec accepts a new sequence after the sender paused") {
   CHECK(codec.accept(frame, out) == RxVerdict::stale);
   frame.timestamp_ns = 1'020'000'000;    // ...20 ms later: the sender paused, a new sequence
   CHECK(codec.accept(frame, out) == RxVerdict::ok);
+}
+
+TEST_CASE("hal/codec SUPERVISOR round trip of every command, and its repeated, stale and corrupt frames rejected") {
+  const MessageSpec* supervisor = find_message(can_id::supervisor);
+  REQUIRE(supervisor != nullptr);
+  CHECK(supervisor->sender == Node::operator_station);
+  CanFrameCodec codec;
+  const MessageSpec* out = nullptr;
+  std::uint8_t counter = 0;
+  for (const SupervisorCommand command :
+       {SupervisorCommand::none, SupervisorCommand::start, SupervisorCommand::stop, SupervisorCommand::acknowledge}) {
+    CAPTURE(to_string(command));
+    const double value[] = {static_cast<double>(command)};
+    const CanFrame frame = encoded(*supervisor, counter++, value);
+    CHECK(frame.len == 2);
+    CHECK(frame.fd);
+    // The command's raw bits are where the DBC puts them: bits 4..7 of byte 0.
+    CHECK((frame.data[0] >> 4) == static_cast<unsigned>(command));
+    REQUIRE(codec.accept(frame, out) == RxVerdict::ok);
+    REQUIRE(out == supervisor);
+    double decoded[1] = {-1};
+    decode_message(*out, frame, decoded);
+    CHECK(decoded[0] == static_cast<double>(command));
+  }
+  // A command beyond the DBC's range is sent as its end (counted), never as another command's bits.
+  const double beyond[] = {9};
+  CanFrame clamped;
+  CHECK(encode_message(*supervisor, counter, beyond, clamped).saturated == 1);
+  CHECK((clamped.data[0] >> 4) == 3);
+
+  const double stop[] = {static_cast<double>(SupervisorCommand::stop)};
+  CHECK(codec.accept(encoded(*supervisor, 3, stop), out) == RxVerdict::repeated);  // the last one again
+  CHECK(out == nullptr);
+  CHECK(codec.accept(encoded(*supervisor, 12, stop), out) == RxVerdict::stale);
+  CanFrame corrupt = encoded(*supervisor, 4, stop);
+  corrupt.data[0] ^= 0x10;  // stop (2) turned into acknowledge (3): the checksum catches it
+  CHECK(codec.accept(corrupt, out) == RxVerdict::corrupt);
+  // The same payload on FW_HEARTBEAT's identifier (also 2 bytes): the checksum covers the ID.
+  CanFrame moved = encoded(*supervisor, 4, stop);
+  moved.id = can_id::fw_heartbeat;
+  CHECK(codec.accept(moved, out) == RxVerdict::corrupt);
+  CHECK(codec.accept(encoded(*supervisor, 4, stop), out) == RxVerdict::ok);
+  CHECK(codec.stats().ok == 5);
+  CHECK(codec.stats().rejected() == 4);
 }

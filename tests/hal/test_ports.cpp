@@ -175,6 +175,51 @@ TEST_CASE("hal/ports deliver emergency stops and heartbeats both ways") {
   CHECK(firmware.last_valid_rx_ns() > 0);
 }
 
+TEST_CASE("hal/ports carry an operator's SUPERVISOR commands to the firmware only, each frame once") {
+  MemoryBusHub hub;
+  MemoryBusNode* fw_node = hub.attach();
+  MemoryBusNode* pl_node = hub.attach();
+  MemoryBusNode* op_node = hub.attach();
+  FirmwareCanPort firmware(*fw_node);
+  PlantCanPort plant(*pl_node);
+  OperatorCanPort station(*op_node);
+  const auto bit = [](SupervisorCommand c) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(c)); };
+  CHECK(station.send(SupervisorCommand::acknowledge));
+  CHECK(station.send(SupervisorCommand::start));
+  SensorState state;
+  firmware.read(state);
+  CHECK(state.supervisor_pending == (bit(SupervisorCommand::acknowledge) | bit(SupervisorCommand::start)));
+  state.supervisor_pending = 0;  // taken
+  firmware.read(state);
+  CHECK(state.supervisor_pending == 0);  // nothing new: nothing pending
+  // The same frame again (a repeat on the bus) is rejected by its counter, so it commands nothing.
+  CanFrame stop;
+  const double value[] = {static_cast<double>(SupervisorCommand::stop)};
+  encode_message(*find_message(can_id::supervisor), station.next_counter(), value, stop);
+  REQUIRE(op_node->send(stop));
+  REQUIRE(op_node->send(stop));
+  firmware.read(state);
+  CHECK(state.supervisor_pending == bit(SupervisorCommand::stop));
+  CHECK(firmware.rx_stats().repeated == 1);
+  // The plant passes it: no command set, no SYNC, nothing latched.
+  std::uint64_t cycle = 0;
+  CHECK_FALSE(plant.poll_sync(cycle));
+  CommandState command;
+  CHECK_FALSE(plant.read(command));
+  CHECK_FALSE(command.valid);
+  // On SocketCAN the plant's kernel filter keeps SUPERVISOR out; the firmware's lets it in.
+  std::uint32_t ids[kMessageCount];
+  const auto listens = [&](Node node) {
+    const std::size_t n = receive_ids(node, ids, kMessageCount);
+    for (std::size_t i = 0; i < n; ++i) {
+      if (ids[i] == can_id::supervisor) return true;
+    }
+    return false;
+  };
+  CHECK(listens(Node::firmware));
+  CHECK_FALSE(listens(Node::plant));
+}
+
 TEST_CASE("hal/ports refuse a classical frame, or an FD frame of another length, where the DBC has an FD frame") {
   Bench bench;
   MemoryBusNode* foreign = bench.hub.attach();

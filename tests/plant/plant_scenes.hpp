@@ -43,6 +43,31 @@ struct SceneText {
   Scene scene() const { return read_scene(settings::Document::parse(yaml(), "<test>")); }
 };
 
+// The reference machine with its hydraulics at the reference pose, the tip 1.8 m above flat ground (no soil).
+inline Scene hydraulic_scene() {
+  SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  return t.scene();
+}
+
+// Every spool at an opening (-1..1), the plant's own valve command.
+inline ActuatorCommand valve(const Vec4& opening) {
+  ActuatorCommand c;
+  c.mode = ActuatorCommand::valve;
+  c.value = opening;
+  return c;
+}
+
+// The shipped scenes that drive the hydraulic machine through its valves, and whether their swing
+// moves (flow-based control lags a moving swing past its tracking limit: not run there).
+struct ShippedHydraulicScene {
+  const char* scene;
+  bool swing_moves;
+};
+inline constexpr ShippedHydraulicScene kShippedHydraulicScenes[] = {
+    {"dig.yaml", false},       {"free_motion.yaml", true},      {"clay_slope.yaml", false},     {"sand_skim.yaml", false},
+    {"loam_noisy_late.yaml", false}, {"truck_loading.yaml", true}, {"truck_clay_slope.yaml", true}};
+
 inline const char* kMethods[] = {"semi_implicit_euler", "rk4", "implicit_midpoint"};
 inline const char* kFormulations[] = {"independent", "augmented_baumgarte", "augmented_projection"};
 

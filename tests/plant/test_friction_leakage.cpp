@@ -18,21 +18,12 @@
 using namespace exc;
 using namespace exc::plant;
 
+using plant::test::hydraulic_scene;
+using plant::test::valve;
+
 namespace {
 
-ActuatorCommand valve(const Vec4& opening) {
-  ActuatorCommand c;
-  c.mode = ActuatorCommand::valve;
-  c.value = opening;
-  return c;
-}
 
-// The hydraulic machine at the reference pose, the tip 1.8 m above flat ground (no soil).
-Scene hydraulic_scene() {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  return t.scene();
-}
 
 // The efforts that hold the plant's machine still at q_a (gravity only): eq. 16b with qdd = 0.
 Vec4 holding_effort(const Plant& plant, const Vec4& q_a) {

@@ -854,19 +854,53 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
   const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "merged" / "sweep.json"));
   const double watchdog = exc::sim::load_scene_bundle(kDig).firmware.controller.watchdog_timeout;
   int runs = 0, kinds = 0;
+  // Judged by the machine (issue 32): a stop after which the machine still moves at the run's end is
+  // "neither". Those are counted and printed apart (docs/safety.md: open, on the free motion); every
+  // other way of ending neither must not happen.
+  std::map<std::string, int> not_at_rest;
+  int not_at_rest_total = 0;
+  {
+    std::istringstream lines(read_text_file(dir / "all.jsonl"));
+    for (std::string line; std::getline(lines, line);) {
+      const nlohmann::json l = nlohmann::json::parse(line);
+      for (const char* c : {"pid", "adaptive"}) {
+        const nlohmann::json& r = l[c];
+        if (r.value("outcome", "") != "neither") continue;
+        const std::string why = r.value("why", "");
+        INFO("case " << l["case"] << " " << c << ": " << why);
+        CHECK(why.rfind("the firmware stopped but the machine still moved", 0) == 0);
+        CHECK(r["safe_state_time"].get<double>() - r["fault_detected_time"].get<double>() <= watchdog + 1e-9);
+        ++not_at_rest[std::string(c) + " " + l["fault"]["kind"].get<std::string>()];
+        ++not_at_rest_total;
+      }
+    }
+  }
+  MESSAGE("runs stopped in time but not at rest at the run's end: " << not_at_rest_total);
   for (const char* c : {"pid", "adaptive"}) {
     REQUIRE(j["campaign"].contains(c));
     std::map<std::string, int> per_scene;
     for (const auto& [kind, k] : j["campaign"][c].items()) {
       INFO(c << " " << kind << ": " << k.dump());
-      CHECK(k["neither"].get<int>() == 0);
-      CHECK(k["tracked"].get<int>() + k["safe_state"].get<int>() == k["runs"].get<int>());
+      CHECK(k["neither"].get<int>() == not_at_rest[std::string(c) + " " + kind]);
+      CHECK(k["tracked"].get<int>() + k["safe_state"].get<int>() + k["neither"].get<int>() == k["runs"].get<int>());
       if (!k["worst_time_from_detection"].is_null()) CHECK(k["worst_time_from_detection"].get<double>() <= watchdog + 1e-9);
       for (const auto& [scene, n] : k["scenes"].items()) per_scene[scene] += n["runs"].get<int>();
       runs += k["runs"].get<int>();
       ++kinds;
     }
     CHECK(per_scene == std::map<std::string, int>{{"dig", 12}, {"free_motion", 12}});  // cases 0-11 on the dig, 12-23 on the free motion
+    // The same runs per safety function (the fault that took the stop): they add up to the runs,
+    // and each row's kinds to its runs.
+    REQUIRE(j["safety_functions"].contains(c));
+    int by_function = 0;
+    for (const auto& [name, f] : j["safety_functions"][c].items()) {
+      INFO(c << " " << name << ": " << f.dump());
+      int by_kind = 0;
+      for (const auto& [kind, n] : f["kinds"].items()) by_kind += n.get<int>();
+      CHECK(by_kind == f["runs"].get<int>());
+      by_function += f["runs"].get<int>();
+    }
+    CHECK(by_function == 24);
   }
   CHECK(runs == 2 * 24);
   CHECK(kinds == 2 * 7);

@@ -123,7 +123,8 @@ CaptureReport check_capture(std::istream& in, const std::string& interface_name)
   std::size_t last_plant = accepted.size(), last_firmware = accepted.size();
   for (std::size_t i = 0; i < accepted.size(); ++i) {
     const std::uint32_t id = accepted[i].frame.id;
-    if (id == can_id::fw_emergency || id == can_id::plant_emergency) continue;
+    // An operator station's frames are neither side's.
+    if (id == can_id::fw_emergency || id == can_id::plant_emergency || id == can_id::supervisor) continue;
     (accepted[i].spec->sender == Node::plant ? last_plant : last_firmware) = i;
   }
   if (last_plant < accepted.size()) {

@@ -4,7 +4,7 @@
 // {name: physical value}}), named by DBC signal here, independently of the ports' own mapping. An
 // independent DBC decoder (tests/vcan/canmatrix_decode.py) then decodes the capture and compares.
 // Every frame kind goes out: SYNC, the three command sets in turn, SENS_MACHINE with every pressure,
-// both heartbeats and both emergency frames.
+// both heartbeats, both emergency frames and the operator station's SUPERVISOR (every command).
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -144,9 +144,12 @@ int main(int argc, char** argv) {
   MemoryBusHub hub(&SimClock::read, &clock);
   MemoryBusNode* fw_node = hub.attach();
   MemoryBusNode* pl_node = hub.attach();
+  MemoryBusNode* op_node = hub.attach();
   MemoryBusNode* tap = hub.attach(16);
   FirmwareCanPort firmware(*fw_node);
   PlantCanPort plant(*pl_node);
+  OperatorCanPort station(*op_node);
+  std::uint64_t supervisor_frames = 0;
   Recorder rec(*tap, capture, sent);
   bool ok = true;
   for (long n = 0; n < cycles && ok; ++n) {
@@ -161,6 +164,12 @@ int main(int argc, char** argv) {
     if (k % 97 == 13) {
       firmware.send_fault(k % 2 == 1, static_cast<std::uint16_t>(k * 31));
       ok &= rec.record("FW_EMERGENCY", {{"EmergencyStop", k % 2 == 1 ? 1.0 : 0.0}, {"FaultCode", static_cast<double>((k * 31) & 0xFFFF)}});
+    }
+    if (k % 113 == 29) {
+      const auto command = static_cast<SupervisorCommand>(k / 113 % 4);
+      station.send(command);
+      ++supervisor_frames;
+      ok &= rec.record("SUPERVISOR", {{"Command", static_cast<double>(command)}});
     }
     std::uint64_t cycle = 0;
     while (plant.poll_sync(cycle)) {
@@ -189,6 +198,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf("vcan-port-capture: %ld cycles, %llu frames written to %s\n", cycles,
-              static_cast<unsigned long long>(firmware.tx_stats().frames_sent + plant.tx_stats().frames_sent), argv[2]);
+              static_cast<unsigned long long>(firmware.tx_stats().frames_sent + plant.tx_stats().frames_sent + supervisor_frames),
+              argv[2]);
   return 0;
 }

@@ -9,6 +9,10 @@
 #   kill-firmware  the firmware is killed mid-run: the plant holds and says so (PLANT_EMERGENCY).
 #   no-plant       (not in all) the firmware alone on the bus: nothing answers, so it never tracks;
 #                  it must say so: exit 1, ok false, the reason, its tracking figures null (not 0).
+#   ack            (not in all) issue 32's capture: the arm's spool sticks (the plant's --stuck-spool),
+#                  the firmware's emergency stop holds until excavator-operator's acknowledge frame;
+#                  then the plant is frozen (SIGSTOP: a sensor timeout), the stop holds again until a
+#                  second acknowledge. --ack-check judges the capture on the host.
 # Nothing waits on wall-clock speed: every wait ends on an event (a receiver registered on vcan0,
 # frames in the capture, a process exit); the time limits only catch hangs.
 #
@@ -33,6 +37,7 @@ Usage: two_process.sh --vcan-vm PATH --plant PATH --firmware PATH --sim PATH --c
                       --scene FILE --work DIR [--duration S] [--watchdog-cycles N]
                       [--scenario all|run|kill-plant|kill-firmware|realtime|no-plant[,...]] [--timeout S]
                       [--decode-check COMMAND] [--bus-load-check COMMAND] [--rt-vm PRIORITY]
+                      [--operator PATH] [--ack-check COMMAND]
 Runs the two-process scenarios (see the head of this file) inside vcan-vm, in one VM.
   --work DIR          output directory (made writable in the VM): captures, program output, JSON
   --duration S        simulated seconds of the run scenario (default 3)
@@ -45,6 +50,9 @@ Runs the two-process scenarios (see the head of this file) inside vcan-vm, in on
   --bus-load-check CMD  after the VM, on the host: run CMD --log run/firmware.lcm run/capture.log
                       (the run scenario's firmware telemetry and capture; tests/vcan/bus_load_check.py:
                       EXC_CAN_STATS.bus_load against the captured frames' exact on-wire time)
+  --operator PATH     excavator-operator (the ack scenario sends its acknowledge frames with it)
+  --ack-check CMD     after the VM, on the host: run CMD with the ack scenario's capture.log as its
+                      last argument (tests/vcan/ack_capture_check.py); a non-zero exit fails the run
   --rt-vm PRIORITY    once the VM has booted, and before the scenarios run, give QEMU's threads
                       SCHED_FIFO PRIORITY on the host where permitted (root), as the firmware has
                       in the guest: the emulated vCPU is a host thread, and on a busy host each of its
@@ -61,6 +69,7 @@ EOF
 }
 
 vcan_vm="" plant="" firmware="" sim="" capture_check="" scene="" work="" decode_check="" bus_load_check="" rt_vm=0
+operator="" ack_check=""
 duration=3 watchdog_cycles=20 scenario=all timeout_s=280 inside=0
 while [ $# -gt 0 ]; do
   case $1 in
@@ -72,6 +81,8 @@ while [ $# -gt 0 ]; do
     --capture-check) capture_check=$2; shift 2 ;;
     --decode-check) decode_check=$2; shift 2 ;;
     --bus-load-check) bus_load_check=$2; shift 2 ;;
+    --operator) operator=$2; shift 2 ;;
+    --ack-check) ack_check=$2; shift 2 ;;
     --rt-vm) rt_vm=$2; shift 2 ;;
     --scene) scene=$2; shift 2 ;;
     --work) work=$2; shift 2 ;;
@@ -92,7 +103,10 @@ done
 [[ $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "two_process.sh: --duration '$duration': must be positive seconds" >&2; exit 2; }
 [[ $watchdog_cycles =~ ^[0-9]+$ ]] || { echo "two_process.sh: --watchdog-cycles '$watchdog_cycles': must be a whole number" >&2; exit 2; }
 for one in ${scenario//,/ }; do
-  case $one in all|run|kill-plant|kill-firmware|realtime|no-plant) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware, realtime or no-plant (or a comma-separated list)" >&2; exit 2 ;; esac
+  case $one in all|run|kill-plant|kill-firmware|realtime|no-plant|ack) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware, realtime, no-plant or ack (or a comma-separated list)" >&2; exit 2 ;; esac
+  if [ "$one" = ack ]; then
+    [ -n "$operator" ] && [ -x "$operator" ] || { echo "two_process.sh: --operator '$operator': the ack scenario needs excavator-operator" >&2; exit 2; }
+  fi
 done
 
 if [ "$inside" = 0 ]; then
@@ -103,11 +117,12 @@ if [ "$inside" = 0 ]; then
   # Absolute paths: the scenarios run in the work directory.
   plant=$(realpath "$plant") firmware=$(realpath "$firmware") sim=$(realpath "$sim")
   capture_check=$(realpath "$capture_check") scene=$(realpath "$scene")
+  [ -z "$operator" ] || operator=$(realpath "$operator")
   rm -f "$work/.guest_up" "$work/.vm_priority"
   "$vcan_vm" --timeout "$timeout_s" --share "$work" -- "$self" --inside \
     --plant "$plant" --firmware "$firmware" --sim "$sim" --capture-check "$capture_check" \
     --scene "$scene" --work "$work" --duration "$duration" --watchdog-cycles "$watchdog_cycles" --scenario "$scenario" \
-    --rt-vm "$rt_vm" &
+    --rt-vm "$rt_vm" ${operator:+--operator "$operator"} &
   vm_pid=$!
   if [ "$rt_vm" != 0 ]; then
     # The guest says when it is up; QEMU (a descendant of vcan-vm: timeout, then qemu-system-x86_64)
@@ -138,13 +153,25 @@ if [ "$inside" = 0 ]; then
       echo "FAIL [bus-load]: EXC_CAN_STATS.bus_load does not match the capture:"; cat "$work/run/bus_load_check.out"; rc=1
     fi
   fi
+  case ",$scenario," in
+    *,ack,*)
+      if [ -n "$ack_check" ]; then
+        current=ack-check
+        # shellcheck disable=SC2086  # the command line is split into words on purpose
+        if $ack_check "$work/ack/capture.log" > "$work/ack/ack_check.out" 2>&1; then
+          grep -E 'stop [0-9]|stops held' "$work/ack/ack_check.out" | sed 's/^[^:]*: /[ack-check] /'
+        else
+          echo "FAIL [ack-check]: the capture does not show the stops held until the acknowledge:"; sed -n '1,30p' "$work/ack/ack_check.out"; rc=1
+        fi
+      fi ;;
+  esac
   [ -n "$decode_check" ] || exit $rc
   # The second decoder, on the host (fast there, slow in the emulated VM), on every capture this run
   # wrote: it must read every frame as the DBC defines it.
   current=decode
   dirs=""
   for one in ${scenario//,/ }; do
-    case $one in all) dirs="$dirs run kill_plant kill_firmware" ;; realtime|no-plant) ;; *) dirs="$dirs ${one/-/_}" ;; esac
+    case $one in all) dirs="$dirs run kill_plant kill_firmware" ;; realtime|no-plant) ;; *) dirs="$dirs ${one//-/_}" ;; esac
   done
   for d in $dirs; do
     log=$work/$d/capture.log
@@ -397,6 +424,50 @@ scenario_no_plant() {
   grep -q 'FAILED: the firmware never tracked' "$dir/firmware.out" || fail "with no plant the firmware did not say it never tracked"
 }
 
+# Issue 32's capture: a stuck spool, then a sensor timeout, each stop held until an acknowledge.
+# Every wait counts cycles on the bus (SYNC frames), never wall-clock time.
+sends_at_least() { [ "$(grep -c " $2#" "$1" 2>/dev/null)" -ge "$3" ]; }
+scenario_ack() {
+  current=ack
+  local dir=$work/ack long=600 seen stops
+  rm -rf "$dir"; mkdir -p "$dir"
+  # The arm's spool sticks at 0.4 from 1 s to 1.5 s of the run: the velocity monitor's emergency stop.
+  start_capture_and_plant "$dir" "$long" "--stuck-spool arm --stuck-opening 0.4 --stuck-from 1 --stuck-until 1.5" || return
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$FIRMWARE_ARGS" "$long" "$dir/two_process.json" "$dir") > "$dir/firmware.out" 2>&1 &
+  local fw_pid=$!
+  local give_up="stop $fw_pid; stop $plant_pid; stop_capture $dir"
+  wait_until "FW_EMERGENCY after the stuck spool" id_in_capture "$capture" 010 || { eval "$give_up"; return; }
+  # Stopped for 1000 cycles (1 s of the run), then acknowledged. The counters go 0, 1: in sequence
+  # for the capture check, which allows no gap.
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "1000 cycles stopped" syncs_at_least "$capture" $((seen + 1000)) || { eval "$give_up"; return; }
+  "$operator" --can vcan0 --counter 0 ack > "$dir/operator1.out" 2>&1 || fail "excavator-operator ack: $(cat "$dir/operator1.out")"
+  note "$(cat "$dir/operator1.out") after $(grep -c ' 080#' "$capture") cycles"
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "500 cycles after the acknowledge" syncs_at_least "$capture" $((seen + 500)) || { eval "$give_up"; return; }
+  # A sensor timeout: the plant frozen. The firmware's cycles go on (each waits for the sensors).
+  stops=$(grep -c ' 010#' "$capture")
+  kill -STOP "$plant_pid"
+  note "plant frozen (SIGSTOP) after $(grep -c ' 080#' "$capture") cycles"
+  wait_until "FW_EMERGENCY after the sensor timeout" sends_at_least "$capture" 010 $((stops + 1)) || { kill -CONT "$plant_pid"; eval "$give_up"; return; }
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "10 cycles without the plant" syncs_at_least "$capture" $((seen + 10))
+  kill -CONT "$plant_pid"
+  note "plant resumed (SIGCONT) after $(grep -c ' 080#' "$capture") cycles"
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "500 cycles with the plant back" syncs_at_least "$capture" $((seen + 500)) || { eval "$give_up"; return; }
+  "$operator" --can vcan0 --counter 1 ack > "$dir/operator2.out" 2>&1 || fail "excavator-operator ack: $(cat "$dir/operator2.out")"
+  note "$(cat "$dir/operator2.out") after $(grep -c ' 080#' "$capture") cycles"
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "300 cycles after the second acknowledge" syncs_at_least "$capture" $((seen + 300))
+  stop "$fw_pid"; stop "$plant_pid"; stop_capture "$dir"
+  # Not vcan-capture-check: a plant thawed from SIGSTOP answers the SYNCs queued while it was frozen,
+  # each after a later SYNC, which that strict check counts as out of cycle. canmatrix (--decode-check)
+  # reads every frame, --ack-check judges the stops.
+  grep -q 'arm spool stuck' "$dir/plant.out" || fail "the plant did not stick the arm's spool: $(tail -3 "$dir/plant.out")"
+}
+
 current=setup
 # The programs may write defaults (telemetry logs, out/) relative to the working directory: the
 # work directory is the one place the VM can write that the host sees.
@@ -410,6 +481,7 @@ for one in ${scenario//,/ }; do
     kill-firmware) scenario_kill_firmware ;;
     realtime) scenario_realtime ;;
     no-plant) scenario_no_plant ;;
+    ack) scenario_ack ;;
   esac
 done
 if [ $failures -eq 0 ]; then echo "two_process.sh: all scenarios passed ($scenario)"; exit 0; fi

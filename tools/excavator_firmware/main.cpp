@@ -11,6 +11,7 @@
 
 #include <atomic>
 #include <csignal>
+#include <exception>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -56,6 +57,24 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
           {"count", c.count()}};
 }
 
+// Every way out of the loop once the node exists (end of run, SIGINT/SIGTERM, a second signal, an
+// exception) leaves a safe command on the bus: valves centred and FW_EMERGENCY (docs/safety.md, H8).
+// An exception unwinding through it takes the emergency stop.
+class LastSafeCommand {
+ public:
+  explicit LastSafeCommand(exc::app::FirmwareNode& node) : node_(node) {}
+  LastSafeCommand(const LastSafeCommand&) = delete;
+  LastSafeCommand& operator=(const LastSafeCommand&) = delete;
+  ~LastSafeCommand() {
+    if (!node_.safe_command_sent())
+      node_.send_safe_command(std::uncaught_exceptions() > 0 ? exc::app::FirmwareFault::fatal_error
+                                                             : exc::app::FirmwareFault::exited);
+  }
+
+ private:
+  exc::app::FirmwareNode& node_;
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -66,7 +85,7 @@ int main(int argc, char** argv) {
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
   std::string iface, scene_path, controller, json_path, lcm_url;
   double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;
-  bool realtime = false, print_config = false;
+  bool realtime = false, print_config = false, wait_for_start = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config)");
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
   app.add_option("--controller", controller, exc::control::kControllerKinds.names() + " (default: the scene's controller.type, else adaptive)")
@@ -87,6 +106,7 @@ int main(int argc, char** argv) {
                  "real time: the run fails when its late wake-ups and skipped periods together exceed this "
                  "fraction of its cycles (default 0.01)")
       ->check(exc::cli::number_in({0, 1}, ""));
+  app.add_flag("--wait-for-start", wait_for_start, "hold until an operator's start (SUPERVISOR frame, excavator-operator start)");
   app.add_flag("--print-config", print_config,
                "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
@@ -114,6 +134,7 @@ int main(int argc, char** argv) {
     }
     fc.controller = settings.controller;
     fc.site_map = settings.terrain;
+    fc.wait_for_start = wait_for_start;
     const char* const kind_name = exc::control::to_string(fc.kind);
 
     const double period_s = settings.controller.period;
@@ -143,6 +164,7 @@ int main(int argc, char** argv) {
     }
     exc::hal::FirmwareCanPort port(*io.bus);
     exc::app::FirmwareNode node(model, settings.task, fc, port, io.publisher.get());
+    LastSafeCommand last_safe_command(node);
 
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
@@ -211,7 +233,12 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
       }
     }
-    node.publish_counters();
+    // The run is over (its end, or a signal): the machine is left with its valves centred.
+    node.send_safe_command(exc::app::FirmwareFault::exited);
+    std::printf("excavator-firmware: last command sent: valves centred, FW_EMERGENCY %s stop (%s)\n",
+                exc::app::to_string(node.emergency_sent() ? exc::app::StopKind::emergency : exc::app::StopKind::controlled),
+                node.mode() == exc::control::Mode::safe_stop ? node.last_fault_text() : "firmware exited");
+    node.publish_counters(true);
     if (io.publisher) io.publisher->stop();
 
     // The verdict: a run that never tracked, went to its safe state, or missed its deadlines failed.
@@ -261,6 +288,7 @@ int main(int argc, char** argv) {
       j["deadlines"] = {{"overruns", overruns}, {"skipped_periods", skipped},
                         {"interval_us", timing_json(node.interval_timing())}};
       j["safe_stops"] = node.safe_stops();
+      j["estop"] = node.emergency_sent();  // any FW_EMERGENCY with EmergencyStop = 1, the last command included
       if (node.safe_stops() > 0) j["last_fault"] = node.last_fault_text();
       j["task_finished"] = node.trajectory_finished();
       j["can_frames_rejected"] = port.rx_stats().rejected();

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <stdexcept>
 
 #include "app/float_environment.hpp"
 #include "app/node_io.hpp"
@@ -35,6 +36,9 @@ int main(int argc, char** argv) {
   std::string iface, scene_path, lcm_url;
   double duration = 0, silence_ms = 500, startup_s = 120;
   bool realtime = false;
+  // A main-valve spool stuck (as the fault campaign's spool_stuck) for the vcan safety tests.
+  std::string stuck_function;
+  double stuck_opening = 0, stuck_from = 0, stuck_until = 1e9;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--scene", scene_path, "scene file")->required();
   app.add_option("--duration", duration, "exit after this many simulated seconds (default: the scene's)")
@@ -47,6 +51,11 @@ int main(int argc, char** argv) {
   app.add_flag("--realtime", realtime,
                "the firmware runs --realtime: a full telemetry ring drops and counts messages instead of "
                "delaying the answer to SYNC past the firmware's deadline (default: wait, lose nothing)");
+  app.add_option("--stuck-spool", stuck_function, "stick this function's main-valve spool (hydraulic machine)")
+      ->check(CLI::IsMember({"swing", "boom", "arm", "bucket"}));
+  app.add_option("--stuck-opening", stuck_opening, "the opening the spool sticks at")->check(exc::cli::number_in({-1, 1}, ""));
+  app.add_option("--stuck-from", stuck_from, "simulated time it sticks")->check(exc::cli::number_in({0, 1e9}, "s"));
+  app.add_option("--stuck-until", stuck_until, "simulated time it frees (default: never)")->check(exc::cli::number_in({0, 1e9}, "s"));
   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
   try {
@@ -66,6 +75,15 @@ int main(int argc, char** argv) {
     auto& publisher = io.publisher;
     exc::hal::PlantCanPort port(*bus);
     exc::app::PlantNode node(plant, port, publisher.get());
+    exc::app::InjectedFault stuck;
+    if (!stuck_function.empty()) {
+      if (plant.scene().actuators.fidelity != exc::plant::ActuatorFidelity::hydraulic)
+        throw std::invalid_argument("--stuck-spool needs the hydraulic machine; the scene's actuators are not");
+      stuck.kind = exc::app::InjectedFault::Kind::valve_stuck;
+      stuck.joint = stuck_function == "swing" ? 0 : stuck_function == "boom" ? 1 : stuck_function == "arm" ? 2 : 3;
+      stuck.magnitude = stuck_opening;
+    }
+    bool stuck_now = false;
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
 
@@ -80,6 +98,13 @@ int main(int argc, char** argv) {
                 iface.c_str(), static_cast<unsigned long long>(cycles));
     std::fflush(stdout);
     while (!g_stop && node.steps() < cycles) {
+      const double t = static_cast<double>(node.steps()) * plant.scene().cycle;
+      if (stuck.kind != exc::app::InjectedFault::Kind::none && (t >= stuck_from && t < stuck_until) != stuck_now) {
+        stuck_now = !stuck_now;
+        node.set_fault(stuck_now ? stuck : exc::app::InjectedFault{});
+        std::printf("excavator-plant: %s spool %s at %.3f s\n", stuck_function.c_str(), stuck_now ? "stuck" : "freed", t);
+        std::fflush(stdout);
+      }
       if (node.wait(slice_ns)) {
         silent_ms = 0;
         if (announced) {

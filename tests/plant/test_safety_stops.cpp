@@ -1,0 +1,221 @@
+// Issue 32's stops judged by the machine (docs/safety.md): a main-valve spool stuck on any of the
+// four functions, at openings both ways, under every law that drives the valves, in the dig scene:
+// the velocity plausibility monitor finds it within 100 ms of the stick, the firmware sends the
+// emergency stop (the machine cuts its pilot supply and stops its engine), and the machine is at rest
+// (plant truth: cylinders under 1 mm/s, swing under 1 mrad/s, to the run's end) within 1.5 s. And
+// without a fault the monitor stays inside its band on every shipped hydraulic scene's law: its
+// margin is printed. Firmware and plant in lockstep over the in-memory bus (harness/lockstep_run.hpp).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "app/firmware_node.hpp"
+#include "control/controller_kinds.hpp"
+#include "harness/lockstep_run.hpp"
+#include "plant_scenes.hpp"
+#include "sim_plant/plant.hpp"
+
+using namespace exc;
+
+namespace {
+
+// The valve-driving laws the dig scene runs (flow-based control included: the dig's swing is still).
+constexpr control::ControllerKind kLaws[] = {control::ControllerKind::pid, control::ControllerKind::adaptive,
+                                             control::ControllerKind::slotine_li, control::ControllerKind::flow};
+
+}  // namespace
+
+TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent, detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
+  // Issue 32's requirement is detection within 100 ms and the machine at rest within 1.5 s of the
+  // stick. Asserted: every case found by the flow plausibility monitor, within 100 ms under the
+  // laws that command an effort (the flow law asks only a small flow against a stuck swing, so less
+  // oil arrives against its command: 150 ms), the emergency stop sent. The time to rest is printed
+  // per case against 1.5 s: after the engine's run-down the machine's own dynamics (a gravity load
+  // through a stuck spool to its end stop, a boom ringing on its oil column) decide it;
+  // docs/safety.md reports which cases miss it and why.
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  const double t_stick = 3.0;
+  double worst_detection = 0, worst_rest = 0;
+  int cases = 0, detected_in_time = 0, at_rest_in_time = 0, never_at_rest = 0;
+  std::string worst_detection_case, worst_rest_case;
+  for (const control::ControllerKind law : kLaws) {
+    for (int joint = 0; joint < 4; ++joint) {
+      for (const double opening : {-0.8, -0.4, 0.4, 0.8}) {
+        sim::LockstepOptions o;
+        o.controller = law;
+        o.duration = t_stick + 4.0;
+        o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
+        o.fault.start = t_stick;
+        o.fault.duration = 1e9;  // to the run's end
+        o.fault.joint = joint;
+        o.fault.magnitude = opening;
+        const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+        const std::string name = std::string(control::to_string(law)) + ", " + kActiveNames[static_cast<std::size_t>(joint)] +
+                                 " stuck at " + std::to_string(opening);
+        INFO(name << ": " << r.failure);
+        ++cases;
+        REQUIRE(r.first_safe_stop_time >= 0);
+        const bool flow_swing = law == control::ControllerKind::flow && joint == 0;
+        CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible));
+        const double detection = r.first_fault_detected_time - t_stick;
+        CHECK(detection > 0);
+        CHECK(detection <= (flow_swing ? 0.15 : 0.1));
+        CHECK(r.estop);
+        const double rest = r.machine_at_rest_time >= 0 ? r.machine_at_rest_time - t_stick : -1;
+        MESSAGE(name << ": detected after " << detection * 1e3 << " ms, at rest "
+                     << (rest >= 0 ? std::to_string(rest) + " s" : std::string("never (moving at the end)"))
+                     << " after the stick");
+        detected_in_time += detection <= 0.1 ? 1 : 0;
+        at_rest_in_time += rest >= 0 && rest <= 1.5 ? 1 : 0;
+        never_at_rest += rest < 0 ? 1 : 0;
+        if (detection > worst_detection) {
+          worst_detection = detection;
+          worst_detection_case = name;
+        }
+        if (rest > worst_rest) {
+          worst_rest = rest;
+          worst_rest_case = name;
+        }
+      }
+    }
+  }
+  MESSAGE("spool stuck, " << cases << " cases (4 laws x 4 functions x 4 openings): detected within 100 ms " << detected_in_time
+                          << ", at rest within 1.5 s " << at_rest_in_time << ", never at rest " << never_at_rest
+                          << "; worst detection " << worst_detection * 1e3 << " ms (" << worst_detection_case
+                          << "), worst time to rest of those at rest " << worst_rest << " s (" << worst_rest_case << ")");
+}
+
+TEST_CASE("firmware/plausibility: without a fault the velocity monitor never trips on the shipped hydraulic scenes under every law they run, its margins printed") {
+  // The shipped scenes that drive the hydraulic machine through its valves, the laws each runs
+  // without faulting (flow-based control lags a moving swing past its tracking limit: not run there).
+  for (const auto& sc : plant::test::kShippedHydraulicScenes) {
+    const sim::SceneBundle b = sim::load_scene_bundle(std::string(EXC_SOURCE_DIR "/scenes/") + sc.scene);
+    for (const control::ControllerKind law : kLaws) {
+      if (law == control::ControllerKind::flow && sc.swing_moves) continue;
+      Vec4 worst = Vec4::Zero();
+      sim::LockstepOptions o;
+      o.controller = law;
+      o.node_observer = [&worst](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+        worst = node.plausibility().worst_ratio();
+      };
+      const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+      const std::string what = std::string(sc.scene) + ", " + control::to_string(law);
+      INFO(what << ": " << r.failure);
+      MESSAGE(what << ": largest test value / floor per function " << worst.transpose()
+                       << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
+      // The monitor's own criterion: outside its floor for its debounce time in a row. A single
+      // cycle beyond the floor is no fault (the printed figure is the largest single cycle's).
+      CHECK(r.first_fault_code != static_cast<int>(app::FirmwareFault::velocity_implausible));
+      CHECK(r.safe_stops == 0);
+    }
+  }
+}
+
+namespace {
+
+// What a run with operator frames looked like, cycle by cycle, from the firmware's mode and the
+// plant's truth (the machine at rest: cylinders under 1 mm/s, swing under 1 mrad/s).
+struct SupervisedRun {
+  sim::RunRecord record;
+  double first_stop = -1;           // s, the first cycle in the safe state
+  double left_stop = -1;            // s, the first cycle out of it (-1: never)
+  double last_moving_stopped = -1;  // s, the last cycle the machine moved while the firmware was stopped
+  int stopped_cycles = 0;
+  bool estop = false;               // FW_EMERGENCY with EmergencyStop = 1 sent
+  app::FirmwareFault fault = app::FirmwareFault::none;
+  std::string fault_text, leave_reason;
+};
+
+SupervisedRun run_supervised(const sim::SceneBundle& b, sim::LockstepOptions o) {
+  SupervisedRun run;
+  o.observer = [&run](std::int64_t, const plant::Plant& plant, const app::FirmwareNode& node) {
+    const bool stopped = node.mode() == control::Mode::safe_stop;
+    const double t = node.time();
+    if (stopped) {
+      ++run.stopped_cycles;
+      if (run.first_stop < 0) {
+        run.first_stop = t;
+        run.fault = node.last_fault();
+        run.fault_text = node.last_fault_text();
+      }
+      const auto& qd = plant.state().qd_a;
+      bool moving = std::abs(qd[0]) >= sim::kRestSwingRate;
+      for (int j = 1; j < 4; ++j) moving = moving || std::abs(qd[j]) >= sim::kRestCylinderRate;
+      if (moving) run.last_moving_stopped = t;
+    } else if (run.first_stop >= 0 && run.left_stop < 0) {
+      run.left_stop = t;
+      run.leave_reason = node.last_transition().reason;
+    }
+    run.estop = run.estop || node.emergency_sent();
+  };
+  run.record = sim::run_lockstep(b.scene, b.firmware, o);
+  return run;
+}
+
+}  // namespace
+
+TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the machine at rest until a SUPERVISOR acknowledge frame arrives on the bus") {
+  // The arm's spool sticks at 0.4 for 0.5 s from 3 s (then frees): the velocity monitor stops the
+  // firmware with the emergency stop. The operator station acknowledges at 7 s; without that frame
+  // the same run stays stopped to its end.
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  sim::LockstepOptions o;
+  o.controller = control::ControllerKind::pid;
+  o.duration = 8.0;
+  o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
+  o.fault.start = 3.0;
+  o.fault.duration = 0.5;
+  o.fault.joint = 2;
+  o.fault.magnitude = 0.4;
+  const double t_ack = 7.0;
+  SUBCASE("acknowledged by the frame") {
+    o.supervisor = {{t_ack, hal::SupervisorCommand::acknowledge}};
+    const SupervisedRun run = run_supervised(b, o);
+    INFO(run.record.failure << " " << run.fault_text);
+    REQUIRE(run.first_stop > 3.0);
+    CHECK(run.fault == app::FirmwareFault::velocity_implausible);
+    CHECK(run.estop);
+    // Stopped from the fault to the acknowledge's cycle, and not a cycle less (a frame sent before
+    // the harness's cycle at t is read in the firmware's cycle t + 1 ms).
+    CHECK(run.left_stop == doctest::Approx(t_ack + 1e-3).epsilon(1e-9));
+    CHECK(run.leave_reason == "acknowledged, sensor frames fresh, no fault");
+    // The machine came to rest while stopped, long before the acknowledge, and stayed there.
+    CHECK(run.last_moving_stopped >= 0);
+    CHECK(run.last_moving_stopped < t_ack - 1.0);
+    MESSAGE("stuck arm spool: stopped at " << run.first_stop << " s (" << run.fault_text << "), machine at rest from "
+                                           << run.last_moving_stopped << " s, released by the acknowledge frame at " << run.left_stop << " s");
+    // Released into hold, not back into the task.
+    CHECK(run.record.safe_stops == 1);
+  }
+  SUBCASE("no acknowledge frame: stopped to the run's end") {
+    const SupervisedRun run = run_supervised(b, o);
+    REQUIRE(run.first_stop > 3.0);
+    CHECK(run.left_stop < 0);
+    CHECK(run.last_moving_stopped < t_ack - 1.0);
+  }
+}
+
+TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machine (controlled, named, at rest), latched until acknowledged") {
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  sim::LockstepOptions o;
+  o.controller = control::ControllerKind::adaptive;
+  o.duration = 7.0;
+  o.supervisor = {{3.0, hal::SupervisorCommand::stop},
+                  {4.0, hal::SupervisorCommand::start},  // a start does not end a stop
+                  {6.0, hal::SupervisorCommand::acknowledge}};
+  const SupervisedRun run = run_supervised(b, o);
+  INFO(run.record.failure << " " << run.fault_text);
+  // Taken on the cycle the frame arrives (the firmware's cycle 3.001 s).
+  CHECK(run.first_stop == doctest::Approx(3.0 + 1e-3).epsilon(1e-9));
+  CHECK(run.fault == app::FirmwareFault::operator_stop);
+  CHECK(run.fault_text.find("operator stop: SUPERVISOR stop in track") != std::string::npos);
+  CHECK(app::stop_of(run.fault) == app::StopKind::controlled);
+  // Controlled; the standstill monitor may escalate it (printed): in the dig it does.
+  CHECK(run.last_moving_stopped < 4.5);
+  CHECK(run.left_stop == doctest::Approx(6.0 + 1e-3).epsilon(1e-9));
+  CHECK_FALSE(run.record.task_finished);
+  MESSAGE("operator stop at 3 s: machine at rest from " << run.last_moving_stopped << " s, released at " << run.left_stop
+                                                      << " s; escalated to the emergency stop: " << std::string(run.estop ? "yes" : "no"));
+}

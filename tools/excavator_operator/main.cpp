@@ -1,0 +1,66 @@
+// excavator-operator: sends one operator command to the firmware as a SUPERVISOR frame on a SocketCAN
+// interface, as an operator station or a remote e-stop kit would: start (a firmware run with
+// --wait-for-start begins its task), stop (a controlled stop that latches like a fault) or ack
+// (acknowledges a latched stop; the firmware holds where the machine is once its condition is gone).
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <map>
+#include <string>
+
+#include "hal/can_ports.hpp"
+#include "hal/can_protocol.hpp"
+#include "hal/socketcan_bus.hpp"
+#include "option_checks.hpp"
+
+namespace {
+
+// The command words a person types, and what each sends.
+const std::map<std::string, exc::hal::SupervisorCommand> kCommands{
+    {"start", exc::hal::SupervisorCommand::start},
+    {"stop", exc::hal::SupervisorCommand::stop},
+    {"ack", exc::hal::SupervisorCommand::acknowledge},
+    {"acknowledge", exc::hal::SupervisorCommand::acknowledge},
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "excavator-operator: sends one operator command (a SUPERVISOR frame, hal/excavator.dbc) to the firmware on a "
+      "SocketCAN interface.\n  start  a firmware run with --wait-for-start begins its task\n  stop   a controlled "
+      "stop (valves centred), latched until acknowledged\n  ack    acknowledges a latched stop (also: acknowledge)"};
+  std::string iface, command_word;
+  int counter = 0;
+  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (MTU 72: CAN FD)")->required();
+  app.add_option("--counter", counter,
+                 "the frame's rolling counter, 0..15 (default 0: the firmware takes a frame more than 5 ms after "
+                 "the previous SUPERVISOR as a new sequence, so each run of this program is heard)")
+      ->check(exc::cli::count_in(0, 15));
+  app.add_option("command", command_word, "start, stop or ack")->required();
+  if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
+
+  const auto found = kCommands.find(command_word);
+  if (found == kCommands.end()) {
+    std::fprintf(stderr, "excavator-operator: command '%s' is not one of start, stop, ack (or acknowledge)\n",
+                 command_word.c_str());
+    return 2;
+  }
+  std::string error;
+  // This end receives nothing it needs: the filter passes only other stations' SUPERVISOR frames.
+  const std::uint32_t ids[] = {exc::hal::can_id::supervisor};
+  auto bus = exc::hal::SocketCanBus::open(iface, ids, 1, error);
+  if (bus == nullptr) {
+    std::fprintf(stderr, "excavator-operator: %s\n", error.c_str());
+    return 3;
+  }
+  exc::hal::OperatorCanPort station(*bus, static_cast<std::uint8_t>(counter));
+  if (!station.send(found->second)) {
+    std::fprintf(stderr, "excavator-operator: %s: the SUPERVISOR frame could not be queued (interface down or its queue full)\n",
+                 iface.c_str());
+    return 1;
+  }
+  std::printf("excavator-operator: SUPERVISOR %s (Command %u, counter %d) sent on %s\n", exc::hal::to_string(found->second),
+              static_cast<unsigned>(found->second), counter, iface.c_str());
+  return 0;
+}
