@@ -20,6 +20,7 @@
 #include "app/firmware_node.hpp"
 #include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
+#include "app/last_safe_command.hpp"
 #include "app/node_io.hpp"
 #include "app/realtime_setup.hpp"
 #include "control/controller_kinds.hpp"
@@ -56,24 +57,6 @@ nlohmann::json timing_json(const exc::control::PerfCounter& c) {
   return {{"median", c.median_us()}, {"p99", c.p99_us()}, {"p99_9", c.percentile_us(0.999)}, {"max", c.max_us()},
           {"count", c.count()}};
 }
-
-// Every way out of the loop once the node exists (end of run, SIGINT/SIGTERM, a second signal, an
-// exception) leaves a safe command on the bus: valves centred and FW_EMERGENCY (docs/safety.md, H8).
-// An exception unwinding through it takes the emergency stop.
-class LastSafeCommand {
- public:
-  explicit LastSafeCommand(exc::app::FirmwareNode& node) : node_(node) {}
-  LastSafeCommand(const LastSafeCommand&) = delete;
-  LastSafeCommand& operator=(const LastSafeCommand&) = delete;
-  ~LastSafeCommand() {
-    if (!node_.safe_command_sent())
-      node_.send_safe_command(std::uncaught_exceptions() > 0 ? exc::app::FirmwareFault::fatal_error
-                                                             : exc::app::FirmwareFault::exited);
-  }
-
- private:
-  exc::app::FirmwareNode& node_;
-};
 
 }  // namespace
 
@@ -164,7 +147,7 @@ int main(int argc, char** argv) {
     }
     exc::hal::FirmwareCanPort port(*io.bus);
     exc::app::FirmwareNode node(model, settings.task, fc, port, io.publisher.get());
-    LastSafeCommand last_safe_command(node);
+    exc::app::LastSafeCommand last_safe_command(node);
 
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
