@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <utility>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <cstring>
 #include <stdexcept>
@@ -120,22 +121,15 @@ void FirmwareNode::check_standstill(bool complete) {
   if (machine_.mode() != control::Mode::safe_stop) return;  // tracking: check_plausibility runs the monitor
   if (escalated_ || stop_of(fault_code_) != StopKind::controlled || !complete) {
     plausibility_.update(false);
-    standstill_origin_set_ = false;
-    swing_origin_set_ = false;
+    cylinder_creep_.restart();
+    swing_creep_.restart();
     return;
   }
-  const Vec4 q = to_vec(sensors_.position);
+  const FlowMeasurement m = flow_measurement();
   char why[120] = "";
-  // What a function took: its motion plus, with pressures, its oil columns' compression (a load
-  // that changes, as a braking swing's pull on the front, moves a held cylinder as much as it
-  // compresses its oil; no oil arrives).
-  Vec4 taken = q;
   if (valve_interface() && sensors_.pressure_valid) {
     // The valves are centred: every bit of oil that arrives is unasked for.
-    const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
-    const Vec4 compression = valves_.measured_force(p_a, p_b).cwiseQuotient(valves_.hydraulic_stiffness(q));
-    taken += compression;
-    plausibility_.update(true, Vec4::Zero(), q, compression, valves_.at_relief(p_a, p_b));
+    plausibility_.update(true, Vec4::Zero(), m.position, m.compression, m.at_relief);
     const std::uint8_t found = plausibility_.implausible();
     for (int j = 0; j < 4 && why[0] == 0; ++j)
       if ((found >> j) & 1)
@@ -146,46 +140,25 @@ void FirmwareNode::check_standstill(bool complete) {
   }
   const double since = static_cast<double>(cycle_ - safe_stop_cycle_) * period_;
   if (why[0] == 0 && since >= kStandstillDelay) {
-    if (!standstill_origin_set_) {
-      standstill_origin_ = taken;
-      standstill_origin_cycle_ = cycle_;
-      standstill_origin_set_ = true;
-      standstill_windows_ = 0;
-    }
-    const double window = static_cast<double>(cycle_ - standstill_origin_cycle_) * period_;
-    if (window >= kStandstillWindow) {
-      const Vec4 mean = (taken - standstill_origin_) / window;
-      // Cylinders only: the swing motor's cross-port leakage (5 % of its flow at relief) lets a
-      // swing trapped on its oil spring move on for seconds; the flow test watches it.
-      for (int j = 1; j < 4 && why[0] == 0 && standstill_windows_ > 0; ++j)
-        if (std::abs(mean[j]) > kStandstillCylinderRate &&
-            std::abs(mean[j]) > (1 - kStandstillSlowing) * std::abs(standstill_mean_[j]))
-          std::snprintf(why, sizeof why, "%s takes %.4f %s/s on average over %.1f s, not slowing", kActiveNames[static_cast<std::size_t>(j)],
-                        mean[j], "m", window);
-      standstill_mean_ = mean;
-      ++standstill_windows_;
-      standstill_origin_ = taken;
-      standstill_origin_cycle_ = cycle_;
-    }
+    constexpr double kOut = std::numeric_limits<double>::infinity();
+    // The cylinders on the oil they took: motion plus, with pressures, compression (a load that
+    // changes, as a braking swing's pull on the front, moves a held cylinder as much as it
+    // compresses its oil; no oil arrives). Not the swing: its motor's cross-port leakage moves a
+    // swing trapped on its oil spring for seconds.
+    const std::uint8_t cylinders =
+        cylinder_creep_.update(m.position + m.compression, cycle_, period_, kStandstillWindow,
+                               Vec4(kOut, kStandstillCylinderRate, kStandstillCylinderRate, kStandstillCylinderRate), kStandstillSlowing);
     // The swing on its motion alone, over windows as long as its oil spring's period, which its
     // ringing averages out of: a spool stuck just past its dead zone creeps on, not slowing.
-    if (!swing_origin_set_) {
-      swing_origin_ = q[0];
-      swing_origin_cycle_ = cycle_;
-      swing_origin_set_ = true;
-      swing_windows_ = 0;
-    }
-    const double swing_window = static_cast<double>(cycle_ - swing_origin_cycle_) * period_;
-    if (swing_origin_set_ && swing_window >= kStandstillSwingWindow) {
-      const double mean = (q[0] - swing_origin_) / swing_window;
-      if (why[0] == 0 && swing_windows_ > 0 && std::abs(mean) > kStandstillSwingRate &&
-          std::abs(mean) > (1 - kStandstillSlowing) * std::abs(swing_mean_))
-        std::snprintf(why, sizeof why, "swing moves %.4f rad/s on average over %.1f s, not slowing", mean, swing_window);
-      swing_mean_ = mean;
-      ++swing_windows_;
-      swing_origin_ = q[0];
-      swing_origin_cycle_ = cycle_;
-    }
+    const std::uint8_t swing = swing_creep_.update(m.position, cycle_, period_, kStandstillSwingWindow,
+                                                   Vec4(kStandstillSwingRate, kOut, kOut, kOut), kStandstillSlowing);
+    for (int j = 1; j < 4 && why[0] == 0; ++j)
+      if ((cylinders >> j) & 1)
+        std::snprintf(why, sizeof why, "%s takes %.4f m/s on average over %.1f s, not slowing", kActiveNames[static_cast<std::size_t>(j)],
+                      cylinder_creep_.mean()[j], cylinder_creep_.window());
+    if (why[0] == 0 && (swing & 1))
+      std::snprintf(why, sizeof why, "swing moves %.4f rad/s on average over %.1f s, not slowing", swing_creep_.mean()[0],
+                    swing_creep_.window());
   }
   if (why[0] == 0) return;
   escalated_ = true;
@@ -595,16 +568,23 @@ control::AppliedEffort FirmwareNode::applied_effort() const {
   return a;
 }
 
+FirmwareNode::FlowMeasurement FirmwareNode::flow_measurement() const {
+  FlowMeasurement m;
+  m.position = to_vec(sensors_.position);
+  // Without pressures (or valves) the compression is unknown: the monitor then sees the motion alone.
+  if (!valve_interface() || !sensors_.pressure_valid) return m;
+  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
+  m.compression = valves_.measured_force(p_a, p_b).cwiseQuotient(valves_.hydraulic_stiffness(m.position));
+  m.at_relief = valves_.at_relief(p_a, p_b);
+  return m;
+}
+
 void FirmwareNode::check_plausibility(bool restarted) {
   // The command just computed is what the valves are told from now on; the motion and pressures
   // measured now answer the commands before it, which the monitor's lag stands for.
   const control::ValveCommand& v = valves_.last();
-  const Vec4 q = to_vec(sensors_.position);
-  const Vec4 p_a = to_vec(sensors_.pressure_a), p_b = to_vec(sensors_.pressure_b);
-  // Without pressures the compression is unknown: the monitor then sees the motion alone.
-  const Vec4 compression = sensors_.pressure_valid ? Vec4(v.force.cwiseQuotient(valves_.hydraulic_stiffness(q))) : Vec4::Zero();
-  const std::uint8_t at_relief = sensors_.pressure_valid ? valves_.at_relief(p_a, p_b) : 0;
-  const std::uint8_t found = plausibility_.update(!restarted, v.velocity, q, compression, at_relief);
+  const FlowMeasurement m = flow_measurement();
+  const std::uint8_t found = plausibility_.update(!restarted, v.velocity, m.position, m.compression, m.at_relief);
   if (found == 0 || fault_ || !plausibility_.settings().enabled) return;
   int j = 0;
   while (((found >> j) & 1) == 0) ++j;

@@ -23,6 +23,7 @@
 #include "control/valve_inner_loop.hpp"
 #include "hal/can_ports.hpp"
 #include "app/can_stats_message.hpp"
+#include "app/creep_window.hpp"
 #include "app/firmware_faults.hpp"
 #include "app/subnormal_scan.hpp"
 #include "app/tracking_metrics.hpp"
@@ -192,6 +193,13 @@ class FirmwareNode {
   void take_supervisor_commands();
   // The velocity plausibility monitor on this cycle's valve command (valve interface).
   void check_plausibility(bool restarted);
+  // What the flow plausibility monitor measures: positions, the oil columns' compression F / K_h
+  // (zero without pressures) and the functions at a relief.
+  struct FlowMeasurement {
+    Vec4 position = Vec4::Zero(), compression = Vec4::Zero();
+    std::uint8_t at_relief = 0;
+  };
+  FlowMeasurement flow_measurement() const;
   // The chamber pressures' plausibility monitor on this cycle's sensor set (valve interface, H4).
   void check_pressures(bool restarted);
   // Sends FW_EMERGENCY for the current safe state: EmergencyStop set when its fault takes the
@@ -253,15 +261,8 @@ class FirmwareNode {
   bool emergency_sent_ = false;
   bool safe_command_sent_ = false;
   bool escalated_ = false;  // the controlled stop became an emergency stop (standstill monitor)
-  Vec4 standstill_origin_ = Vec4::Zero();  // position at the start of the standstill window
-  Vec4 standstill_mean_ = Vec4::Zero();    // the window before's mean velocity
-  int standstill_windows_ = 0;
-  double swing_origin_ = 0, swing_mean_ = 0;  // the swing's own windows (kStandstillSwingWindow)
-  std::uint64_t swing_origin_cycle_ = 0;
-  bool swing_origin_set_ = false;
-  int swing_windows_ = 0;
-  std::uint64_t standstill_origin_cycle_ = 0;
-  bool standstill_origin_set_ = false;
+  CreepWindow cylinder_creep_;  // the standstill's creep test on the cylinders' oil taken (kStandstillWindow)
+  CreepWindow swing_creep_;     // and on the swing's motion (kStandstillSwingWindow)
   int plant_hold_run_ = 0;        // consecutive sensor sets saying the plant holds while commanded
   int missed_in_a_row_ = 0;
   std::uint64_t safe_stops_ = 0;

@@ -56,7 +56,6 @@ class VelocityPlausibility {
     if (!active) {
       expected_.setZero();
       delivered_.setZero();
-      asked_.setZero();
       asked_pos_.setZero();
       asked_neg_.setZero();
       primed_ = false;  // the next active cycle starts the sums from its own measurement
@@ -77,7 +76,6 @@ class VelocityPlausibility {
       const double ask = hold ? 0.0 : expected_[i] * period_;
       asked_pos_[i] = decay_ * asked_pos_[i] + std::max(ask, 0.0);
       asked_neg_[i] = decay_ * asked_neg_[i] - std::min(ask, 0.0);
-      asked_[i] = asked_pos_[i] - asked_neg_[i];
       const double a = delivered_[i];
       const double along = a >= 0 ? asked_pos_[i] : asked_neg_[i];
       const double against = a >= 0 ? asked_neg_[i] : asked_pos_[i];
@@ -104,7 +102,7 @@ class VelocityPlausibility {
   }
   const Vec4& expected() const { return expected_; }     // the lagged commanded flow per area
   const Vec4& delivered() const { return delivered_; }   // high-passed displacement that arrived
-  const Vec4& asked() const { return asked_; }           // high-passed displacement asked for
+  Vec4 asked() const { return asked_pos_ - asked_neg_; }  // high-passed displacement asked for, net
   const Vec4& excess() const { return excess_; }
   // The largest test value over its floor seen per function (1: the edge), for margins in reports.
   const Vec4& worst_ratio() const { return worst_ratio_; }
@@ -116,7 +114,7 @@ class VelocityPlausibility {
   double period_ = 1e-3, gain_ = 1, decay_ = 0;
   int debounce_cycles_ = 1;
   bool primed_ = false;
-  Vec4 expected_ = Vec4::Zero(), delivered_ = Vec4::Zero(), asked_ = Vec4::Zero(), excess_ = Vec4::Zero();
+  Vec4 expected_ = Vec4::Zero(), delivered_ = Vec4::Zero(), excess_ = Vec4::Zero();
   Vec4 asked_pos_ = Vec4::Zero(), asked_neg_ = Vec4::Zero();  // asked each way (both >= 0)
   Vec4 last_position_ = Vec4::Zero(), last_compression_ = Vec4::Zero(), worst_ratio_ = Vec4::Zero();
   Eigen::Vector4i run_ = Eigen::Vector4i::Zero();

@@ -1,0 +1,50 @@
+#pragma once
+// The standstill monitor's creep test (docs/safety.md): a quantity's mean rate over back-to-back
+// windows of a set length; a function creeps when its mean rate exceeds its limit and has not fallen
+// by `slowing` against the window before (a function braking slows from window to window, a ringing
+// one averages out, a stuck spool's creep does neither). Fixed-size, no allocation.
+#include <cmath>
+#include <cstdint>
+
+#include "model/types.hpp"
+
+namespace exc::app {
+
+class CreepWindow {
+ public:
+  void restart() { started_ = false; }
+
+  // One sample x at `cycle`; returns the functions found creeping (bit i) when a window closes, 0
+  // otherwise. A limit of infinity leaves a function out.
+  std::uint8_t update(const Vec4& x, std::uint64_t cycle, double period, double length, const Vec4& limit, double slowing) {
+    if (!started_) {
+      origin_ = x;
+      origin_cycle_ = cycle;
+      started_ = true;
+      windows_ = 0;
+    }
+    window_ = static_cast<double>(cycle - origin_cycle_) * period;
+    if (window_ < length) return 0;
+    const Vec4 mean = (x - origin_) / window_;
+    std::uint8_t creeping = 0;
+    for (int i = 0; i < 4 && windows_ > 0; ++i)
+      if (std::abs(mean[i]) > limit[i] && std::abs(mean[i]) > (1 - slowing) * std::abs(mean_[i]))
+        creeping |= static_cast<std::uint8_t>(1u << i);
+    mean_ = mean;
+    ++windows_;
+    origin_ = x;
+    origin_cycle_ = cycle;
+    return creeping;
+  }
+  const Vec4& mean() const { return mean_; }  // the last closed window's mean rate
+  double window() const { return window_; }   // s, that window's length
+
+ private:
+  Vec4 origin_ = Vec4::Zero(), mean_ = Vec4::Zero();
+  std::uint64_t origin_cycle_ = 0;
+  double window_ = 0;
+  int windows_ = 0;
+  bool started_ = false;
+};
+
+}  // namespace exc::app
