@@ -5,16 +5,19 @@
 #include <doctest/doctest.h>
 #include <yaml-cpp/yaml.h>
 
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <vector>
 
 #include "app/allocation_counter.hpp"
 #include "app/firmware_node.hpp"
+#include "app/firmware_runner.hpp"
 #include "closed_loop.hpp"
 #include "dbc_reader.hpp"
 #include "hal/can_bus_load.hpp"
 #include "hal/can_protocol.hpp"
+#include "hal/clock.hpp"
 #include "hal/memory_bus.hpp"
 #include "model/closed_chain.hpp"
 #include "scenes.hpp"
@@ -57,10 +60,16 @@ struct Loop {
   }
 
   void cycle() {
-    clock.now_ns += 1'000'000;
     node.begin_cycle();
+    plant_answer();
+    node.end_cycle();
+  }
+
+  // The plant's side of one cycle: a SYNC waiting is answered, the machine moves on by a period.
+  void plant_answer() {
     std::uint64_t k = 0;
     if (plant_port.poll_sync(k)) {
+      clock.now_ns += 1'000'000;
       plant_port.read(command);
       const TipLoad load = plant.soil_load();
       Vec4 tau = Vec4::Zero();
@@ -87,7 +96,30 @@ struct Loop {
         plant_port.write(s);
       }
     }
-    node.end_cycle();
+  }
+};
+
+// The bus as excavator-firmware's runner waits on it: while the firmware waits for sensors, the
+// plant answers (as the plant process would meanwhile). stall_ns makes the wait at one cycle last
+// that long in real time, a stalled bus or a descheduled thread.
+struct AnsweringBus final : hal::CanBus {
+  Loop& loop;
+  std::atomic<int>* stop_requests = nullptr;
+  std::uint64_t stop_at_cycle = 0, stall_at_cycle = 0;  // 0: never
+  std::int64_t stall_ns = 0;
+  explicit AnsweringBus(Loop& l) : loop(l) {}
+  bool send(const hal::CanFrame& frame) override { return loop.fw_bus->send(frame); }
+  bool receive(hal::CanFrame& frame) override { return loop.fw_bus->receive(frame); }
+  bool wait_readable(std::int64_t) override {
+    const std::uint64_t k = loop.node.cycle();
+    if (stop_requests && k == stop_at_cycle) stop_requests->fetch_add(1);
+    if (k == stall_at_cycle && stall_ns > 0) {
+      const std::int64_t until = hal::monotonic_now_ns() + stall_ns;
+      while (hal::monotonic_now_ns() < until) {
+      }
+    }
+    loop.plant_answer();
+    return loop.fw_bus->pending() > 0;
   }
 };
 
@@ -589,4 +621,146 @@ TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or
                           FirmwareFault::pressure_implausible})
     CHECK(app::stop_of(f) == StopKind::controlled);
   for (int code = 0; code <= 14; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
+}
+
+// excavator-firmware's cycle (app/firmware_runner), run here over the memory bus with the model plant
+// answering while the runner waits: what the process does at its end, on a stop and when it is late.
+TEST_CASE("firmware/runner: a lockstep run does its cycles, tracks, and leaves the valves centred with the exit's code") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  AnsweringBus bus(loop);
+  app::RunnerOptions run;
+  run.cycles = 1500;
+  const std::atomic<int> no_stop{0};
+  const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, no_stop, nullptr);
+  INFO(out.failure);
+  CHECK(out.ok);
+  CHECK(out.cycles == 1500);
+  CHECK(loop.node.measured_tracking().samples() > 1000);
+  CHECK(loop.node.mode() == Mode::track);
+  // The last frames on the bus: valves centred, the exit named, no emergency.
+  std::uint64_t k = 0;
+  loop.plant_port.poll_sync(k);
+  loop.plant_port.read(loop.command);
+  CHECK(loop.command.mode == hal::CommandMode::valve);
+  for (int j = 0; j < 4; ++j) CHECK(loop.command.value[j] == 0.0);
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::exited));
+  CHECK_FALSE(loop.command.emergency_stop);
+}
+
+TEST_CASE("firmware/runner: a stop request holds a tracking machine for the hold time, then ends, and before tracking ends at once") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    AnsweringBus bus(loop);
+    std::atomic<int> stops{0};
+    bus.stop_requests = &stops;
+    bus.stop_at_cycle = 2000;
+    app::RunnerOptions run;
+    run.cycles = 20000;
+    run.stop_hold_s = 0.5;
+    const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, stops, nullptr);
+    INFO(out.failure);
+    CHECK(out.stop_requested);
+    CHECK(out.ok);
+    CHECK(loop.node.mode() == Mode::hold);
+    // The request came while cycle 2000 waited: seen at the next cycle's start, 0.5 s of hold follow.
+    CHECK(out.cycles >= 2000 + 500);
+    CHECK(out.cycles <= 2000 + 503);
+  }
+  {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    AnsweringBus bus(loop);
+    const std::atomic<int> stops{1};
+    app::RunnerOptions run;
+    run.cycles = 20000;
+    run.stop_hold_s = 0.5;
+    const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, stops, nullptr);
+    CHECK(out.stop_requested);
+    CHECK(out.cycles == 0);
+    CHECK_FALSE(out.ok);
+    CHECK(out.failure.find("never tracked") != std::string::npos);
+  }
+}
+
+TEST_CASE("firmware/runner: a second stop request while holding ends the run at once") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  struct TwoStops final : hal::CanBus {
+    AnsweringBus inner;
+    std::atomic<int> stops{0};
+    explicit TwoStops(Loop& l) : inner(l) {}
+    bool send(const hal::CanFrame& f) override { return inner.send(f); }
+    bool receive(hal::CanFrame& f) override { return inner.receive(f); }
+    bool wait_readable(std::int64_t t) override {
+      const std::uint64_t k = inner.loop.node.cycle();
+      if (k == 1000 || k == 1100) stops.fetch_add(1);
+      return inner.wait_readable(t);
+    }
+  } bus(loop);
+  app::RunnerOptions run;
+  run.cycles = 20000;
+  run.stop_hold_s = 5.0;
+  const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, bus.stops, nullptr);
+  CHECK(out.stop_requested);
+  CHECK(out.cycles >= 1100);
+  CHECK(out.cycles <= 1102);
+  CHECK(loop.node.mode() == Mode::hold);
+}
+
+TEST_CASE("firmware/runner: a plant that never answers fails the run as never tracked, after the start-up wait of each cycle") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  loop.answer = false;
+  AnsweringBus bus(loop);
+  app::RunnerOptions run;
+  run.cycles = 5;
+  run.startup_wait_ns = 2'000'000;
+  const std::atomic<int> no_stop{0};
+  const std::int64_t t0 = hal::monotonic_now_ns();
+  const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, no_stop, nullptr);
+  CHECK(hal::monotonic_now_ns() - t0 >= 5 * run.startup_wait_ns);  // each cycle waited its start-up time
+  CHECK(out.cycles == 5);
+  CHECK_FALSE(out.ok);
+  CHECK(out.failure.find("never tracked") != std::string::npos);
+}
+
+TEST_CASE("firmware/runner: in real time a stalled cycle is a late wake-up, and a run allowed none fails naming its period first") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  for (const double allowed : {0.0, 1.0}) {
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    AnsweringBus bus(loop);
+    bus.stall_at_cycle = 100;
+    bus.stall_ns = 5'000'000;  // five periods: the next wake-up is late whatever the machine's load
+    app::RunnerOptions run;
+    run.cycles = 300;
+    run.realtime = true;
+    run.max_overrun_fraction = allowed;
+    const std::atomic<int> no_stop{0};
+    const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, no_stop, nullptr);
+    INFO(out.failure);
+    CHECK(out.cycles == 300);
+    CHECK(out.overruns >= 1);
+    CHECK(out.skipped_periods >= 4);
+    // The lateness is named first, whatever else a loaded machine adds after it.
+    const std::size_t late = out.failure.find(" of 300 cycles woke after their deadline");
+    if (allowed == 0.0) {
+      CHECK_FALSE(out.ok);
+      CHECK(late != std::string::npos);
+      CHECK(late < out.failure.find("; then "));
+      CHECK(out.failure.find("cannot hold its 1 ms period") != std::string::npos);
+    } else {
+      CHECK(late == std::string::npos);
+    }
+  }
 }

@@ -15,48 +15,22 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
-#include <nlohmann/json.hpp>
 
 #include "app/firmware_node.hpp"
+#include "app/firmware_runner.hpp"
 #include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
 #include "app/last_safe_command.hpp"
 #include "app/node_io.hpp"
 #include "app/realtime_setup.hpp"
+#include "app/run_summary.hpp"
 #include "control/controller_kinds.hpp"
-#include "hal/clock.hpp"
 #include "settings/section_reader.hpp"
 
 namespace {
 
 std::atomic<int> g_signals{0};
 void on_signal(int) { g_signals.fetch_add(1); }
-
-// Per joint; null when the firmware never tracked (a metric of no samples is not 0).
-nlohmann::json per_joint(const exc::TrackingMetrics& m, bool rms) {
-  if (m.samples() == 0) return nullptr;
-  nlohmann::json j;
-  for (int i = 0; i < 4; ++i) j[exc::kActiveNames[i]] = rms ? m.rms(i) : m.max_abs(i);
-  return j;
-}
-
-std::string format_ms(double seconds) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g ms", seconds * 1e3);
-  return b;
-}
-
-std::string percent(double fraction) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g %%", fraction * 100);
-  return b;
-}
-
-nlohmann::json timing_json(const exc::control::PerfCounter& c) {
-  if (c.count() == 0) return nullptr;
-  return {{"median", c.median_us()}, {"p99", c.p99_us()}, {"p99_9", c.percentile_us(0.999)}, {"max", c.max_us()},
-          {"count", c.count()}};
-}
 
 }  // namespace
 
@@ -122,9 +96,8 @@ int main(int argc, char** argv) {
 
     const double period_s = settings.controller.period;
     const auto period_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
-    // Real time: sensors may be waited for until 10 % of the period before the next deadline, the
-    // rest is the cycle's own work. A longer timeout cannot be honoured there: refused.
-    const double rt_wait_ms = 0.9 * period_s * 1e3;
+    // Real time: a longer sensor wait than the runner can honour is refused.
+    const double rt_wait_ms = static_cast<double>(exc::app::realtime_sensor_wait_limit_ns(period_ns)) * 1e-6;
     if (realtime && sensor_timeout_ms > rt_wait_ms) {
       std::cerr << "excavator-firmware: --sensor-timeout-ms " << sensor_timeout_ms << " cannot be honoured with --realtime at a "
                 << period_s * 1e3 << " ms period (controller.period): at most " << rt_wait_ms << " ms\n";
@@ -160,133 +133,31 @@ int main(int argc, char** argv) {
                  (rt.fifo ? ", SCHED_FIFO 80" : ", normal priority");
       if (!rt.warnings.empty()) std::fprintf(stderr, "excavator-firmware: warning: %s", rt.warnings.c_str());
     }
-    const auto cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / period_s));
-    const auto wait_ns = static_cast<std::int64_t>(wait_ms * 1e6);
-    const auto startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
-    exc::hal::DeadlineSleeper sleeper(period_ns);
+    exc::app::RunnerOptions run;
+    run.cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / period_s));
+    run.period_ns = period_ns;
+    run.realtime = realtime;
+    run.sensor_wait_ns = static_cast<std::int64_t>(wait_ms * 1e6);
+    run.startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
+    run.max_overrun_fraction = max_overrun_fraction;
+    run.stop_hold_s = fc.controller.blend_time;
     std::printf("excavator-firmware: %s on %s, %lld cycles of %.3g ms, %s; sensor wait %.3g ms; floating point: %s%s%s\n",
-                kind_name, iface.c_str(), static_cast<long long>(cycles), period_s * 1e3,
+                kind_name, iface.c_str(), static_cast<long long>(run.cycles), period_s * 1e3,
                 realtime ? "real time (absolute deadlines)" : "lockstep with the plant", wait_ms,
                 exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread()), rt_notes.empty() ? "" : "; ",
                 rt_notes.c_str());
     std::fflush(stdout);
 
-    std::int64_t last_wake = 0;
-    bool grid_started = false;
-    std::int64_t stop_cycle = -1;  // cycle of the stop request: the machine then holds, and the run ends
-    for (std::int64_t k = 0; k < cycles && g_signals.load() < 2; ++k) {
-      if (g_signals.load() == 1 && stop_cycle < 0) {
-        // A tracking machine is brought to hold first; in any other mode there is nothing to stop.
-        if (!node.tracking()) break;
-        node.request_stop();
-        stop_cycle = k;
-        std::printf("excavator-firmware: stop requested: holding for %.2f s, then exiting\n", fc.controller.blend_time);
-      }
-      if (stop_cycle >= 0 && static_cast<double>(k - stop_cycle) * period_s > fc.controller.blend_time) break;
-      if (realtime && grid_started) {
-        sleeper.wait_next();
-        const std::int64_t now = exc::hal::monotonic_now_ns();
-        node.record_wakeup(now - last_wake, sleeper.overruns(), sleeper.skipped_periods());
-        last_wake = now;
-      }
-      const std::int64_t cycle_start = exc::hal::monotonic_now_ns();
-      node.begin_cycle();
-      // Until the plant has answered once, a cycle waits as long as start-up takes (a slow first
-      // cycle must not desynchronise the counters); afterwards the sensor wait feeds the watchdog.
-      std::int64_t deadline = cycle_start + (node.has_sensors() ? wait_ns : startup_wait_ns);
-      if (realtime && grid_started) deadline = std::min(deadline, sleeper.next_deadline_ns() - period_ns / 10);
-      while (!node.receive()) {
-        const std::int64_t left = deadline - exc::hal::monotonic_now_ns();
-        if (left <= 0) break;
-        io.bus->wait_readable(left);
-      }
-      node.end_cycle();
-      if (realtime && !grid_started && node.has_sensors()) {
-        // The deadline grid starts once the plant has answered: start-up is not a missed deadline.
-        grid_started = true;
-        last_wake = exc::hal::monotonic_now_ns();
-        sleeper.start(last_wake);
-      }
-      const exc::control::Transition& t = node.last_transition();
-      if (t.changed) {
-        std::printf("excavator-firmware: cycle %llu (%.3f s): %s -> %s: %s%s%s\n",
-                    static_cast<unsigned long long>(node.cycle()), node.time(), exc::control::to_string(t.from),
-                    exc::control::to_string(t.to), t.reason, t.to == exc::control::Mode::safe_stop ? ": " : "",
-                    t.to == exc::control::Mode::safe_stop ? node.last_fault_text() : "");
-        std::fflush(stdout);
-      }
-    }
-    // The run is over (its end, or a signal): the machine is left with its valves centred.
-    node.send_safe_command(exc::app::FirmwareFault::exited);
-    std::printf("excavator-firmware: last command sent: valves centred, FW_EMERGENCY %s stop (%s)\n",
-                exc::app::to_string(node.emergency_sent() ? exc::app::StopKind::emergency : exc::app::StopKind::controlled),
-                node.mode() == exc::control::Mode::safe_stop ? node.last_fault_text() : "firmware exited");
-    node.publish_counters(true);
+    const exc::app::RunnerOutcome outcome = exc::app::run_firmware(node, *io.bus, run, g_signals, stdout);
     if (io.publisher) io.publisher->stop();
-
-    // The verdict: a run that never tracked, went to its safe state, or missed its deadlines failed.
-    const std::uint64_t done = node.cycle();
-    const std::uint64_t overruns = sleeper.overruns(), skipped = sleeper.skipped_periods();
-    // Missed deadlines come first when they are there: a loop that cannot hold its period starves
-    // its own sensor watchdog, so the safe stop that follows is their consequence, named after them.
-    std::string failure;
-    const auto add = [&failure](const std::string& reason) { failure += (failure.empty() ? "" : "; then ") + reason; };
-    if (realtime && static_cast<double>(overruns + skipped) > max_overrun_fraction * static_cast<double>(done))
-      add(std::to_string(overruns) + " of " + std::to_string(done) + " cycles woke after their deadline and " +
-          std::to_string(skipped) + " periods were skipped (allowed together: " + percent(max_overrun_fraction) +
-          " of the cycles): the loop cannot hold its " + format_ms(period_s) + " period");
-    if (node.measured_tracking().samples() == 0)
-      add(std::string("the firmware never tracked (mode ") + exc::control::to_string(node.mode()) + ")");
-    else if (node.safe_stops() > 0)
-      add(std::string("safe state: ") + node.last_fault_text());
-    const bool ok = failure.empty();
-    std::uint64_t telemetry_dropped = 0;
-    exc::telemetry::TelemetryCounters tcn;
-    if (io.publisher) {
-      tcn = io.publisher->counters();
-      telemetry_dropped = tcn.dropped_full_total;
-    }
-    const auto& c = node.control_timing();
-    std::printf("excavator-firmware: %llu cycles of %.3g ms; control step median %.1f us, p99 %.1f us, max %.1f us; "
-                "deadline overruns %llu, skipped periods %llu; safe stops %llu; CAN rejects %llu; telemetry dropped %llu\n",
-                static_cast<unsigned long long>(done), period_s * 1e3, c.median_us(), c.p99_us(), c.max_us(),
-                static_cast<unsigned long long>(overruns), static_cast<unsigned long long>(skipped),
-                static_cast<unsigned long long>(node.safe_stops()), static_cast<unsigned long long>(port.rx_stats().rejected()),
-                static_cast<unsigned long long>(telemetry_dropped));
-    std::printf("excavator-firmware: %s%s\n", ok ? "ok" : "FAILED: ", failure.c_str());
+    const exc::app::RunContext context{node,     outcome, kind_name, realtime, period_s, port.rx_stats().rejected(),
+                                       io.publisher.get(), overflow};
+    exc::app::print_run_summary(context, stdout);
     if (!json_path.empty()) {
-      nlohmann::json j;
-      j["ok"] = ok;
-      if (!ok) j["failure"] = failure;
-      j["controller"] = kind_name;
-      j["mode"] = realtime ? "realtime" : "lockstep";
-      j["float_mode"] = exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread());  // the loop thread's, at its end
-      j["period_s"] = period_s;
-      j["cycles"] = done;
-      j["tracking"] = {{"rms_error", per_joint(node.measured_tracking(), true)},
-                       {"max_error", per_joint(node.measured_tracking(), false)}};
-      j["tracking_samples"] = node.measured_tracking().samples();
-      j["control_step_us"] = timing_json(c);
-      j["cycle_us"] = timing_json(node.cycle_timing());
-      j["deadlines"] = {{"overruns", overruns}, {"skipped_periods", skipped},
-                        {"interval_us", timing_json(node.interval_timing())}};
-      j["safe_stops"] = node.safe_stops();
-      j["estop"] = node.emergency_sent();  // any FW_EMERGENCY with EmergencyStop = 1, the last command included
-      if (node.safe_stops() > 0) j["last_fault"] = node.last_fault_text();
-      j["task_finished"] = node.trajectory_finished();
-      j["can_frames_rejected"] = port.rx_stats().rejected();
-      if (io.publisher) {
-        nlohmann::json dropped;
-        for (std::size_t i = 0; i < exc::telemetry::channel_count; ++i)
-          dropped[io.publisher->channel_name(static_cast<exc::telemetry::Channel>(i))] = tcn.dropped_full[i];
-        j["telemetry"] = {{"enqueued", tcn.enqueued}, {"published", tcn.published}, {"dropped", telemetry_dropped},
-                          {"dropped_by_channel", dropped}, {"ring_high_water", tcn.ring_high_water},
-                          {"ring_capacity", tcn.ring_capacity}, {"overflow_policy", exc::telemetry::to_string(overflow)}};
-      }
-      json_file << j.dump(2) << "\n";
+      json_file << exc::app::run_summary_json(context).dump(2) << "\n";
       exc::output::finish_file(json_file, json_path);
     }
-    return ok ? 0 : 1;
+    return outcome.ok ? 0 : 1;
   } catch (const std::exception& e) {
     std::cerr << "excavator-firmware: " << e.what() << "\n";
     return 2;
