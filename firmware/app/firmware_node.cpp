@@ -231,12 +231,41 @@ void FirmwareNode::take_supervisor_commands() {
   if (mode == control::Mode::safe_stop && !stop_now) {
     operator_stop_pending_ = false;  // stopped already: the stop has latched
   } else if (operator_stop_pending_ && (mode == control::Mode::hold || mode == control::Mode::track) && !fault_) {
-    // Not yet commanding (start-up): raised on the first cycle the node commands the machine.
+    // Not yet commanding (start-up): taken on the first cycle the node commands the machine. A
+    // tracking machine first decelerates along its path; the stop latches once the path is at rest.
     operator_stop_pending_ = false;
-    raise(FirmwareFault::operator_stop);
-    std::snprintf(pending_text_, sizeof pending_text_, "operator stop: SUPERVISOR stop in %s at t = %.3f s",
-                  control::to_string(mode), time());
+    if (!operator_stop_on_rest_) operator_stop_time_ = time();
+    operator_stop_on_rest_ = true;
+    if (mode == control::Mode::track && !path_stop_.active()) begin_path_stop(time());
   }
+  const bool path_moving = path_stop_.active() && !path_stop_.done(time() - path_stop_start_);
+  if (operator_stop_on_rest_ && !path_moving && !fault_) {
+    operator_stop_on_rest_ = false;
+    raise(FirmwareFault::operator_stop);
+    pending_time_ = operator_stop_time_;  // detected when its frame came, whatever the deceleration took
+    std::snprintf(pending_text_, sizeof pending_text_,
+                  "operator stop: SUPERVISOR stop in %s at t = %.3f s, the path at rest %.3f s later",
+                  control::to_string(mode), operator_stop_time_, time() - operator_stop_time_);
+  }
+}
+
+void FirmwareNode::begin_path_stop(double t) {
+  const double tau0 = t - track_start_ + task_.start_time();
+  Vec4 q, yd, ydd;
+  task_.trajectory.evaluate(tau0, q, yd, ydd);
+  path_stop_.begin(tau0, yd, model_.machine.speed_max(), config_.controller.stop_ramp_time);
+  path_stop_start_ = t;
+}
+
+double FirmwareNode::path_time_at(double t, double& rate, double& rate_dot) const {
+  if (!path_stop_.active()) {
+    rate = 1;
+    rate_dot = 0;
+    return t - track_start_ + task_.start_time();
+  }
+  double tau = 0;
+  path_stop_.path_time(t - path_stop_start_, tau, rate, rate_dot);
+  return tau;
 }
 
 bool FirmwareNode::receive() {
@@ -269,6 +298,12 @@ void FirmwareNode::end_cycle() {
   const std::int64_t read_ns = hal::monotonic_now_ns();
   read_timing_.record_ns(read_ns - start_ns);
 
+  // A stop request decelerates a tracking machine along its path first; it holds once the path is at rest.
+  if (stop_requested_ && machine_.mode() == control::Mode::track && !path_stop_.active()) begin_path_stop(t);
+  const bool path_moving = path_stop_.active() && !path_stop_.done(t - path_stop_start_);
+  double rate = 1, rate_dot = 0;
+  const double tau = path_time_at(t, rate, rate_dot);
+
   control::StateMachineInputs in;
   in.t = t;
   in.have_valid_frame = have_valid_;
@@ -276,15 +311,15 @@ void FirmwareNode::end_cycle() {
   // The task starts once. After a safe stop the machine holds where it is when the sensors are back:
   // resuming would restart the path from its first point, a step command nobody asked for.
   in.track_requested = t >= config_.track_delay && safe_stops_ == 0 && (start_received_ || !config_.wait_for_start);
-  in.stop_requested = stop_requested_;
+  in.stop_requested = stop_requested_ && !path_moving;
   // Once the task has ended it stays ended: hold must not re-enter track and restart the path.
-  in.trajectory_finished =
-      finished_ || (machine_.mode() == control::Mode::track && t - track_start_ + task_.start_time() >= task_.end_time());
+  in.trajectory_finished = finished_ || (machine_.mode() == control::Mode::track && tau >= task_.end_time());
   in.fault = fault_;
   in.acknowledged = acknowledged;
   const control::Transition transition = machine_.step(in);
   transition_ = transition;
   if (transition.changed) {
+    if (transition.from == control::Mode::track) path_stop_.cancel();
     if (transition.to == control::Mode::hold) {
       // From track, hold where the path was (its last point when it ended): the desired pose never
       // steps. From start-up or a safe stop, hold where the machine is.
@@ -304,6 +339,7 @@ void FirmwareNode::end_cycle() {
     }
     if (transition.to == control::Mode::track) track_start_ = t;
     if (transition.to == control::Mode::safe_stop) {
+      operator_stop_on_rest_ = false;  // whatever stopped the machine, an operator's stop under way is in it
       ++safe_stops_;
       safe_stop_cycle_ = cycle_;
       fault_code_ = fault_ ? pending_fault_ : FirmwareFault::sensor_timeout;
@@ -477,7 +513,13 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
   }
 
   if (mode == control::Mode::track) {
-    task_.trajectory.evaluate(t - track_start_ + task_.start_time(), q_d_, qd_d_, qdd_d_);
+    double rate = 1, rate_dot = 0;
+    path_time_ = path_time_at(t, rate, rate_dot);
+    task_.trajectory.evaluate(path_time_, q_d_, qd_d_, qdd_d_);
+    if (path_stop_.active()) {
+      const Vec4 yd = qd_d_, ydd = qdd_d_;  // in path time
+      control::PathStop::scale(rate, rate_dot, yd, ydd, qd_d_, qdd_d_);
+    }
   } else {
     q_d_ = held_q_;
     qd_d_.setZero();

@@ -13,6 +13,7 @@
 
 #include "model/actuator_friction.hpp"
 #include "control/actuator_lag_compensator.hpp"
+#include "control/path_stop.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
 #include "control/perf_counter.hpp"
@@ -73,9 +74,10 @@ class FirmwareNode {
   bool receive();
   // Completes the cycle once the plant had its chance to answer.
   void end_cycle();
-  // A stop from outside the control loop (a signal, the caller): the next cycle leaves track for
-  // hold at the desired pose of that moment, and the node stays in hold. Real-time safe (sets a
-  // flag). An operator's SUPERVISOR stop is stronger: a controlled stop that latches
+  // A stop from outside the control loop (a signal, the caller): a tracking machine decelerates
+  // along its path (control/path_stop.hpp, controller.stop_ramp_time) and then holds where the path
+  // came to rest; the node stays in hold. Real-time safe (sets a flag). An operator's SUPERVISOR
+  // stop is stronger: the same deceleration, then a controlled stop that latches
   // (FirmwareFault::operator_stop) until acknowledged.
 
   void request_stop() { stop_requested_ = true; }
@@ -110,9 +112,9 @@ class FirmwareNode {
   bool trajectory_finished() const { return finished_; }
   // The trajectory time being tracked this cycle (task clock: the first waypoint's time at the start
   // of tracking); negative when not tracking.
-  double task_time() const {
-    return machine_.mode() == control::Mode::track ? time() - track_start_ + task_.start_time() : -1.0;
-  }
+  double task_time() const { return machine_.mode() == control::Mode::track ? path_time_ : -1.0; }
+  // A stop along the path is under way (the machine still tracks, on a slowing path).
+  bool stopping_on_path() const { return path_stop_.active(); }
   double finish_time() const { return finish_time_; }
   // Desired and measured q_a of the last cycle (valid while tracking or holding).
   const Vec4& q_desired() const { return q_d_; }
@@ -191,6 +193,9 @@ class FirmwareNode {
   // Takes the SUPERVISOR commands the port received: acknowledge, start, and stop (raised as
   // FirmwareFault::operator_stop once the node commands the machine).
   void take_supervisor_commands();
+  // The stop along the path (control/path_stop.hpp) from loop time t, and the path time at t.
+  void begin_path_stop(double t);
+  double path_time_at(double t, double& rate, double& rate_dot) const;
   // The velocity plausibility monitor on this cycle's valve command (valve interface).
   void check_plausibility(bool restarted);
   // What the flow plausibility monitor measures: positions, the oil columns' compression F / K_h
@@ -242,6 +247,11 @@ class FirmwareNode {
   TrackingMetrics measured_;
   double last_valid_time_ = -1e300;
   double track_start_ = 0;
+  double path_time_ = 0;          // the task time tracked this cycle (slowed by a stop along the path)
+  control::PathStop path_stop_;
+  double path_stop_start_ = 0;    // s, loop time the stop along the path began
+  bool operator_stop_on_rest_ = false;  // the SUPERVISOR stop latches once the path has come to rest
+  double operator_stop_time_ = 0;       // s, the cycle its frame arrived
   Vec4 held_q_ = Vec4::Zero();
   Vec4 q_d_ = Vec4::Zero(), qd_d_ = Vec4::Zero(), qdd_d_ = Vec4::Zero();
   Vec4 last_sent_ = Vec4::Zero();

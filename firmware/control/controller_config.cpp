@@ -149,6 +149,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
           "real time: wake-ups in a row after their deadline that are a fault (controlled stop)");
   r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "", "rad (swing), m: above it the firmware faults");
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
+  r.number("stop_ramp_time", c.stop_ramp_time, {0, 10}, "s",
+           "a stop along the path decelerates each function by at most its top speed per this time (0: at once)");
   r.flag("integral_action", c.integral_action, "integral action in the adaptive law (beyond the paper)");
   r.numbers("lyapunov_q_integral", c.lyapunov_q_integral, kWeight, "", "Q of the integral states");
   r.number("actuator_lag", c.actuator_lag, {0, 1}, "s", "the effort lag the firmware compensates (0: none)");

@@ -121,6 +121,10 @@ struct ControllerConfig {
   // baseline in the dig scene (bucket 0.12 m), 0.5-1 m at the tip: rad (swing), m (cylinders).
   Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();
   double blend_time = 0.2;          // s, bumpless switch fade
+  // A stop along the path (an operator's stop, a stop request) slows the path so that each function
+  // decelerates at most its top speed per this time (path_stop.hpp): a function at top speed stops
+  // in 0.63 s over its path, a slower one sooner. About the ramp an operator's joystick release gives.
+  double stop_ramp_time = 0.4;
 
   static PidGains default_gains() {
     PidGains g;

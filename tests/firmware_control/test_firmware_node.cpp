@@ -180,10 +180,83 @@ TEST_CASE("firmware/node: after its task the machine holds the final pose, the p
   CHECK(largest_step_after <= largest_step_tracking);
 }
 
-TEST_CASE("firmware/node: a stop request from outside brings a tracking machine to hold at the desired pose of that moment") {
+TEST_CASE("firmware/node: a stop request decelerates a tracking machine along its path, no faster than its top speed per ramp time, and holds where the path came to rest") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   cfg.kind = ControllerKind::pid;
+  Loop loop(model, sim::kFreeMotionTask, cfg);
+  while (loop.node.time() < 3.0) loop.cycle();
+  REQUIRE(loop.node.mode() == Mode::track);
+  const double t_stop = loop.node.time() + 1e-3;  // the request is taken on the next cycle
+  const double tau0 = loop.node.task_time() + 1e-3;
+  Vec4 q0, v0, a0;
+  loop.task.trajectory.evaluate(tau0, q0, v0, a0);
+  const Vec4 vmax = model.machine.speed_max();
+  const double ramp = cfg.controller.stop_ramp_time;
+  // The closed form of path_stop.hpp: T = (pi / 2) ramp max_j |v_j| / v_max_j.
+  const double T = 0.5 * M_PI * ramp * (v0.cwiseAbs().array() / vmax.array()).maxCoeff();
+  REQUIRE(T > 0.05);  // the path moves at 3 s: there is a deceleration to see
+  // The path's own largest speed and acceleration over the stretch the stop covers.
+  Vec4 v_seg = Vec4::Zero(), a_seg = Vec4::Zero();
+  for (int i = 0; i <= 200; ++i) {
+    Vec4 q, v, a;
+    loop.task.trajectory.evaluate(tau0 + 0.5 * T * i / 200.0, q, v, a);
+    v_seg = v_seg.cwiseMax(v.cwiseAbs());
+    a_seg = a_seg.cwiseMax(a.cwiseAbs());
+  }
+  loop.node.request_stop();
+  Vec4 q_prev = loop.node.q_desired(), step_prev = Vec4::Zero();
+  bool have_step = false;
+  double last_tau = -1;
+  int hold_at = -1;
+  for (int k = 0; k < 3000; ++k) {
+    loop.cycle();
+    const Vec4 q_d = loop.node.q_desired();
+    if (loop.node.mode() == Mode::track) {
+      REQUIRE(loop.node.stopping_on_path());
+      const double tau = loop.node.task_time();
+      CHECK(tau >= last_tau);  // the path's clock never runs back
+      last_tau = tau;
+      // On the path: the desired pose is the trajectory's point at the slowed clock.
+      Vec4 q, v, a;
+      loop.task.trajectory.evaluate(tau, q, v, a);
+      CHECK((q_d - q).cwiseAbs().maxCoeff() < 1e-12);
+    } else if (hold_at < 0) {
+      hold_at = k;
+      CHECK(loop.node.last_transition().changed);
+      CHECK(std::string(loop.node.last_transition().reason) == "stop requested");
+    }
+    // The desired motion never runs faster than the path, and decelerates by at most each function's
+    // top speed per ramp time on top of the path's own acceleration.
+    const Vec4 step = q_d - q_prev;
+    for (int j = 0; j < 4; ++j) {
+      CHECK(std::abs(step[j]) <= v_seg[j] * 1e-3 + 1e-12);
+      if (have_step) CHECK(std::abs(step[j] - step_prev[j]) / 1e-6 <= vmax[j] / ramp + a_seg[j] + 1e-6);
+    }
+    q_prev = q_d;
+    step_prev = step;
+    have_step = true;
+    if (hold_at >= 0) REQUIRE(loop.node.mode() == Mode::hold);
+  }
+  REQUIRE(hold_at >= 0);
+  // In hold once the path's clock has stopped: T after the request, to the cycle.
+  CHECK(std::abs(t_stop + hold_at * 1e-3 - (t_stop + T)) <= 2e-3);
+  // Where it holds: the path's point T / 2 of path time on (the half-cosine's travel), to within the
+  // last tracking cycle's creep (the rate's cube: nanometres).
+  Vec4 q_rest, v, a;
+  loop.task.trajectory.evaluate(tau0 + 0.5 * T, q_rest, v, a);
+  CHECK((loop.node.q_desired() - q_rest).cwiseAbs().maxCoeff() < 1e-6);
+  CHECK_FALSE(loop.node.trajectory_finished());
+  // Held, the machine settles where the path stopped (within 1 mm / 1 mrad).
+  CHECK((loop.plant.q() - q_rest).cwiseAbs().maxCoeff() < 1e-3);
+  MESSAGE("stop along the path at " << t_stop << " s: " << T << " s to rest (ramp " << ramp << " s)");
+}
+
+TEST_CASE("firmware/node: with stop_ramp_time 0 a stop request holds at the desired pose of that moment") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.kind = ControllerKind::pid;
+  cfg.controller.stop_ramp_time = 0;
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 3.0) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::track);
@@ -191,15 +264,12 @@ TEST_CASE("firmware/node: a stop request from outside brings a tracking machine 
   loop.node.request_stop();
   loop.cycle();
   CHECK(loop.node.mode() == Mode::hold);
-  CHECK(loop.node.last_transition().changed);
   CHECK(std::string(loop.node.last_transition().reason) == "stop requested");
   for (int k = 0; k < 3000; ++k) {
     loop.cycle();
     REQUIRE(loop.node.mode() == Mode::hold);
     CHECK((loop.node.q_desired() - q_at_stop).cwiseAbs().maxCoeff() == 0.0);
   }
-  CHECK_FALSE(loop.node.trajectory_finished());
-  // Held, the machine settles where it was told to stop (within 1 mm / 1 mrad).
   CHECK((loop.plant.q() - q_at_stop).cwiseAbs().maxCoeff() < 1e-3);
 }
 
@@ -591,7 +661,8 @@ TEST_CASE("firmware/node: SUPERVISOR stop and acknowledge in one cycle: the stop
   while (loop.node.time() < 1.0) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::track);
   REQUIRE(station.send(hal::SupervisorCommand::stop));
-  loop.cycle();
+  // The machine decelerates along its path (at most (pi / 2) stop_ramp_time), then the stop latches.
+  for (int k = 0; k < 700 && loop.node.mode() == Mode::track; ++k) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::safe_stop);
   CHECK(loop.node.last_fault() == app::FirmwareFault::operator_stop);
   CHECK(loop.node.last_stop() == app::StopKind::controlled);
@@ -668,7 +739,8 @@ TEST_CASE("firmware/runner: a stop request holds a tracking machine for the hold
     CHECK(out.stop_requested);
     CHECK(out.ok);
     CHECK(loop.node.mode() == Mode::hold);
-    // The request came while cycle 2000 waited: seen at the next cycle's start, 0.5 s of hold follow.
+    // The request came while cycle 2000 waited: seen at the next cycle's start; the machine slows
+    // along its path and holds, and the run ends stop_hold_s after the request.
     CHECK(out.cycles >= 2000 + 500);
     CHECK(out.cycles <= 2000 + 503);
   }
@@ -711,7 +783,8 @@ TEST_CASE("firmware/runner: a second stop request while holding ends the run at 
   CHECK(out.stop_requested);
   CHECK(out.cycles >= 1100);
   CHECK(out.cycles <= 1102);
-  CHECK(loop.node.mode() == Mode::hold);
+  // Ended while the first stop was still slowing the path, or already holding.
+  CHECK((loop.node.stopping_on_path() || loop.node.mode() == Mode::hold));
 }
 
 TEST_CASE("firmware/runner: a plant that never answers fails the run as never tracked, after the start-up wait of each cycle") {
