@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "app/firmware_faults.hpp"
+#include "control/path_stop.hpp"
 
 namespace exc::sim {
 namespace {
@@ -89,8 +90,15 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
   if (r.failure.rfind("plant stopped", 0) == 0) {
     why = r.failure;
   } else if (r.first_safe_stop_time >= 0) {
-    const double late = r.first_safe_stop_time - r.first_fault_detected_time - watchdog;
-    if (late > 1e-9) why = "the safe state " + std::to_string(late * 1e3) + " ms later than the watchdog time after detection";
+    // A stop along the path latches once the path is at rest: it may take the deceleration's time too.
+    const double allowed =
+        watchdog + (app::stops_along_path(static_cast<app::FirmwareFault>(r.first_fault_code))
+                        ? control::PathStop::longest(firmware.controller.stop_ramp_time)
+                        : 0.0);
+    const double late = r.first_safe_stop_time - r.first_fault_detected_time - allowed;
+    if (late > 1e-9)
+      why = "the safe state " + std::to_string(late * 1e3) + " ms later than allowed after detection (the watchdog time" +
+            (allowed > watchdog ? " and the deceleration along the path)" : ")");
     else if (r.machine_at_rest_time < 0) why = "the firmware stopped but the machine still moved at the run's end";
   } else if (r.tracking_samples == 0) {
     why = r.failure;

@@ -53,6 +53,12 @@ constexpr StopKind stop_of(FirmwareFault fault) {
   return StopKind::emergency;  // an unknown code: the stronger stop
 }
 
+// A controlled stop that first decelerates the machine along its path (control/path_stop.hpp) and
+// latches once the path is at rest: only where the law, its sensors and the path are all sound. An
+// operator's stop is; a tracking error, a refused model state, a late or pressure-blind loop are not,
+// and their stop centres the valves at once.
+constexpr bool stops_along_path(FirmwareFault fault) { return fault == FirmwareFault::operator_stop; }
+
 // The standstill monitor of a controlled stop (IEC 60204-1 category 1: a controlled stop, then the
 // power removed if the machine does not stand still). Two tests escalate the stop to the emergency
 // stop. First, on the valve interface, the flow plausibility monitor keeps running against centred

@@ -33,6 +33,8 @@ class PathStop {
   void cancel() { active_ = false; }
   bool active() const { return active_; }
   double duration() const { return duration_; }            // T, s
+  // The longest T: the path's fastest function at its top speed (a task faster is refused at load).
+  static double longest(double ramp_time) { return 0.5 * kPi * ramp_time; }
   double path_time_at_rest() const { return tau0_ + 0.5 * duration_; }
   bool done(double s) const { return s >= duration_; }
 
