@@ -904,6 +904,22 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
   }
   CHECK(runs == 2 * 24);
   CHECK(kinds == 2 * 7);
+  // docs/safety.md's tables come from this file through tools/sweep/campaign_tables.py: each fault
+  // kind's row carries the merge's tracked / safe / neither per law.
+  REQUIRE(std::system((in_dir + "/usr/bin/python3 " + EXC_SOURCE_DIR +
+                       "/tools/sweep/campaign_tables.py merged > tables.md 2> tables.err").c_str()) == 0);
+  const std::string tables = read_text_file(dir / "tables.md");
+  for (const auto& [kind, k] : j["campaign"]["pid"].items()) {
+    const nlohmann::json& a = j["campaign"]["adaptive"][kind];
+    const auto cell = [](const nlohmann::json& r) {
+      return std::to_string(r["tracked"].get<int>()) + " / " + std::to_string(r["safe_state"].get<int>()) + " / " +
+             std::to_string(r["neither"].get<int>());
+    };
+    const std::string row = "| " + kind + " | " + std::to_string(k["runs"].get<int>()) + " | " + cell(k) + " | " + cell(a) + " |";
+    INFO(row << "\n" << tables);
+    CHECK(tables.find(row) != std::string::npos);
+  }
+  CHECK(tables.find("| H3 sensor watchdog |") != std::string::npos);  // bus_burst's stops, under their hazard
 }
 
 TEST_CASE("tools/excavator-sim sweep refuses a spec naming both scene and scenes, and pump_loss on a scene without pumps before any run") {

@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""The safety campaign's two tables in Markdown, from a merged sweep (docs/safety.md, the README).
+
+usage: campaign_tables.py DIR [--requirements]
+  reads DIR/sweep.json (excavator-sim sweep-merge's "safety_functions" and "campaign") and prints
+  per safety function (the fault that took the stop) and per fault kind: runs, worst detection,
+  worst time to rest, runs stopped but never at rest, emergency stops; PID and adaptive side by side.
+  Exit 2 when the file is missing or holds no campaign (a sweep without faults).
+"""
+import json
+import os
+import sys
+
+LAWS = ("pid", "adaptive")
+# The hazard each safety function serves (docs/safety.md), in the concept's order.
+FUNCTIONS = (
+    ("velocity implausible", "H1 flow plausibility"),
+    ("tracking error", "H2 tracking-error limit"),
+    ("sensor timeout", "H3 sensor watchdog"),
+    ("pressure implausible", "H4 pressure plausibility"),
+    ("plant fault", "H6 the machine's own fault"),
+    ("plant emergency", "H6 the machine's emergency"),
+    ("plant holding", "H6 the machine holding"),
+    ("deadline overrun", "H7 missed deadlines"),
+    ("operator stop", "H9 operator stop"),
+    ("none", "no stop (tracked, or neither)"),
+)
+
+
+def seconds(x):
+    if x is None:
+        return "-"
+    return "%.0f ms" % (x * 1e3) if x < 1 else "%.2f s" % x
+
+
+def pair(rows, key, fmt=str):
+    return " / ".join(fmt(r.get(key)) if r else "-" for r in rows)
+
+
+def kinds(rows):
+    """Each fault kind behind a function with its runs per law ("rock 10 / 3"; one number when equal)."""
+    names = sorted({k for r in rows for k in (r or {}).get("kinds", {})},
+                   key=lambda k: -max((r or {}).get("kinds", {}).get(k, 0) for r in rows))
+    cells = []
+    for k in names:
+        counts = [(r or {}).get("kinds", {}).get(k, 0) for r in rows]
+        cells.append("%s %s" % (k, counts[0] if len(set(counts)) == 1 else " / ".join(map(str, counts))))
+    return ", ".join(cells)
+
+
+def main(argv):
+    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+        print(__doc__.strip())
+        return 0 if len(argv) == 2 else 2
+    path = os.path.join(argv[1], "sweep.json")
+    try:
+        with open(path) as f:
+            merged = json.load(f)
+    except (OSError, ValueError) as e:
+        print("campaign_tables.py: %s: %s" % (path, e), file=sys.stderr)
+        return 2
+    functions, campaign = merged.get("safety_functions"), merged.get("campaign")
+    if not functions or not campaign:
+        print("campaign_tables.py: %s holds no campaign (a sweep with faults has 'safety_functions' and 'campaign')"
+              % path, file=sys.stderr)
+        return 2
+    laws = [law for law in LAWS if law in functions]
+    print("| safety function (the fault that took the stop) | runs %s | fault kinds behind it | worst detection "
+          "| worst time to rest | never at rest | estop |" % " / ".join(laws))
+    print("|---|---|---|---|---|---|---|")
+    known = {name for name, _ in FUNCTIONS}
+    names = [(n, label) for n, label in FUNCTIONS] + [(n, n) for law in laws for n in functions[law] if n not in known]
+    seen = set()
+    for name, label in names:
+        rows = [functions[law].get(name) for law in laws]
+        if name in seen or not any(rows):
+            continue
+        seen.add(name)
+        print("| %s | %s | %s | %s | %s | %s | %s |" % (
+            label, pair(rows, "runs"), kinds(rows), pair(rows, "worst_detection", seconds),
+            pair(rows, "worst_time_to_rest", seconds), pair(rows, "never_at_rest"), pair(rows, "estop")))
+    print()
+    print("| fault | runs per law | %s | worst detection | worst time to rest | estop %s |"
+          % (" | ".join("%s tracked / safe / neither" % law for law in laws), " / ".join(laws)))
+    print("|---|---|%s---|---|---|" % ("---|" * len(laws)))
+    for kind in sorted(campaign[laws[0]]):
+        rows = [campaign[law].get(kind, {}) for law in laws]
+        cells = " | ".join("%d / %d / %d" % (r.get("tracked", 0), r.get("safe_state", 0), r.get("neither", 0)) for r in rows)
+        detection = max((r.get("worst_detection") for r in rows if r.get("worst_detection") is not None), default=None)
+        rest = max((r.get("worst_time_to_rest") for r in rows if r.get("worst_time_to_rest") is not None), default=None)
+        print("| %s | %d | %s | %s | %s | %s |" % (kind, rows[0].get("runs", 0), cells, seconds(detection), seconds(rest),
+                                                pair(rows, "estop")))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
