@@ -6,7 +6,7 @@
 #include <memory>
 #include <sstream>
 
-#include "control/make_controller.hpp"
+#include "control/controller_registry.hpp"
 #include "mjcf_export.hpp"
 #include "output_files/output_file.hpp"
 #include "model/closed_chain.hpp"
@@ -24,7 +24,7 @@ namespace {
 // our inverse dynamics alone, on the states of a run.
 void time_controller(const BenchScene& s, const OpenLoopResult& run, PeerResult& out) {
   const Model model = build_model(s.scene.machine);
-  auto controller = control::make_controller(control::ControllerKind::adaptive, model, s.controller);
+  auto controller = control::make_controller("adaptive", model, s.controller);
   Workspace ws(model);
   std::vector<double> control_us, id_us;
   control::ControlInput in;
