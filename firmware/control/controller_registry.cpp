@@ -32,52 +32,12 @@ void register_shipped_controllers(ControllerRegistry& r) {
 }  // namespace
 
 void ControllerRegistry::add(ControllerEntry entry) {
-  if (entry.name.empty()) throw std::invalid_argument("a control law needs a name");
-  if (find(entry.name)) throw std::invalid_argument("control law '" + entry.name + "' is registered twice");
-  if (!entry.make) throw std::invalid_argument("control law '" + entry.name + "' has no factory");
+  if (!entry.make) throw std::invalid_argument("controller '" + entry.name + "' has no factory");
   if ((entry.interfaces & kAnyInterface) == 0)
-    throw std::invalid_argument("control law '" + entry.name + "' drives no command interface");
+    throw std::invalid_argument("controller '" + entry.name + "' drives no command interface");
   // The telemetry carries the number in an int8.
-  if (entries_.size() >= 127) throw std::invalid_argument("control law '" + entry.name + "': 127 laws at most");
-  entries_.push_back(std::move(entry));
-}
-
-const ControllerEntry* ControllerRegistry::find(std::string_view name) const {
-  for (const ControllerEntry& e : entries_)
-    if (e.name == name) return &e;
-  return nullptr;
-}
-
-const ControllerEntry& ControllerRegistry::at(std::string_view name) const {
-  if (const ControllerEntry* e = find(name)) return *e;
-  throw std::invalid_argument("unknown controller '" + std::string(name) + "' (allowed: " + names() + ")");
-}
-
-std::int8_t ControllerRegistry::id_of(std::string_view name) const {
-  return static_cast<std::int8_t>(&at(name) - entries_.data());
-}
-
-std::optional<std::string> ControllerRegistry::named(std::string_view name) const {
-  if (find(name)) return std::string(name);
-  return std::nullopt;
-}
-
-std::string ControllerRegistry::names() const {
-  std::string s;
-  for (const ControllerEntry& e : entries_) s += (s.empty() ? "" : ", ") + e.name;
-  return s;
-}
-
-std::vector<std::string> ControllerRegistry::name_list() const {
-  std::vector<std::string> v;
-  for (const ControllerEntry& e : entries_) v.push_back(e.name);
-  return v;
-}
-
-std::string ControllerRegistry::help() const {
-  std::string s;
-  for (const ControllerEntry& e : entries_) s += (s.empty() ? "  " : "\n  ") + e.name + ": " + e.what;
-  return s;
+  if (entries().size() >= 127) throw std::invalid_argument("controller '" + entry.name + "': 127 laws at most");
+  NameRegistry::add(std::move(entry));
 }
 
 ControllerRegistry& controller_registry() {

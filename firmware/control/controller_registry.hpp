@@ -12,16 +12,15 @@
 // calls the built Controller.
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <string_view>
 #include <type_traits>
-#include <vector>
 
 #include "control/controller_config.hpp"
 #include "control/effort_limits.hpp"
 #include "control/task.hpp"
 #include "model/model.hpp"
+#include "settings/name_registry.hpp"
 
 namespace exc::control {
 
@@ -52,29 +51,14 @@ struct ControllerEntry {
 template <typename Law>
 std::unique_ptr<Controller> build_law(const Model& model, const ControllerConfig& config);
 
-class ControllerRegistry {
+class ControllerRegistry : public settings::NameRegistry<ControllerEntry> {
  public:
+  ControllerRegistry() : NameRegistry("controller") {}
   // Throws std::invalid_argument for an empty or taken name, a missing factory or no interface.
   void add(ControllerEntry entry);
-
-  const std::vector<ControllerEntry>& entries() const { return entries_; }
-  const ControllerEntry* find(std::string_view name) const;
-  // The entry of a name; std::invalid_argument naming the allowed ones when none has it.
-  const ControllerEntry& at(std::string_view name) const;
   // The telemetry's controller number (command_t, controller_state_t): the registration index, so the
   // shipped laws keep the numbers logs already carry (pid 0, adaptive 1, slotine_li 2, flow 3).
-  std::int8_t id_of(std::string_view name) const;
-
-  // What the settings reader and the command lines take (settings::EnumTable's interface).
-  std::optional<std::string> named(std::string_view name) const;
-  const std::string& name_of(const std::string& name) const { return name; }
-  std::string names() const;  // "pid, adaptive, ..."
-  std::vector<std::string> name_list() const;
-  // One line a law, "  name: what", for --help.
-  std::string help() const;
-
- private:
-  std::vector<ControllerEntry> entries_;
+  std::int8_t id_of(std::string_view name) const { return static_cast<std::int8_t>(index_of(name)); }
 };
 
 // The process's registry: the shipped laws, then whatever was registered. Not thread-safe to add to:
