@@ -47,7 +47,7 @@ std::string describe_setup(const SceneBundle& bundle) {
     else
       o << " (the run's " << fw.duration << " s cover part of the path, as the scene asks)";
   }
-  o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
+  o << "; integrator " << sc.integrator.method << " / " << plant::to_string(sc.integrator.formulation)
     << " at " << sc.integrator.step * 1e3 << " ms";
   return o.str();
 }

@@ -18,6 +18,7 @@
 #include "control/controller_registry.hpp"
 #include "control/task.hpp"
 #include "harness/lockstep_run.hpp"
+#include "sim_plant/integration_methods.hpp"
 #include "settings/section_reader.hpp"
 #include "sweep_tables.hpp"
 #include "scratch_files.hpp"
@@ -78,7 +79,7 @@ TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly
   using namespace exc;
   CHECK(names_in_row("scene-schema.md", "soil.preset", 2) == names_of(plant::kSoilPresets));
   CHECK(names_in_row("scene-schema.md", "actuators.fidelity", 2) == names_of(plant::kActuatorFidelities));
-  CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::kIntegrationMethods));
+  CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::integration_methods()));
   CHECK(names_in_row("scene-schema.md", "integrator.formulation", 2) == names_of(plant::kFormulations));
   CHECK(names_in_row("scene-schema.md", "integrator.pressure_method", 2) == names_of(plant::kPressureMethods));
   CHECK(names_in_row("scene-schema.md", "controller.type", 2) == names_of(control::controller_registry()));
