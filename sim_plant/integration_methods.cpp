@@ -1,4 +1,4 @@
-// The shipped integration methods (model.md s.4), one line each in register_shipped_methods, and
+// The shipped integration methods (model.md s.4), one line each in shipped_methods, and
 // the registry that holds them.
 #include "sim_plant/integration_methods.hpp"
 
@@ -7,10 +7,9 @@
 namespace exc::plant {
 namespace {
 
-// Symplectic Euler: the velocity first, then the position with the new velocity.
+// Symplectic Euler: the velocity first, then the position with the new velocity (so an impulse at the
+// step's end moved the position by all of it: impulse_position_share 1).
 struct SemiImplicitEuler {
-  static constexpr bool implicit = false;
-  static constexpr double impulse_position_share = 1.0;
   template <class V>
   static StepOutcome step(const IntegratorSettings&, double h, const V& q0, const V& v0, const Evaluation& start,
                           StepDynamics<V>& dynamics, V& q, V& v) {
@@ -22,8 +21,6 @@ struct SemiImplicitEuler {
 
 // Classical Runge-Kutta, fourth order.
 struct Rk4 {
-  static constexpr bool implicit = false;
-  static constexpr double impulse_position_share = 0.5;
   template <class V>
   static StepOutcome step(const IntegratorSettings&, double h, const V& q0, const V& v0, const Evaluation& start,
                           StepDynamics<V>& dynamics, V& q, V& v) {
@@ -47,8 +44,6 @@ struct Rk4 {
 // Implicit midpoint, symplectic and A-stable. Unknown: the midpoint velocity w, with
 // w = v0 + h/2 a(q0 + h/2 w, w), iterated with StepDynamics::correct.
 struct ImplicitMidpoint {
-  static constexpr bool implicit = true;
-  static constexpr double impulse_position_share = 0.5;
   template <class V>
   static StepOutcome step(const IntegratorSettings& settings, double h, const V& q0, const V& v0, const Evaluation& start,
                           StepDynamics<V>& dynamics, V& q, V& v) {
@@ -74,10 +69,14 @@ struct ImplicitMidpoint {
   }
 };
 
-void register_shipped_methods(IntegrationMethodRegistry& r) {
-  r.add(integration_method<SemiImplicitEuler>("semi_implicit_euler", "symplectic Euler, first order (the default)"));
+IntegrationMethodRegistry shipped_methods() {
+  IntegrationMethodRegistry r;
+  r.add(integration_method<SemiImplicitEuler>("semi_implicit_euler", "symplectic Euler, first order (the default)",
+                                              Solve::explicitly, 1.0));
   r.add(integration_method<Rk4>("rk4", "classical Runge-Kutta, fourth order"));
-  r.add(integration_method<ImplicitMidpoint>("implicit_midpoint", "implicit midpoint, second order, symplectic"));
+  r.add(integration_method<ImplicitMidpoint>("implicit_midpoint", "implicit midpoint, second order, symplectic",
+                                             Solve::implicitly));
+  return r;
 }
 
 }  // namespace
@@ -89,11 +88,7 @@ void IntegrationMethodRegistry::add(IntegrationMethodEntry entry) {
 }
 
 IntegrationMethodRegistry& integration_methods() {
-  static IntegrationMethodRegistry registry = [] {
-    IntegrationMethodRegistry r;
-    register_shipped_methods(r);
-    return r;
-  }();
+  static IntegrationMethodRegistry registry = shipped_methods();
   return registry;
 }
 

@@ -49,12 +49,15 @@ struct IntegrationMethodEntry {
   double impulse_position_share = 0.5;
 };
 
-// The entry of a method type: `template <class V> static StepOutcome step(...)` (a MethodStep for
-// either V), `static constexpr bool implicit` and `static constexpr double impulse_position_share`.
+enum class Solve : bool { explicitly, implicitly };
+
+// The entry of a method type whose `template <class V> static StepOutcome step(...)` is a MethodStep
+// for either V.
 template <class Method>
-IntegrationMethodEntry integration_method(std::string name, std::string what) {
+IntegrationMethodEntry integration_method(std::string name, std::string what, Solve solve = Solve::explicitly,
+                                          double impulse_position_share = 0.5) {
   return {std::move(name), std::move(what), &Method::template step<Vec4>, &Method::template step<Vec12>,
-          Method::implicit, Method::impulse_position_share};
+          solve == Solve::implicitly, impulse_position_share};
 }
 
 class IntegrationMethodRegistry : public settings::NameRegistry<IntegrationMethodEntry> {

@@ -16,7 +16,8 @@ std::string flow_task_misfit(const Task& task) {
 }
 
 // Their order is their telemetry number (ControllerRegistry::id_of): add new laws at the end.
-void register_shipped_controllers(ControllerRegistry& r) {
+ControllerRegistry shipped_controllers() {
+  ControllerRegistry r;
   r.add({"pid", "closed-chain inverse dynamics + PID (the paper's baseline)", build_law<ComputedTorquePid>,
          kAnyInterface, DefaultRun::yes});
   r.add({"adaptive", "adaptive computed torque with the soil regressor (paper eqs. 12-28)",
@@ -27,6 +28,7 @@ void register_shipped_controllers(ControllerRegistry& r) {
          "flow-based position control: valve flow from the desired velocity plus position feedback, no model (the "
          "industry's baseline; valve-commanded machines only)",
          build_law<FlowPositionControl>, kValveInterface, DefaultRun::yes, flow_task_misfit});
+  return r;
 }
 
 }  // namespace
@@ -41,11 +43,7 @@ void ControllerRegistry::add(ControllerEntry entry) {
 }
 
 ControllerRegistry& controller_registry() {
-  static ControllerRegistry registry = [] {
-    ControllerRegistry r;
-    register_shipped_controllers(r);
-    return r;
-  }();
+  static ControllerRegistry registry = shipped_controllers();
   return registry;
 }
 

@@ -19,8 +19,6 @@ namespace {
 
 // q and v advance with the step's start velocity and acceleration.
 struct ExplicitEuler {
-  static constexpr bool implicit = false;
-  static constexpr double impulse_position_share = 0.5;
   template <class V>
   static StepOutcome step(const IntegratorSettings&, double h, const V& q0, const V& v0, const Evaluation& start,
                           StepDynamics<V>& dynamics, V& q, V& v) {
@@ -36,19 +34,6 @@ void register_explicit_euler_once() {
     return true;
   }();
   (void)registered;
-}
-
-// Free motion (no gravity, no soil, zero efforts) from the reference pose with a velocity on every axis.
-Scene free_motion(const std::string& method, double h) {
-  SceneText t;
-  t.method = method;
-  t.step = h;
-  t.cycle = h;
-  t.qd_a = "[0.3, 0.04, -0.06, 0.08]";
-  t.checks = "energy_tolerance: 1e9, constraint_tolerance: 1";
-  Scene s = t.scene();
-  s.machine.gravity = 0;
-  return s;
 }
 
 Vec4 q_after(const Scene& scene, double seconds) {
@@ -89,9 +74,9 @@ TEST_CASE("plant/registry: an integration method registered in one call is named
 TEST_CASE("plant/registry: the registered forward Euler converges at first order to the shipped RK4, and an unknown method is refused naming it among the registered ones") {
   register_explicit_euler_once();
   const double seconds = 0.5;
-  const Vec4 reference = q_after(free_motion("rk4", 1e-4), seconds);
-  const double coarse = (q_after(free_motion("explicit_euler", 2e-3), seconds) - reference).norm();
-  const double fine = (q_after(free_motion("explicit_euler", 1e-3), seconds) - reference).norm();
+  const Vec4 reference = q_after(test::free_motion_scene("rk4", "independent", 1e-4), seconds);
+  const double coarse = (q_after(test::free_motion_scene("explicit_euler", "independent", 2e-3), seconds) - reference).norm();
+  const double fine = (q_after(test::free_motion_scene("explicit_euler", "independent", 1e-3), seconds) - reference).norm();
   REQUIRE(fine > 0);
   const double order = std::log2(coarse / fine);
   MESSAGE("forward Euler against RK4: " << coarse << " at 2 ms, " << fine << " at 1 ms: order " << order);
