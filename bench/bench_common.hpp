@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "sim_plant/integrators.hpp"
+#include "sim_plant/integration_methods.hpp"
 
 namespace exc::bench {
 
@@ -39,18 +39,15 @@ inline std::string step_label(double h) {
   return buf;
 }
 
-constexpr plant::IntegrationMethod kMethods[] = {plant::IntegrationMethod::semi_implicit_euler,
-                                                 plant::IntegrationMethod::rk4,
-                                                 plant::IntegrationMethod::implicit_midpoint};
+// The methods swept: every registered one (a method added is charted by itself).
+inline std::vector<std::string> bench_methods() { return plant::integration_methods().name_list(); }
 constexpr plant::Formulation kFormulations[] = {plant::Formulation::independent,
                                                 plant::Formulation::augmented_baumgarte,
                                                 plant::Formulation::augmented_projection};
 
-inline std::string method_name(plant::IntegrationMethod m, plant::Formulation f) {
-  return std::string(plant::to_string(m)) + "/" + plant::to_string(f);
-}
+inline std::string method_name(const std::string& m, plant::Formulation f) { return m + "/" + plant::to_string(f); }
 
-inline plant::IntegratorSettings settings_of(plant::IntegrationMethod m, plant::Formulation f, double h) {
+inline plant::IntegratorSettings settings_of(const std::string& m, plant::Formulation f, double h) {
   plant::IntegratorSettings s;
   s.method = m;
   s.formulation = f;

@@ -72,7 +72,7 @@ OpenLoopResult run_open_loop(const BenchScene& s, const EffortProfile& profile, 
 double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b);
 
 struct ClosedLoopVariant {
-  control::ControllerKind controller = control::ControllerKind::adaptive;
+  std::string controller = "adaptive";  // the law's registered name
   plant::ActuatorFidelity fidelity = plant::ActuatorFidelity::ideal;
   bool soil = true;                 // false: soil removed from the scene
   bool dry_friction_and_leakage = true;  // false: the hydraulic machine with viscous friction only (the old plant)

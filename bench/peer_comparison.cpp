@@ -6,7 +6,7 @@
 #include <memory>
 #include <sstream>
 
-#include "control/make_controller.hpp"
+#include "control/controller_registry.hpp"
 #include "mjcf_export.hpp"
 #include "output_files/output_file.hpp"
 #include "model/closed_chain.hpp"
@@ -24,7 +24,7 @@ namespace {
 // our inverse dynamics alone, on the states of a run.
 void time_controller(const BenchScene& s, const OpenLoopResult& run, PeerResult& out) {
   const Model model = build_model(s.scene.machine);
-  auto controller = control::make_controller(control::ControllerKind::adaptive, model, s.controller);
+  auto controller = control::make_controller("adaptive", model, s.controller);
   Workspace ws(model);
   std::vector<double> control_us, id_us;
   control::ControlInput in;
@@ -68,7 +68,7 @@ void time_controller(const BenchScene& s, const OpenLoopResult& run, PeerResult&
 void time_dynamics_step(const BenchScene& s, const EffortProfile& profile, const OpenLoopResult& run, PeerResult& out) {
   const Model model = build_model(s.scene.machine);
   Workspace ws(model);
-  plant::Integrator integrator(model, settings_of(plant::IntegrationMethod::semi_implicit_euler,
+  plant::Integrator integrator(model, settings_of("semi_implicit_euler",
                                                   plant::Formulation::independent, 1e-3));
   plant::SoilModel soil(s.scene.terrain, s.scene.soil);
   std::vector<double> us;
@@ -197,7 +197,7 @@ std::vector<PeerResult> peer_comparison(const std::vector<BenchScene>& scenes,
     PeerResult p;
     p.scene = s.name;
     OpenLoopSettings st;
-    st.integrator = settings_of(plant::IntegrationMethod::semi_implicit_euler, plant::Formulation::independent, 1e-3);
+    st.integrator = settings_of("semi_implicit_euler", plant::Formulation::independent, 1e-3);
     const OpenLoopResult ours = run_open_loop(s, profile, st, true);
     // Step times are the best of kTimingPasses medians, for both engines: a burst of load from
     // elsewhere on this shared machine can cover a whole pass and would otherwise decide the ratio.

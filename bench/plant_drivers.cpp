@@ -14,7 +14,7 @@ Stats stats(std::vector<double> v) {
   return s;
 }
 
-bool stable_in_stiff_clay(const Scene& base, IntegrationMethod m, Formulation f, double h, std::string& why) {
+bool stable_in_stiff_clay(const Scene& base, const std::string& m, Formulation f, double h, std::string& why) {
   Scene s = base;
   s.integrator.method = m;
   s.integrator.formulation = f;

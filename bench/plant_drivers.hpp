@@ -66,7 +66,7 @@ struct ValveDriver {
 // The stiff-clay stability probe (as tests/plant/test_stability.cpp): the reference pose with the
 // tip 0.1 m deep, moving into the soil, efforts holding the weight, 2 s. False, with the plant's
 // check in `why`, when a check stopped it.
-bool stable_in_stiff_clay(const plant::Scene& base, plant::IntegrationMethod m, plant::Formulation f, double h,
+bool stable_in_stiff_clay(const plant::Scene& base, const std::string& m, plant::Formulation f, double h,
                           std::string& why);
 
 }  // namespace exc::bench

@@ -17,11 +17,11 @@ std::vector<WorkPoint> work_precision(const std::vector<BenchScene>& scenes, con
     const EffortProfile profile = effort_profile(s);
     progress("work-precision %s: reference (rk4/independent at %s)\n", s.name, step_label(reference_step));
     OpenLoopSettings ref_settings;
-    ref_settings.integrator = settings_of(plant::IntegrationMethod::rk4, plant::Formulation::independent, reference_step);
+    ref_settings.integrator = settings_of("rk4", plant::Formulation::independent, reference_step);
     references.push_back(run_open_loop(s, profile, ref_settings));
     const OpenLoopResult& ref = references.back();
     if (!ref.ok) throw std::runtime_error("the fine-step reference of " + s.name + " failed: " + ref.failure);
-    for (plant::IntegrationMethod m : kMethods)
+    for (const std::string& m : bench_methods())
       for (plant::Formulation f : kFormulations) {
         progress("work-precision %s: %s\n", s.name, method_name(m, f));
         for (double h : steps) {

@@ -128,7 +128,7 @@ std::int64_t lockstep_cycles(const plant::Scene& scene, double duration) {
 
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
   RunRecord result;
-  result.controller = control::to_string(options.controller);
+  result.controller = options.controller;
   // This thread runs the loop and starts the telemetry thread: subnormals flushed from here on, the
   // caller's mode back at the end (docs/floating-point.md).
   const app::LoopFloatModeScope float_mode(options.float_mode);
@@ -173,8 +173,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   }
 
   app::FirmwareNodeConfig fc;
-  fc.kind = options.controller;
   fc.controller = firmware.controller;
+  fc.controller.law = options.controller;
   fc.site_map = firmware.terrain;
   fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
   fc.theta_true = theta_of(scene.soil);

@@ -162,7 +162,7 @@ struct SupervisorFrameAt {
 };
 
 struct LockstepOptions {
-  control::ControllerKind controller = control::ControllerKind::adaptive;
+  std::string controller = "adaptive";  // the law's registered name (control/controller_registry.hpp)
   double duration = 0;  // s; 0: the scene's
   // Telemetry into this provider (null: none), channels suffixed "/<controller>".
   std::shared_ptr<telemetry::LcmOutput> telemetry;

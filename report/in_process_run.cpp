@@ -5,23 +5,16 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "telemetry/lcm_output.hpp"
 
 namespace exc::sim {
-namespace {
-
-control::ControllerKind parse_kind(const std::string& name) {
-  if (const auto kind = control::kControllerKinds.named(name)) return *kind;
-  throw std::invalid_argument("--controller: unknown controller '" + name + "' (allowed: " +
-                              control::kControllerKinds.names() + ")");
-}
-
-}  // namespace
 
 void check_controller_names(const std::vector<std::string>& names) {
   for (std::size_t i = 0; i < names.size(); ++i) {
-    (void)parse_kind(names[i]);
+    if (!control::controller_registry().find(names[i]))
+      throw std::invalid_argument("--controller: unknown controller '" + names[i] + "' (allowed: " +
+                                  control::controller_registry().names() + ")");
     for (std::size_t k = 0; k < i; ++k)
       if (names[k] == names[i])
         throw std::invalid_argument("--controller: '" + names[i] + "' is given twice; each controller runs once");
@@ -54,7 +47,7 @@ std::string describe_setup(const SceneBundle& bundle) {
     else
       o << " (the run's " << fw.duration << " s cover part of the path, as the scene asks)";
   }
-  o << "; integrator " << plant::to_string(sc.integrator.method) << " / " << plant::to_string(sc.integrator.formulation)
+  o << "; integrator " << sc.integrator.method << " / " << plant::to_string(sc.integrator.formulation)
     << " at " << sc.integrator.step * 1e3 << " ms";
   return o.str();
 }
@@ -71,10 +64,9 @@ Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
     if (!output) throw std::runtime_error("--lcm: " + error);
   }
   for (const std::string& name : options.controllers) {
-    const control::ControllerKind kind = parse_kind(name);
     if (options.progress) std::fprintf(stderr, "excavator-sim: %s with %s\n", bundle.name.c_str(), name.c_str());
     LockstepOptions lo;
-    lo.controller = kind;
+    lo.controller = name;
     lo.duration = options.duration_override;
     lo.telemetry = output;
     lo.log_every = options.log_every;

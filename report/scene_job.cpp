@@ -12,7 +12,7 @@
 #include <stdexcept>
 #include <string_view>
 
-#include "control/flow_position_control.hpp"
+#include "control/controller_registry.hpp"
 #include "harness/log_volume.hpp"
 #include "output_files/output_file.hpp"
 #include "run_report.hpp"
@@ -23,6 +23,24 @@ namespace exc::sim {
 namespace fs = std::filesystem;
 
 namespace {
+
+// The laws registered to run by default that can drive the scene's command interface, in registration
+// order; a law that cannot run the scene's task is left out, and `out` says why.
+std::vector<std::string> default_controllers(const SceneBundle& bundle, std::ostream& out) {
+  std::vector<std::string> names;
+  for (const control::ControllerEntry& law : control::controller_registry().entries()) {
+    if (law.default_run != control::DefaultRun::yes) continue;
+    if (!control::interface_misfit(law, bundle.firmware.controller.command_interface).empty()) continue;
+    const std::string why = law.task_misfit ? law.task_misfit(bundle.firmware.task) : "";
+    if (why.empty()) {
+      names.push_back(law.name);
+    } else {
+      out << "excavator-sim: " << bundle.name << ": " << law.name << " left out of the default controllers: " << why
+          << "; --controller " << law.name << " runs it\n";
+    }
+  }
+  return names;
+}
 
 // LCM's file provider: file://PATH?mode=w.
 constexpr std::string_view kFileScheme = "file://";
@@ -75,23 +93,15 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
   options.duration_override = job.duration;
   options.progress = job.progress;
   options.log_every = job.log_every;
-  // Which controllers: --controller, else the scene's controller.type, else the paper's comparison
-  // (and on a valve-commanded machine the industry's flow-based baseline beside it).
+  // Which controllers: --controller, else the scene's controller.type, else the registry's default set
+  // (the paper's comparison, and on a valve-commanded machine the industry's flow-based baseline beside it).
   const control::ControllerConfig& cc = bundle.firmware.controller;
-  const std::string scene_kind = control::to_string(cc.kind);
-  if (!job.controllers.empty() && cc.kind_given && job.controllers != std::vector<std::string>{scene_kind})
-    throw std::invalid_argument("--controller conflicts with " + job.scene_path + "'s controller.type: " + scene_kind +
+  if (!job.controllers.empty() && cc.law_given && job.controllers != std::vector<std::string>{cc.law})
+    throw std::invalid_argument("--controller conflicts with " + job.scene_path + "'s controller.type: " + cc.law +
                                 "; give one of them");
-  const bool valves = cc.command_interface == control::CommandInterface::valve;
-  const bool flow_fits = control::flow_law_fits(bundle.firmware.task);
   options.controllers = !job.controllers.empty() ? job.controllers
-                        : cc.kind_given          ? std::vector<std::string>{scene_kind}
-                        : valves && flow_fits    ? std::vector<std::string>{"pid", "adaptive", "flow"}
-                                                 : std::vector<std::string>{"pid", "adaptive"};
-  if (job.controllers.empty() && !cc.kind_given && valves && !flow_fits)
-    std::cerr << "excavator-sim: " << bundle.name
-              << ": flow left out of the default controllers: the task moves the swing, which flow-based control "
-                 "cannot accelerate (docs/control.md); --controller flow runs it\n";
+                        : cc.law_given           ? std::vector<std::string>{cc.law}
+                                                 : default_controllers(bundle, std::cerr);
   check_controller_names(options.controllers);
   plan.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   options.lcm_url = job.lcm_url.empty()

@@ -1,4 +1,5 @@
-// Integrators: semi-implicit Euler, RK4, implicit midpoint; independent and augmented formulations.
+// The integrator's formulations (independent, augmented): the dynamics a registered method's step
+// evaluates (integration_methods.hpp), and the implicit methods' iteration matrices.
 #include "sim_plant/integrators.hpp"
 
 #include <cmath>
@@ -8,71 +9,12 @@
 #include "model/forward_dynamics.hpp"
 #include "model/front_kinematics.hpp"
 #include "model/newton_euler.hpp"
+#include "sim_plant/integration_methods.hpp"
 
 namespace exc::plant {
 
-namespace {
-
-// One step of the configured method on one coordinate set: V is Vec4 (the independent formulation,
-// accelerations in Evaluation::qdd_a) or Vec12 (the augmented ones, Evaluation::qdd). The step starts
-// at (q0, v0), where `start` was evaluated, and ends in (q, v). evaluate(q, v) gives the dynamics at
-// a state; correct(e, r, dw) gives the implicit midpoint's update dw of its midpoint velocity from the
-// residual r at evaluation e (false: singular).
-template <class V, class Evaluate, class Correct>
-StepOutcome advance(const IntegratorSettings& settings, double h, const V& q0, const V& v0, const Evaluation& start,
-                    V Evaluation::*acceleration, Evaluate&& evaluate, Correct&& correct, V& q, V& v) {
-  StepOutcome out;
-  switch (settings.method) {
-    case IntegrationMethod::semi_implicit_euler: {
-      v = v0 + h * (start.*acceleration);
-      q = q0 + h * v;
-      break;
-    }
-    case IntegrationMethod::rk4: {
-      const V k1v = start.*acceleration, k1q = v0;
-      Evaluation e = evaluate(q0 + 0.5 * h * k1q, v0 + 0.5 * h * k1v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const V k2v = e.*acceleration, k2q = v0 + 0.5 * h * k1v;
-      e = evaluate(q0 + 0.5 * h * k2q, v0 + 0.5 * h * k2v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const V k3v = e.*acceleration, k3q = v0 + 0.5 * h * k2v;
-      e = evaluate(q0 + h * k3q, v0 + h * k3v);
-      if (!e.report.ok()) return out.report = e.report, out;
-      const V k4v = e.*acceleration, k4q = v0 + h * k3v;
-      q = q0 + h / 6.0 * (k1q + 2 * k2q + 2 * k3q + k4q);
-      v = v0 + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v);
-      break;
-    }
-    case IntegrationMethod::implicit_midpoint: {
-      // Unknown: the midpoint velocity w, with w = v0 + h/2 a(q0 + h/2 w, w).
-      V w = v0 + 0.5 * h * (start.*acceleration);
-      out.converged = false;
-      for (int it = 0; it < settings.implicit_max_iterations; ++it) {
-        const Evaluation e = evaluate(q0 + 0.5 * h * w, w);
-        if (!e.report.ok()) return out.report = e.report, out;
-        const V r = w - v0 - 0.5 * h * (e.*acceleration);
-        out.iterations = it + 1;
-        V dw;
-        if (!correct(e, r, dw)) return out.report = ModelReport{ModelStatus::singular, -1, 0}, out;
-        w += dw;
-        if (r.template lpNorm<Eigen::Infinity>() <
-            settings.implicit_tolerance * (1.0 + w.template lpNorm<Eigen::Infinity>())) {
-          out.converged = true;
-          break;
-        }
-      }
-      q = q0 + h * w;
-      v = 2.0 * w - v0;
-      break;
-    }
-  }
-  return out;
-}
-
-}  // namespace
-
 Integrator::Integrator(const Model& model, const IntegratorSettings& settings)
-    : model_(&model), settings_(settings) {}
+    : model_(&model), method_(&integration_methods().at(settings.method)), settings_(settings) {}
 
 ModelReport Integrator::closed_chain(Workspace& ws, const Vec4& q_a, const Vec4& qd_a) {
   if (cache_valid_ && q_a == cached_q_ && qd_a == cached_qd_) return cached_report_;
@@ -186,20 +128,30 @@ StepOutcome Integrator::step_independent(Workspace& ws, const SoilModel& soil, c
   const Vec4 q0 = s.q_a, v0 = s.qd_a;
   start = evaluate_independent(ws, soil, tau, q0, v0);
   if (!start.report.ok()) return out.report = start.report, out;
-  const auto evaluate = [&](const Vec4& q, const Vec4& v) { return evaluate_independent(ws, soil, tau, q, v); };
-  // Implicit midpoint: Newton with the Jacobian I + h/2 A^-1 J_t^T (B_t + h/2 K_t) J_t, exact for the
-  // soil (the stiff part), the rigid-body terms left to the iteration.
-  const auto newton = [&](const Evaluation& e, const Vec4& r, Vec4& dw) {
-    Mat4 jac = last_effective_mass_;
-    if (e.load.added_mass.any() || e.load.force.any()) {
-      const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
-      jac += 0.5 * h * last_J_t_.transpose() * c.asDiagonal() * last_J_t_;
+  struct Independent final : StepDynamics<Vec4> {
+    Independent(Integrator& i, Workspace& w, const SoilModel& so, const Vec4& t, double step)
+        : integrator(i), ws(w), soil(so), tau(t), h(step) {}
+    Evaluation evaluate(const Vec4& q, const Vec4& v) override { return integrator.evaluate_independent(ws, soil, tau, q, v); }
+    const Vec4& acceleration(const Evaluation& e) const override { return e.qdd_a; }
+    // Newton with the Jacobian I + h/2 A^-1 J_t^T (B_t + h/2 K_t) J_t, exact for the soil (the stiff
+    // part), the rigid-body terms left to the iteration.
+    bool correct(const Evaluation& e, const Vec4& r, Vec4& dw) override {
+      Mat4 jac = integrator.last_effective_mass_;
+      if (e.load.added_mass.any() || e.load.force.any()) {
+        const Vec2 c = soil.parameters().damping + 0.5 * h * soil.parameters().stiffness;
+        jac += 0.5 * h * integrator.last_J_t_.transpose() * c.asDiagonal() * integrator.last_J_t_;
+      }
+      const Eigen::LLT<Mat4> llt(jac);
+      dw = -llt.solve(integrator.last_effective_mass_ * r);
+      return dw.allFinite();
     }
-    const Eigen::LLT<Mat4> llt(jac);
-    dw = -llt.solve(last_effective_mass_ * r);
-    return dw.allFinite();
-  };
-  out = advance(settings_, h, q0, v0, start, &Evaluation::qdd_a, evaluate, newton, s.q_a, s.qd_a);
+    Integrator& integrator;
+    Workspace& ws;
+    const SoilModel& soil;
+    const Vec4& tau;
+    double h;
+  } dynamics(*this, ws, soil, tau, h);
+  out = method_->step_independent(settings_, h, q0, v0, start, dynamics, s.q_a, s.qd_a);
   if (!out.report.ok()) return out;
   if (!s.q_a.allFinite() || !s.qd_a.allFinite()) out.report = ModelReport{ModelStatus::non_finite_input, -1, 0};
   return out;
@@ -214,8 +166,7 @@ StepOutcome Integrator::step_augmented(Workspace& ws, const SoilModel& soil, con
   // Implicit midpoint: a chord iteration whose Jacobian is frozen at the step's start: on the
   // constraint manifold (range of Psi) it is the independent-coordinate one with the soil's stiffness
   // and damping, A^-1 (A + h/2 J_t^T (B + h/2 K) J_t); off the manifold the identity (plain fixed point).
-  const bool soil_active = settings_.method == IntegrationMethod::implicit_midpoint &&
-                           (start.load.added_mass.any() || start.load.force.any());
+  const bool soil_active = method_->implicit && (start.load.added_mass.any() || start.load.force.any());
   Mat12x4 Psi = Mat12x4::Zero();
   Mat4 A = Mat4::Identity();
   Eigen::LLT<Mat4> llt;
@@ -235,18 +186,32 @@ StepOutcome Integrator::step_augmented(Workspace& ws, const SoilModel& soil, con
     llt.compute(N);
     Psi = ws.Psi;
   }
-  const auto evaluate = [&](const Vec12& q, const Vec12& v) { return evaluate_augmented(ws, soil, tau, q, v); };
-  const auto chord = [&](const Evaluation&, const Vec12& r, Vec12& dw) {
-    dw = -r;
-    if (soil_active) {
-      Vec4 r_a;
-      for (int k = 0; k < kNumActive; ++k) r_a[k] = r[kActiveJoints[k]];
-      const Vec4 dw_a = -llt.solve(A * r_a);
-      dw = -(r - Psi * r_a) + Psi * dw_a;
+  struct Augmented final : StepDynamics<Vec12> {
+    Augmented(Integrator& i, Workspace& w, const SoilModel& so, const Vec4& t, bool active, const Mat12x4& psi,
+              const Mat4& a, const Eigen::LLT<Mat4>& l)
+        : integrator(i), ws(w), soil(so), tau(t), soil_active(active), Psi(psi), A(a), llt(l) {}
+    Evaluation evaluate(const Vec12& q, const Vec12& v) override { return integrator.evaluate_augmented(ws, soil, tau, q, v); }
+    const Vec12& acceleration(const Evaluation& e) const override { return e.qdd; }
+    bool correct(const Evaluation&, const Vec12& r, Vec12& dw) override {
+      dw = -r;
+      if (soil_active) {
+        Vec4 r_a;
+        for (int k = 0; k < kNumActive; ++k) r_a[k] = r[kActiveJoints[k]];
+        const Vec4 dw_a = -llt.solve(A * r_a);
+        dw = -(r - Psi * r_a) + Psi * dw_a;
+      }
+      return true;
     }
-    return true;
-  };
-  out = advance(settings_, h, q0, v0, start, &Evaluation::qdd, evaluate, chord, s.q, s.qd);
+    Integrator& integrator;
+    Workspace& ws;
+    const SoilModel& soil;
+    const Vec4& tau;
+    bool soil_active;
+    const Mat12x4& Psi;
+    const Mat4& A;
+    const Eigen::LLT<Mat4>& llt;
+  } dynamics(*this, ws, soil, tau, soil_active, Psi, A, llt);
+  out = method_->step_augmented(settings_, h, q0, v0, start, dynamics, s.q, s.qd);
   if (!out.report.ok()) return out;
   if (!s.q.allFinite() || !s.qd.allFinite()) return out.report = ModelReport{ModelStatus::non_finite_input, -1, 0}, out;
   for (int k = 0; k < kNumActive; ++k) {

@@ -1,5 +1,6 @@
 #pragma once
-// Time integration of the closed chain: three methods x three formulations (model.md s.4).
+// Time integration of the closed chain: the registered methods (integration_methods.hpp) x three
+// formulations (model.md s.4).
 //   methods       semi_implicit_euler (symplectic Euler: v then q), rk4 (classical), implicit_midpoint
 //                 (symplectic, A-stable; solved by a chord iteration whose Jacobian carries the
 //                 soil's stiffness and damping exactly on the constraint manifold, the identity off it)
@@ -8,6 +9,8 @@
 //                 augmented_projection (all 12, eq. 8 as written, then projected back onto h = 0
 //                 after every step: passive q from the closed form, qd = Psi qd_a)
 // The efforts are held over a step. Nothing here allocates.
+#include <string>
+
 #include "settings/enum_table.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/chamber.hpp"
@@ -15,25 +18,18 @@
 
 namespace exc::plant {
 
-enum class IntegrationMethod { semi_implicit_euler, rk4, implicit_midpoint };
 enum class Formulation { independent, augmented_baumgarte, augmented_projection };
 
-// The names a scene's integrator.method and integrator.formulation take (and the benches' options).
-inline constexpr settings::EnumTable<IntegrationMethod, 3> kIntegrationMethods{{{
-    {IntegrationMethod::semi_implicit_euler, "semi_implicit_euler", "symplectic Euler, first order (the default)"},
-    {IntegrationMethod::rk4, "rk4", "classical Runge-Kutta, fourth order"},
-    {IntegrationMethod::implicit_midpoint, "implicit_midpoint", "implicit midpoint, second order, symplectic"},
-}}};
+// The names a scene's integrator.formulation takes (and the benches' options).
 inline constexpr settings::EnumTable<Formulation, 3> kFormulations{{{
     {Formulation::independent, "independent", "the active coordinates, loops solved each step (eqs. 14-17)"},
     {Formulation::augmented_baumgarte, "augmented_baumgarte", "all joints with loop forces, Baumgarte stabilised (eq. 8)"},
     {Formulation::augmented_projection, "augmented_projection", "all joints with loop forces, projected back on h(q) = 0"},
 }}};
-inline const char* to_string(IntegrationMethod m) { return kIntegrationMethods.name_of(m); }
 inline const char* to_string(Formulation f) { return kFormulations.name_of(f); }
 
 struct IntegratorSettings {
-  IntegrationMethod method = IntegrationMethod::semi_implicit_euler;
+  std::string method = "semi_implicit_euler";  // a registered method's name (integration_methods.hpp)
   Formulation formulation = Formulation::independent;
   double step = 1e-3;              // s
   double baumgarte_alpha = 20.0;   // 1/s (augmented_baumgarte)
@@ -66,10 +62,14 @@ struct StepOutcome {
   int iterations = 0;
 };
 
+struct IntegrationMethodEntry;
+
 class Integrator {
  public:
+  // std::invalid_argument for a method not registered.
   Integrator(const Model& model, const IntegratorSettings& settings);
   const IntegratorSettings& settings() const { return settings_; }
+  const IntegrationMethodEntry& method() const { return *method_; }
 
   // Advance s by dt with efforts tau_a held and the soil's anchor fixed (re-anchoring is the plant's
   // discrete event after the step). 'start' receives the evaluation at the initial state.
@@ -106,6 +106,7 @@ class Integrator {
   ModelReport closed_chain(Workspace& ws, const Vec4& q_a, const Vec4& qd_a);
 
   const Model* model_;
+  const IntegrationMethodEntry* method_;
   bool cache_valid_ = false;
   Vec4 cached_q_ = Vec4::Zero(), cached_qd_ = Vec4::Zero();
   ModelReport cached_report_;

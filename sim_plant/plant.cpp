@@ -6,6 +6,7 @@
 
 #include "model/loop_closure.hpp"
 #include "sim_plant/coulomb_friction.hpp"
+#include "sim_plant/integration_methods.hpp"
 #include "sim_plant/mechanical_energy.hpp"
 
 namespace exc::plant {
@@ -160,7 +161,7 @@ bool Plant::apply_limits(const Vec4& qd_start) {
       const double limit = std::copysign(speed_max_[i], v);
       const double d = v - limit;
       const double lambda = d / mi(i, i);
-      const double moved = scene_.integrator.method == IntegrationMethod::semi_implicit_euler ? 1.0 : 0.5;
+      const double moved = integrator_.method().impulse_position_share;
       const Vec4 excess = mi.col(i) * lambda;
       mech_.qd_a -= excess;
       mech_.q_a -= moved * scene_.integrator.step * excess;
@@ -210,7 +211,7 @@ Vec4 Plant::apply_dry_friction(const MechanicalState& before) {
   dry_impulse_ = r.impulse;
   state_.friction_stuck = r.stuck;
   state_.friction_sweeps = r.sweeps;
-  const double moved = scene_.integrator.method == IntegrationMethod::semi_implicit_euler ? 1.0 : 0.5;
+  const double moved = integrator_.method().impulse_position_share;
   const Vec4 dv = inverse_mass * r.impulse;
   if (!independent) {
     const Vec12 dv_tree = ws_.Psi * dv;

@@ -5,6 +5,8 @@
 #include <cstdarg>
 #include <cstdio>
 
+#include "sim_plant/integration_methods.hpp"
+
 namespace exc::plant {
 
 const char* to_string(PlantFailure f) {
@@ -42,13 +44,14 @@ namespace {
 void unstable(PlantStatus& status, PlantFailure failure, const CheckInputs& in, const char* what, double value,
               double limit) {
   const IntegratorSettings& s = *in.integrator;
-  const char* other = s.method == IntegrationMethod::implicit_midpoint ? "rk4" : "implicit_midpoint";
+  // An unstable explicit method: the implicit one; an unstable implicit one: the fourth-order one.
+  const char* other = integration_methods().at(s.method).implicit ? "rk4" : "implicit_midpoint";
   // Explicit pressures of a hydraulic machine are the first suspect.
   const bool explicit_pressures = in.pressure_a != nullptr && s.pressure_method == PressureMethod::forward_euler;
   set_failure(status, failure, in.time, in.cycle,
               "%s (%.4g, limit %.4g) with integrator %s / %s%s at step %.4g s: the integration is unstable here; "
               "use a smaller integrator.step (try %.4g s) or another integrator.%s (%s)",
-              what, value, limit, to_string(s.method), to_string(s.formulation),
+              what, value, limit, s.method.c_str(), to_string(s.formulation),
               explicit_pressures ? " / pressures forward_euler" : "", s.step, 0.5 * s.step,
               explicit_pressures ? "pressure_method" : "method", explicit_pressures ? "backward_euler" : other);
 }
@@ -80,7 +83,7 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
                 "%.4g s; a cylinder left the lengths where the mechanism assembles: use a smaller integrator.step "
                 "(try %.4g s) if the motion was unstable, or actuators.fidelity limited (end stops)",
                 to_string(in.model_report.status), in.model_report.loop, st.q_a[0], st.q_a[1], st.q_a[2], st.q_a[3],
-                to_string(integ.method), to_string(integ.formulation), integ.step, 0.5 * integ.step);
+                integ.method.c_str(), to_string(integ.formulation), integ.step, 0.5 * integ.step);
     return false;
   }
   if (!in.implicit_converged) {
@@ -125,7 +128,7 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
     set_failure(status, PlantFailure::constraint_drift, in.time, in.cycle,
                 "loop-closure residual %.3g m above the tolerance %.3g m with integrator %s / %s at step %.4g s; "
                 "use formulation augmented_projection or independent, larger Baumgarte gains, or a smaller step",
-                in.constraint_residual, settings.constraint_tolerance, to_string(integ.method),
+                in.constraint_residual, settings.constraint_tolerance, integ.method.c_str(),
                 to_string(integ.formulation), integ.step);
     return false;
   }

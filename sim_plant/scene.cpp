@@ -5,6 +5,7 @@
 
 #include "model/scene_common.hpp"
 #include "settings/section_reader.hpp"
+#include "sim_plant/integration_methods.hpp"
 
 namespace exc::plant {
 
@@ -33,7 +34,7 @@ void read_soil(SectionReader& soil, Scene& s) {
 
 void read_integrator(SectionReader& integ, Scene& s) {
   IntegratorSettings& i = s.integrator;
-  integ.choice("method", i.method, kIntegrationMethods, "the integration method");
+  integ.choice("method", i.method, integration_methods(), "the integration method");
   integ.choice("formulation", i.formulation, kFormulations, "the equations integrated");
   integ.number("cycle", s.cycle, {1e-4, 1.0}, "s", "one plant step (the SYNC period)");
   i.step = s.cycle;

@@ -11,7 +11,7 @@
 #include <stdexcept>
 
 #include "settings/section_reader.hpp"
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "fault_campaign.hpp"
 #include "sweep_knobs.hpp"
 #include "sweep_tables.hpp"
@@ -277,7 +277,7 @@ SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
   for (const std::string& scene_path : spec.scenes)
     spec.sources.push_back(std::make_shared<const SceneSource>(load_scene_source(scene_path)));
   s.choice("run", spec.run, kSweepRuns, "what one run of a case is");
-  s.choices("controllers", spec.controllers, control::kControllerKinds, 1, "the controllers each case runs");
+  s.choices("controllers", spec.controllers, control::controller_registry(), 1, "the controllers each case runs");
   s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws per grid point and variant, case i from (seed, i)");
   s.whole("seed", spec.seed, 0, 4e9, "", "the draws' seed");
   if (s.given("duration")) s.number("duration", spec.duration, {1e-3, 3600}, "s", "per run (absent: the scene's)");

@@ -5,7 +5,6 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "control/controller_kinds.hpp"
 #include "fault_campaign.hpp"
 #include "output_files/output_file.hpp"
 #include "report/run_report.hpp"
@@ -18,7 +17,7 @@ namespace fs = std::filesystem;
 
 RunRecord run_bundle(const SceneBundle& b, const SweepSpec& spec, const SweepCase& c, const std::string& controller) {
   LockstepOptions o;
-  o.controller = *control::kControllerKinds.named(controller);
+  o.controller = controller;
   o.duration = spec.duration;
   o.stop_at_safe_state = spec.stop_at_safe_state;
   o.fault = fault_schedule(c, spec.seed);

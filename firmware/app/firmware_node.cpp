@@ -11,7 +11,7 @@
 
 #include "app/can_stats_message.hpp"
 #include "app/timing_message.hpp"
-#include "control/make_controller.hpp"
+#include "control/controller_registry.hpp"
 #include "exlcm/command_t.hpp"
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/fault_t.hpp"
@@ -35,6 +35,16 @@ bool finite(const Vec4& v) { return v.allFinite(); }
 
 // SensorState::supervisor_pending's bit of a command.
 std::uint8_t supervisor_bit(hal::SupervisorCommand c) { return static_cast<std::uint8_t>(1u << static_cast<unsigned>(c)); }
+
+// Refuses a law the command interface cannot carry (a flow law on the effort interface) before it
+// is built: std::invalid_argument naming both.
+std::unique_ptr<control::Controller> checked_controller(const Model& model, const control::ControllerConfig& config) {
+  const control::ControllerEntry& law = control::controller_registry().at(config.law);
+  if (const std::string why = control::interface_misfit(law, config.command_interface); !why.empty())
+    throw std::invalid_argument("controller " + why + " (the scene's controller.command_interface is " +
+                                control::kCommandInterfaces.name_of(config.command_interface) + ")");
+  return law.make(model, config);
+}
 
 }  // namespace
 
@@ -68,14 +78,6 @@ const char* to_string(StopKind stop) {
   return "unknown";
 }
 
-void check_controller_interface(control::ControllerKind kind, const control::ControllerConfig& config) {
-  if (kind == control::ControllerKind::flow && config.command_interface != control::CommandInterface::valve)
-    throw std::invalid_argument(std::string("controller ") + control::to_string(kind) +
-                                " commands the valves' flow; the scene's controller.command_interface is " +
-                                control::kCommandInterfaces.name_of(config.command_interface) +
-                                " (set it to valve for a hydraulic machine)");
-}
-
 FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
                            hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry)
     : model_(model),
@@ -84,7 +86,8 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       config_(config),
       port_(port),
       telemetry_(telemetry),
-      controller_(control::make_controller(config.kind, model, config.controller)),
+      controller_(checked_controller(model, config.controller)),
+      controller_id_(control::controller_registry().id_of(config.controller.law)),
       estimator_(config.controller.filter),
       machine_(config.controller.watchdog_timeout),
       blender_(config.controller.blend_time),
@@ -99,9 +102,7 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       write_timing_("write", 100.0),
       telemetry_timing_("telemetry", 100.0),
       interval_timing_("interval", config.controller.period * 1.5e6),
-      period_(config.controller.period) {
-  check_controller_interface(config.kind, config.controller);
-}
+      period_(config.controller.period) {}
 
 FirmwareNode::~FirmwareNode() = default;
 
@@ -410,15 +411,12 @@ void FirmwareNode::scan_state(SubnormalScan& scan) const {
   scan.scan("law velocity (flow law)", out_.velocity);
   scan.scan("law disturbance (observer)", out_.disturbance);
   scan.scan("law tip_force", out_.tip_force);
-  if (const auto* pid = dynamic_cast<const control::ComputedTorquePid*>(controller_.get()))
-    scan.scan("pid integral", pid->pid().integral());
-  if (const auto* a = dynamic_cast<const control::AdaptiveComputedTorque*>(controller_.get())) {
-    scan.scan("adaptive observer estimate", a->observer_estimate());
-    scan.scan("adaptive identification covariance", a->identification_covariance());
-    scan.scan("adaptive regression filter", a->regression_filtered());
-    scan.scan("adaptive tip filter chain", a->tip_chain());
-    scan.scan("adaptive anchor tip filter", a->tip_filtered());
-  }
+  struct LawScan final : control::StateVisitor {
+    explicit LawScan(SubnormalScan& s) : scan(s) {}
+    void visit(const char* name, const double* values, std::size_t count) override { scan.scan(name, values, count); }
+    SubnormalScan& scan;
+  } law_scan(scan);
+  controller_->visit_state(law_scan);
   // The stages after the law: the actuator-lag lead and the valve stage.
   scan.scan("actuator-lag lead delivered effort", lag_compensator_.delivered());
   const control::ValveCommand& v = valves_.last();
@@ -699,7 +697,7 @@ void FirmwareNode::publish_cycle() {
   exlcm::command_t c{};
   c.utime = utime;
   c.mode = static_cast<std::int8_t>(machine_.mode());
-  c.controller = static_cast<std::int8_t>(config_.kind);
+  c.controller = controller_id_;
   c.command_interface = static_cast<std::int8_t>(config_.controller.command_interface);
   const bool effort = command_.mode == hal::CommandMode::effort;
   const bool valves = command_.mode == hal::CommandMode::pilot;
@@ -718,7 +716,7 @@ void FirmwareNode::publish_cycle() {
 
   exlcm::controller_state_t s{};
   s.utime = utime;
-  s.controller = static_cast<std::int8_t>(config_.kind);
+  s.controller = controller_id_;
   s.mode = static_cast<std::int8_t>(machine_.mode());
   for (int j = 0; j < 4; ++j) {
     s.q_desired[j] = q_d_[j];

@@ -37,8 +37,7 @@ class TelemetryPublisher;
 namespace exc::app {
 
 struct FirmwareNodeConfig {
-  control::ControllerKind kind = control::ControllerKind::adaptive;
-  control::ControllerConfig controller;
+  control::ControllerConfig controller;  // its law names the control law the node runs
   Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
   double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
   // Hold until an operator's start (SUPERVISOR Command = start) before tracking; false: the task
@@ -48,10 +47,6 @@ struct FirmwareNodeConfig {
   bool theta_known = false;
   Vec6 theta_true = Vec6::Zero();
 };
-
-// Refuses a controller the command interface cannot carry (a flow law on the effort interface):
-// start-up check, throws std::invalid_argument naming both.
-void check_controller_interface(control::ControllerKind kind, const control::ControllerConfig& config);
 
 inline constexpr int kPumpWarningCycles = 20;
 // Cycles between the node's counter messages (EXC_TIMING per stage, EXC_CAN_STATS).
@@ -220,6 +215,7 @@ class FirmwareNode {
   hal::FirmwareCanPort& port_;
   telemetry::TelemetryPublisher* telemetry_;
   std::unique_ptr<control::Controller> controller_;
+  std::int8_t controller_id_;  // the law's number in telemetry (ControllerRegistry::id_of)
   control::StateEstimator estimator_;
   control::ControlStateMachine machine_;
   control::CommandBlender blender_;

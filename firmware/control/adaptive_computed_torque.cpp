@@ -56,6 +56,14 @@ void AdaptiveComputedTorque::reset() {
   saturated_ = 0;
 }
 
+void AdaptiveComputedTorque::visit_state(StateVisitor& visitor) const {
+  visitor.visit("adaptive observer estimate", observer_estimate());
+  visitor.visit("adaptive identification covariance", identification_covariance());
+  visitor.visit("adaptive regression filter", regression_filtered());
+  visitor.visit("adaptive tip filter chain", tip_chain());
+  visitor.visit("adaptive anchor tip filter", tip_filtered());
+}
+
 Vec6 AdaptiveComputedTorque::gamma() const {
   Vec6 g;
   for (int i = 0; i < 6; ++i) g[i] = config_.adaptation_rate[i] > 0 ? 1 / config_.adaptation_rate[i] : 0;

@@ -60,7 +60,7 @@ class AdaptiveComputedTorque final : public Controller {
   AdaptiveComputedTorque(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
-  ControllerKind kind() const override { return ControllerKind::adaptive; }
+  void visit_state(StateVisitor& visitor) const override;
 
   // P of V over z = [int e; e; ed] (without integral action the int e rows and columns are zero).
   const Mat12& lyapunov_p() const { return P_; }
@@ -71,7 +71,7 @@ class AdaptiveComputedTorque final : public Controller {
   // Gamma of V (the inverse of the adaptation rates; a zero rate gives an infinite weight, so V is
   // reported with that parameter's term left out).
   Vec6 gamma() const;
-  // The composite update's memory (the subnormal scan reads it: it decays while the machine holds).
+  // The composite update's memory (visit_state shows it: it decays while the machine holds).
   const Vec4& observer_estimate() const { return observer_.estimate(); }
   const Mat6& identification_covariance() const { return identification_.covariance(); }
   const Eigen::Matrix<double, 12, 1>& regression_filtered() const { return regression_filter_.value(); }

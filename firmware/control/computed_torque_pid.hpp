@@ -18,7 +18,7 @@ class ComputedTorquePid final : public Controller {
   ComputedTorquePid(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
-  ControllerKind kind() const override { return ControllerKind::pid; }
+  void visit_state(StateVisitor& visitor) const override { visitor.visit("pid integral", pid_.integral()); }
   Pid& pid() { return pid_; }
   const Pid& pid() const { return pid_; }
 

@@ -2,6 +2,7 @@
 // What every controller takes and returns, and the interface the firmware loop calls
 // (ros2_control's update(): the loop reads sensors, calls update(), writes the command).
 // All fixed-size; update() never allocates, throws or blocks.
+#include <cstddef>
 #include <cstdint>
 
 #include "model/model_status.hpp"
@@ -76,8 +77,19 @@ struct ControlOutput {
   Vec4 velocity = Vec4::Zero();
 };
 
-enum class ControllerKind : std::uint8_t { pid = 0, adaptive = 1, slotine_li = 2, flow = 3 };
-const char* to_string(ControllerKind kind);
+// What a law shows of its inner state, value by value (the firmware's scan for subnormal numbers,
+// docs/floating-point.md), so the firmware reads a law's memory without knowing the law.
+class StateVisitor {
+ public:
+  virtual void visit(const char* name, const double* values, std::size_t count) = 0;
+  template <typename Derived>
+  void visit(const char* name, const Eigen::PlainObjectBase<Derived>& values) {
+    visit(name, values.data(), static_cast<std::size_t>(values.size()));
+  }
+
+ protected:
+  ~StateVisitor() = default;
+};
 
 class Controller {
  public:
@@ -85,7 +97,9 @@ class Controller {
   // Forget integrators and adaptation state; theta_hat restarts at the configured initial value.
   virtual void reset() = 0;
   virtual ControlOutput update(const ControlInput& in) = 0;
-  virtual ControllerKind kind() const = 0;
+  // The state the law carries from cycle to cycle beyond its ControlOutput (integrals, filters,
+  // estimates); a law without any shows nothing. Allocation-free.
+  virtual void visit_state(StateVisitor& visitor) const { (void)visitor; }
 };
 
 }  // namespace exc::control

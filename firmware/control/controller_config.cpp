@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 
 namespace exc::control {
 namespace {
@@ -53,10 +53,8 @@ void check_nyquist(const SectionReader& f, const ControllerConfig& c) {
 
 }  // namespace
 
-const char* to_string(ControllerKind kind) { return kControllerKinds.name_of(kind); }
-
 void read_controller_config(SectionReader& r, ControllerConfig& c) {
-  r.choice("type", c.kind, c.kind_given, kControllerKinds,
+  r.choice("type", c.law, c.law_given, controller_registry(),
            "the control law to run (absent: the program's choice; excavator-sim runs pid and adaptive)");
   r.number("period", c.period, {1e-5, 0.1}, "s", "control period (the update law integrated at it)");
   r.numbers("kp", c.gains.kp, {1e-3, 1e6}, "1/s^2", "position gains, swing, boom, arm, bucket");
@@ -159,8 +157,10 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   fl.numbers("kp", c.flow_kp, {0, 1e3}, "1/s", "position gains: u = qd_d - kp e");
   fl.finish();
   r.finish();
-  if (c.kind_given && c.kind == ControllerKind::flow && c.command_interface != CommandInterface::valve)
-    r.fail("type", "flow commands the valves' flow: it needs command_interface: valve");
+  if (c.law_given) {
+    if (const std::string why = interface_misfit(controller_registry().at(c.law), c.command_interface); !why.empty())
+      r.fail("type", why);
+  }
   c.filter.period = c.period;
   check_nyquist(f, c);
   if (!(c.external_force.cutoff_hz < c.filter.acceleration_cutoff_hz))

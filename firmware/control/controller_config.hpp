@@ -50,8 +50,9 @@ struct ExternalForceSettings {
 };
 
 struct ControllerConfig {
-  ControllerKind kind = ControllerKind::adaptive;
-  bool kind_given = false;  // the scene set controller.type (it then chooses the controller to run)
+  // The control law to run, by its name in the registry (controller_registry.hpp).
+  std::string law = "adaptive";
+  bool law_given = false;  // the scene set controller.type (it then chooses the controller to run)
   double period = 1e-3;  // s, the control period (update law integrated at it)
 
   // Computed-torque error dynamics e'' + kv e' + kp e (+ ki int e for the PID baseline).

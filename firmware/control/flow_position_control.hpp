@@ -44,7 +44,6 @@ class FlowPositionControl final : public Controller {
     out.velocity = in.qd_d - gains_.cwiseProduct(out.e);
     return out;
   }
-  ControllerKind kind() const override { return ControllerKind::flow; }
 
  private:
   Vec4 gains_;

@@ -24,7 +24,6 @@ class SlotineLi final : public Controller {
   SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
-  ControllerKind kind() const override { return ControllerKind::slotine_li; }
   const Vec6& theta_hat() const { return theta_hat_; }
 
  private:

@@ -102,9 +102,11 @@ class SectionReader {
     rows.assign(n, lo);
     for (std::size_t i = 0; i < n; ++i) read_row(key, i, rows[i].data(), static_cast<int>(rows[i].size()), lo.data(), hi.data(), unit);
   }
-  // One of an enumeration's names; the default is value's.
-  template <typename E, std::size_t N>
-  void choice(const char* key, E& value, const EnumTable<E, N>& table, const char* what) {
+  // One of a table's names; the default is value's. The table is an EnumTable or a registry of
+  // things added at start-up (control/controller_registry.hpp): named(name) -> optional<E>,
+  // name_of(E), names() ("a, b, c").
+  template <typename E, typename Table>
+  void choice(const char* key, E& value, const Table& table, const char* what) {
     declare(key);
     std::string name = table.name_of(value);
     if (value_given(key)) {
@@ -116,15 +118,15 @@ class SectionReader {
     note(key, Declaration::Type::choice, 0, nullptr, nullptr, 0, "", table.names().c_str());
   }
   // The same without a default: `given` tells whether the file names one; recorded only then.
-  template <typename E, std::size_t N>
-  void choice(const char* key, E& value, bool& given, const EnumTable<E, N>& table, const char* what) {
+  template <typename E, typename Table>
+  void choice(const char* key, E& value, bool& given, const Table& table, const char* what) {
     given = this->given(key);
     if (given) choice(key, value, table, what);
   }
-  // A list of at least `min` names of an enumeration (kept as names, each checked against the table,
-  // none twice).
-  template <typename E, std::size_t N>
-  void choices(const char* key, std::vector<std::string>& names, const EnumTable<E, N>& table, std::size_t min,
+  // A list of at least `min` names of a table (kept as names, each checked against the table, none
+  // twice).
+  template <typename Table>
+  void choices(const char* key, std::vector<std::string>& names, const Table& table, std::size_t min,
                const char* what) {
     if (given(key)) {
       names = read_names(key, min, std::string("a list of names from: ") + table.names() + " (" + what + ")");

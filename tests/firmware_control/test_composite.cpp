@@ -155,8 +155,8 @@ TEST_CASE("firmware/adaptive composite update: told the applied efforts, it iden
   ControllerConfig cfg;
   cfg.adaptation_rate.setZero();  // the composite term alone
   sim::SoilTruth loam;            // theta (200, 5e3, 7e4) on both axes
-  const sim::TrackingResult told = sim::run_tracking(model, task, ControllerKind::adaptive, cfg, loam, true);
-  const sim::TrackingResult blind = sim::run_tracking(model, task, ControllerKind::adaptive, cfg, loam, false);
+  const sim::TrackingResult told = sim::run_tracking(model, task, "adaptive", cfg, loam, true);
+  const sim::TrackingResult blind = sim::run_tracking(model, task, "adaptive", cfg, loam, false);
 
   REQUIRE(told.ok);
   REQUIRE(blind.ok);
@@ -170,7 +170,7 @@ TEST_CASE("firmware/adaptive composite update: told the applied efforts, it iden
   ControllerConfig no_observer = cfg;
   no_observer.external_force.observer = false;
   no_observer.external_force.identification_memory = 0;
-  const sim::TrackingResult paper = sim::run_tracking(model, task, ControllerKind::adaptive, no_observer, loam, true);
+  const sim::TrackingResult paper = sim::run_tracking(model, task, "adaptive", no_observer, loam, true);
   MESSAGE("RMS (mm) with observer and update: " << 1e3 * told.rms.transpose() << "; without: " << 1e3 * paper.rms.transpose());
   for (int j = 2; j < 4; ++j) CHECK(told.rms[j] < 0.5 * paper.rms[j]);
 }

@@ -134,7 +134,7 @@ Vec2 tip_of(const Model& model, const Vec4& q) {
 TEST_CASE("firmware/node: after its task the machine holds the final pose, the path never restarts and the command never jumps") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::adaptive;
+  cfg.controller.law = "adaptive";
   Loop loop(model, sim::kDigTask, cfg);
   const double end = loop.task.end_time();  // 10 s
   Vec4 q_final, qd_end, qdd_end;
@@ -183,7 +183,7 @@ TEST_CASE("firmware/node: after its task the machine holds the final pose, the p
 TEST_CASE("firmware/node: a stop request decelerates a tracking machine along its path, no faster than its top speed per ramp time, and holds where the path came to rest") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 3.0) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::track);
@@ -255,7 +255,7 @@ TEST_CASE("firmware/node: a stop request decelerates a tracking machine along it
 TEST_CASE("firmware/node: with stop_ramp_time 0 a stop request holds at the desired pose of that moment") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   cfg.controller.stop_ramp_time = 0;
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 3.0) loop.cycle();
@@ -300,9 +300,9 @@ TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fau
 TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over 20000 cycles of the dig task") {
   REQUIRE(exc::app::allocation_counting_works());
   const Model model = build_model(reference_machine());
-  for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {
+  for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
     app::FirmwareNodeConfig cfg;
-    cfg.kind = kind;
+    cfg.controller.law = kind;
     cfg.controller.actuator_lag = 0.02;
     Loop loop(model, sim::kDigTask, cfg);
     loop.cycle();  // start-up cycle outside the count (first touch)
@@ -313,7 +313,7 @@ TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over
       for (int k = 0; k < 20000; ++k) loop.cycle();
       allocations = counter.count();
     }
-    INFO(to_string(kind));
+    INFO(kind);
     CHECK(allocations == 0);
     CHECK(loop.node.trajectory_finished());  // the run crossed track -> hold too
   }
@@ -373,7 +373,7 @@ TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle t
 TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated) trips the tracking-error fault within one cycle's motion past the limit") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFastSwingTask, cfg);
   const double limit = cfg.controller.tracking_error_limit[0];
   double error_before = 0, desired_step = 0;
@@ -406,12 +406,12 @@ TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated
 TEST_CASE("firmware/node: the reference dig and free-motion tasks on the force-actuated model never trip the tracking-error fault with any effort law") {
   const Model model = build_model(reference_machine());
   for (const char* task : {sim::kDigTask, sim::kFreeMotionTask}) {
-    for (const ControllerKind kind : {ControllerKind::pid, ControllerKind::adaptive, ControllerKind::slotine_li}) {
+    for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
       app::FirmwareNodeConfig cfg;
-      cfg.kind = kind;
+      cfg.controller.law = kind;
       Loop loop(model, task, cfg);
       for (int k = 0; k < 11000; ++k) loop.cycle();
-      INFO(to_string(kind) << ": " << loop.node.last_fault_text());
+      INFO(kind << ": " << loop.node.last_fault_text());
       CHECK(loop.node.safe_stops() == 0);
       CHECK(loop.node.trajectory_finished());
     }
@@ -454,7 +454,7 @@ TEST_CASE("firmware/node: the port counts every frame on the bus once, at its ex
 TEST_CASE("firmware/node: a sensor timeout takes the emergency stop (EmergencyStop = 1) and the stop latches until acknowledged") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 1.0) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::track);
@@ -493,7 +493,7 @@ TEST_CASE("firmware/node: a sensor timeout takes the emergency stop (EmergencySt
 TEST_CASE("firmware/node: an acknowledge while the frames are still missing is spent, the stop stays") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 1.0) loop.cycle();
   loop.answer = false;
@@ -510,7 +510,7 @@ TEST_CASE("firmware/node: an acknowledge while the frames are still missing is s
 TEST_CASE("firmware/node: the machine's own signals are heard and named: PLANT_EMERGENCY, PlantFaults, PlantState hold") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   SUBCASE("PLANT_EMERGENCY") {
     Loop loop(model, sim::kFreeMotionTask, cfg);
     while (loop.node.time() < 1.0) loop.cycle();
@@ -570,7 +570,7 @@ TEST_CASE("firmware/node: the machine's own signals are heard and named: PLANT_E
 TEST_CASE("firmware/node: consecutive missed deadlines in real time are a fault (controlled stop), scattered ones are not") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 1.0) loop.cycle();
   const int limit = cfg.controller.max_missed_deadlines;
@@ -603,7 +603,7 @@ TEST_CASE("firmware/node: the last command of a program that leaves centres the 
   const Model model = build_model(reference_machine());
   for (const app::FirmwareFault why : {app::FirmwareFault::exited, app::FirmwareFault::fatal_error}) {
     app::FirmwareNodeConfig cfg;
-    cfg.kind = ControllerKind::pid;
+    cfg.controller.law = "pid";
     Loop loop(model, sim::kFreeMotionTask, cfg);
     while (loop.node.time() < 1.0) loop.cycle();
     REQUIRE(loop.node.mode() == Mode::track);
@@ -624,7 +624,7 @@ TEST_CASE("firmware/node: the last command of a program that leaves centres the 
 TEST_CASE("firmware/node: a node set to wait for the operator holds until a SUPERVISOR start frame, then tracks, and without the setting it starts by itself") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   SUBCASE("waits for start") {
     cfg.wait_for_start = true;
     Loop loop(model, sim::kFreeMotionTask, cfg);
@@ -654,7 +654,7 @@ TEST_CASE("firmware/node: a node set to wait for the operator holds until a SUPE
 TEST_CASE("firmware/node: SUPERVISOR stop and acknowledge in one cycle: the stop stands until an acknowledge of its own") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   hal::MemoryBusNode* station_bus = loop.hub.attach();
   hal::OperatorCanPort station(*station_bus);
@@ -699,7 +699,7 @@ TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or
 TEST_CASE("firmware/runner: a lockstep run does its cycles, tracks, and leaves the valves centred with the exit's code") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   AnsweringBus bus(loop);
   app::RunnerOptions run;
@@ -724,7 +724,7 @@ TEST_CASE("firmware/runner: a lockstep run does its cycles, tracks, and leaves t
 TEST_CASE("firmware/runner: a stop request holds a tracking machine for the hold time, then ends, and before tracking ends at once") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   {
     Loop loop(model, sim::kFreeMotionTask, cfg);
     AnsweringBus bus(loop);
@@ -762,7 +762,7 @@ TEST_CASE("firmware/runner: a stop request holds a tracking machine for the hold
 TEST_CASE("firmware/runner: a second stop request while holding ends the run at once") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   struct TwoStops final : hal::CanBus {
     AnsweringBus inner;
@@ -790,7 +790,7 @@ TEST_CASE("firmware/runner: a second stop request while holding ends the run at 
 TEST_CASE("firmware/runner: a plant that never answers fails the run as never tracked, after the start-up wait of each cycle") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   loop.answer = false;
   AnsweringBus bus(loop);
@@ -809,7 +809,7 @@ TEST_CASE("firmware/runner: a plant that never answers fails the run as never tr
 TEST_CASE("firmware/runner: in real time a stalled cycle is a late wake-up, and a run allowed none fails naming its period first") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
-  cfg.kind = ControllerKind::pid;
+  cfg.controller.law = "pid";
   for (const double allowed : {0.0, 1.0}) {
     Loop loop(model, sim::kFreeMotionTask, cfg);
     AnsweringBus bus(loop);

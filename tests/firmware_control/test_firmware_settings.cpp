@@ -73,7 +73,7 @@ TEST_CASE("firmware/settings refuse a flow law on the effort interface, naming b
   check_error("name: x\nduration: 2\ncontroller: {type: flow}\n" + std::string(kTask), "controller.type", "flow",
               "flow commands the valves' flow: it needs command_interface: valve");
   CHECK(read("name: x\nduration: 2\ncontroller: {type: flow, command_interface: valve}\n" + std::string(kTask))
-            .controller.kind == control::ControllerKind::flow);
+            .controller.law == "flow");
 }
 
 TEST_CASE("firmware/settings derive the defaults a scene leaves out from the machine, the interface and the other settings, and keep what it gives") {

@@ -4,7 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "closed_loop.hpp"
-#include "control/make_controller.hpp"
+#include "control/controller_registry.hpp"
 #include "control/state_estimator.hpp"
 #include "control/task.hpp"
 
@@ -33,7 +33,7 @@ inline ControlInput estimated_input(StateEstimator& est, const Vec4& q, const Ve
 
 // applied_known: the law is told the efforts the plant applied last step (the model plant's actuators
 // are ideal: what was commanded), as a hydraulic machine's pressures tell the firmware.
-inline TrackingResult run_tracking(const Model& model, const Task& task, ControllerKind kind,
+inline TrackingResult run_tracking(const Model& model, const Task& task, const std::string& kind,
                                    const ControllerConfig& cfg, const SoilTruth& soil, bool applied_known = false) {
   auto ctrl = make_controller(kind, model, cfg);
   ModelPlant plant(model, soil);

@@ -12,7 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "harness/lockstep_run.hpp"
 
 using namespace exc;
@@ -24,8 +24,8 @@ int main(int argc, char** argv) {
   std::string controller = "adaptive";
   double duration = 60, early = 11;
   int window = 1000;
-  app.add_option("--controller", controller, control::kControllerKinds.names())
-      ->check(CLI::IsMember(control::kControllerKinds.name_list()));
+  app.add_option("--controller", controller, control::controller_registry().names())
+      ->check(CLI::IsMember(control::controller_registry().name_list()));
   app.add_option("--duration", duration, "simulated seconds (default 60)")->check(CLI::Range(12.0, 3600.0));
   app.add_option("--early", early, "start of the early window, s (default 11: the path ends at 10.05 s)")
       ->check(CLI::Range(10.1, 3600.0));
@@ -42,7 +42,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   sim::LockstepOptions o;
-  o.controller = *control::kControllerKinds.named(controller);
+  o.controller = controller;
   o.duration = duration;
   // The observer runs after cycle k: a window [begin, begin + window) starts after cycle begin - 1.
   o.observer = [&](std::int64_t k, const plant::Plant&, const app::FirmwareNode&) {

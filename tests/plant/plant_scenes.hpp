@@ -41,7 +41,27 @@ struct SceneText {
            "checks: {" + checks + "}\n";
   }
   Scene scene() const { return read_scene(settings::Document::parse(yaml(), "<test>")); }
+  // The defaults with an integrator and its step (= the cycle).
+  static SceneText stepped(const std::string& method, const std::string& formulation, double h) {
+    SceneText t;
+    t.method = method;
+    t.formulation = formulation;
+    t.step = h;
+    t.cycle = h;
+    return t;
+  }
 };
+
+// Free motion: gravity off, zero efforts, an initial velocity on every axis (a conservative system),
+// the energy and constraint checks left to the test.
+inline Scene free_motion_scene(const std::string& method, const std::string& formulation, double h) {
+  SceneText t = SceneText::stepped(method, formulation, h);
+  t.qd_a = "[0.3, 0.04, -0.06, 0.08]";
+  t.checks = "energy_tolerance: 1e9, constraint_tolerance: 1";
+  Scene s = t.scene();
+  s.machine.gravity = 0;
+  return s;
+}
 
 // The reference machine with its hydraulics at the reference pose, the tip 1.8 m above flat ground (no soil).
 inline Scene hydraulic_scene() {

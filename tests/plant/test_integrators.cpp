@@ -24,20 +24,7 @@ struct RunResult {
   std::string message;
 };
 
-// Free motion: gravity off, zero efforts, an initial velocity on every axis. The system is
-// conservative, so the energy must stay at its initial value.
-Scene free_motion_scene(const char* method, const char* formulation, double h) {
-  SceneText t;
-  t.method = method;
-  t.formulation = formulation;
-  t.step = h;
-  t.cycle = h;
-  t.qd_a = "[0.3, 0.04, -0.06, 0.08]";
-  t.checks = "energy_tolerance: 1e9, constraint_tolerance: 1";
-  Scene s = t.scene();
-  s.machine.gravity = 0;
-  return s;
-}
+using test::free_motion_scene;  // conservative: the energy must stay at its initial value
 
 RunResult run(const Scene& scene, double seconds) {
   Plant plant(scene);

@@ -12,7 +12,6 @@
 #include <string>
 
 #include "app/firmware_node.hpp"
-#include "control/controller_kinds.hpp"
 #include "harness/lockstep_run.hpp"
 #include "plant_scenes.hpp"
 #include "sim_plant/plant.hpp"
@@ -22,8 +21,8 @@ using namespace exc;
 namespace {
 
 // The valve-driving laws the dig scene runs (flow-based control included: the dig's swing is still).
-constexpr control::ControllerKind kLaws[] = {control::ControllerKind::pid, control::ControllerKind::adaptive,
-                                             control::ControllerKind::slotine_li, control::ControllerKind::flow};
+const char* const kLaws[] = {"pid", "adaptive",
+                                             "slotine_li", "flow"};
 
 }  // namespace
 
@@ -40,7 +39,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
   double worst_detection = 0, worst_rest = 0;
   int cases = 0, detected_in_time = 0, at_rest_in_time = 0, never_at_rest = 0;
   std::string worst_detection_case, worst_rest_case;
-  for (const control::ControllerKind law : kLaws) {
+  for (const std::string law : kLaws) {
     for (int joint = 0; joint < 4; ++joint) {
       for (const double opening : {-0.8, -0.4, 0.4, 0.8}) {
         sim::LockstepOptions o;
@@ -52,12 +51,12 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
         o.fault.joint = joint;
         o.fault.magnitude = opening;
         const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
-        const std::string name = std::string(control::to_string(law)) + ", " + kActiveNames[static_cast<std::size_t>(joint)] +
+        const std::string name = law + ", " + kActiveNames[static_cast<std::size_t>(joint)] +
                                  " stuck at " + std::to_string(opening);
         INFO(name << ": " << r.failure);
         ++cases;
         REQUIRE(r.first_safe_stop_time >= 0);
-        const bool flow_swing = law == control::ControllerKind::flow && joint == 0;
+        const bool flow_swing = law == "flow" && joint == 0;
         CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible));
         const double detection = r.first_fault_detected_time - t_stick;
         CHECK(detection > 0);
@@ -92,8 +91,8 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor never tri
   // without faulting (flow-based control lags a moving swing past its tracking limit: not run there).
   for (const auto& sc : plant::test::kShippedHydraulicScenes) {
     const sim::SceneBundle b = sim::load_scene_bundle(std::string(EXC_SOURCE_DIR "/scenes/") + sc.scene);
-    for (const control::ControllerKind law : kLaws) {
-      if (law == control::ControllerKind::flow && sc.swing_moves) continue;
+    for (const std::string law : kLaws) {
+      if (law == "flow" && sc.swing_moves) continue;
       Vec4 worst = Vec4::Zero();
       sim::LockstepOptions o;
       o.controller = law;
@@ -101,7 +100,7 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor never tri
         worst = node.plausibility().worst_ratio();
       };
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
-      const std::string what = std::string(sc.scene) + ", " + control::to_string(law);
+      const std::string what = std::string(sc.scene) + ", " + law;
       INFO(what << ": " << r.failure);
       MESSAGE(what << ": largest test value / floor per function " << worst.transpose()
                        << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
@@ -162,7 +161,7 @@ TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the 
   // the same run stays stopped to its end.
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   sim::LockstepOptions o;
-  o.controller = control::ControllerKind::pid;
+  o.controller = "pid";
   o.duration = 8.0;
   o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
   o.fault.start = 3.0;
@@ -200,7 +199,7 @@ TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the 
 TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machine (controlled, named, at rest), latched until acknowledged") {
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   sim::LockstepOptions o;
-  o.controller = control::ControllerKind::adaptive;
+  o.controller = "adaptive";
   o.duration = 7.0;
   o.supervisor = {{3.0, hal::SupervisorCommand::stop},
                   {4.0, hal::SupervisorCommand::start},  // a start does not end a stop

@@ -16,11 +16,7 @@ namespace {
 // The reference pose with its tip 0.1 m deep in a stiff soil (10x stiffer and 50x more damped than
 // stiff clay: a full bucket pressed against rock), moving into it, efforts holding the weight.
 Scene stiff_soil_scene(const char* method, const char* formulation, double h) {
-  test::SceneText t;
-  t.method = method;
-  t.formulation = formulation;
-  t.step = h;
-  t.cycle = h;
+  test::SceneText t = test::SceneText::stepped(method, formulation, h);
   t.terrain = "height: 1.93";
   t.soil = "stiffness: [2e6, 2e6], damping: [5e5, 5e5], mass: [200, 200]";
   t.checks = "energy_tolerance: 100";

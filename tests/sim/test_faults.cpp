@@ -91,7 +91,7 @@ TEST_CASE("tools/excavator-sim: every shipped scene, for its full duration with 
   for (const fs::path& scene : scenes) {
     const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(scene.string());
     const exc::control::ControllerConfig& cc = bundle.firmware.controller;
-    REQUIRE_FALSE(cc.kind_given);  // no shipped scene picks a controller: each runs the defaults
+    REQUIRE_FALSE(cc.law_given);  // no shipped scene picks a controller: each runs the defaults
     // The defaults (docs/control.md): pid and adaptive, and flow on a valve-commanded scene whose
     // task holds the swing; where it moves, flow is left out and the run says why.
     const bool valves = cc.command_interface == exc::control::CommandInterface::valve;

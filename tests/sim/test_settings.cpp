@@ -15,9 +15,10 @@
 #include <vector>
 
 #include "control/controller_config.hpp"
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "control/task.hpp"
 #include "harness/lockstep_run.hpp"
+#include "sim_plant/integration_methods.hpp"
 #include "settings/section_reader.hpp"
 #include "sweep_tables.hpp"
 #include "scratch_files.hpp"
@@ -78,18 +79,18 @@ TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly
   using namespace exc;
   CHECK(names_in_row("scene-schema.md", "soil.preset", 2) == names_of(plant::kSoilPresets));
   CHECK(names_in_row("scene-schema.md", "actuators.fidelity", 2) == names_of(plant::kActuatorFidelities));
-  CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::kIntegrationMethods));
+  CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::integration_methods()));
   CHECK(names_in_row("scene-schema.md", "integrator.formulation", 2) == names_of(plant::kFormulations));
   CHECK(names_in_row("scene-schema.md", "integrator.pressure_method", 2) == names_of(plant::kPressureMethods));
-  CHECK(names_in_row("scene-schema.md", "controller.type", 2) == names_of(control::kControllerKinds));
+  CHECK(names_in_row("scene-schema.md", "controller.type", 2) == names_of(control::controller_registry()));
   CHECK(names_in_row("scene-schema.md", "controller.regressor_acceleration", 2) ==
         names_of(control::kRegressorAccelerations));
   CHECK(names_in_row("scene-schema.md", "task.type", 2) == names_of(control::kTaskTypes));
   CHECK(names_in_row("scene-schema.md", "controller.command_interface", 2) == names_of(control::kCommandInterfaces));
   CHECK(names_in_row("control.md", "command_interface", 3) == names_of(control::kCommandInterfaces));
-  CHECK(names_in_row("control.md", "type", 3) == names_of(control::kControllerKinds));
+  CHECK(names_in_row("control.md", "type", 3) == names_of(control::controller_registry()));
   CHECK(names_in_row("control.md", "regressor_acceleration", 3) == names_of(control::kRegressorAccelerations));
-  CHECK(names_in_row("sweeps.md", "sweep.controllers", 2) == names_of(control::kControllerKinds));
+  CHECK(names_in_row("sweeps.md", "sweep.controllers", 2) == names_of(control::controller_registry()));
   CHECK(names_in_row("sweeps.md", "sweep.faults", 2) == names_of(sim::kFaultKinds));
   CHECK(names_in_row("sweeps.md", "sweep.run", 2) == names_of(sim::kSweepRuns));
   CHECK(names_in_row("sweeps.md", "sweep.record", 2) == names_of(sim::kSweepRecords));

@@ -141,7 +141,7 @@ void check_mutant(const fs::path& path, const std::vector<fs::path>& files, cons
   exc::sim::SceneBundle bundle;
   if (refused_naming([&] { bundle = exc::sim::load_scene_bundle(path.string()); }, files, tally)) return;
   exc::sim::LockstepOptions options;
-  options.controller = bundle.firmware.controller.kind;
+  options.controller = bundle.firmware.controller.law;
   options.duration = std::min(3.0, bundle.scene.duration);  // past the start-up, into the task
   options.stop_at_safe_state = true;
   try {

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "harness/scene_source.hpp"
+#include "sim_plant/integration_methods.hpp"
 #include "settings_error_check.hpp"
 #include "sim_runs.hpp"
 #include "sweep_knobs.hpp"
@@ -80,7 +81,7 @@ TEST_CASE("tools/settings: the reader records each field's declaration in the do
   const Declaration* method = dig().declaration("integrator.method");
   REQUIRE(method != nullptr);
   CHECK(method->type == Declaration::Type::choice);
-  CHECK(method->what == exc::plant::kIntegrationMethods.names());
+  CHECK(method->what == exc::plant::integration_methods().names());
   CHECK(dig().declaration("sensors.no_such_field") == nullptr);
   CHECK(dig().declaration("soil.stiffness") == nullptr);  // the dig's soil is a preset: its K is not read
 }
@@ -143,7 +144,7 @@ TEST_CASE("tools/sweep knobs: the named knobs write the settings their rows name
   // The open loop's: the integrator by its two names, the step with its cycle, the soil's damping ratio kept.
   const SceneBundle rk4 = with("integrator", SweepValue{SweepValue::Type::name, 0, {}, "rk4/augmented_baumgarte"},
                                SweepRun::open_loop);
-  CHECK(rk4.scene.integrator.method == exc::plant::IntegrationMethod::rk4);
+  CHECK(rk4.scene.integrator.method == "rk4");
   CHECK(rk4.scene.integrator.formulation == exc::plant::Formulation::augmented_baumgarte);
   const SceneBundle coarse = with("integrator.step", number(5e-3), SweepRun::open_loop);
   CHECK(coarse.scene.integrator.step == 5e-3);

@@ -24,7 +24,7 @@
 #include "app/node_io.hpp"
 #include "app/realtime_setup.hpp"
 #include "app/run_summary.hpp"
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "settings/section_reader.hpp"
 
 namespace {
@@ -45,8 +45,9 @@ int main(int argc, char** argv) {
   bool realtime = false, print_config = false, wait_for_start = false;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config)");
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
-  app.add_option("--controller", controller, exc::control::kControllerKinds.names() + " (default: the scene's controller.type, else adaptive)")
-      ->check(CLI::IsMember(exc::control::kControllerKinds.name_list()));
+  app.add_option("--controller", controller, "the control law (default: the scene's controller.type, else adaptive):\n" +
+                                                 exc::control::controller_registry().help())
+      ->check(CLI::IsMember(exc::control::controller_registry().name_list()));
   app.add_option("--duration", duration, "seconds to run (default: the scene's duration)")
       ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   app.add_option("--json", json_path, "write the run's summary (ok, tracking figures, timing, deadlines) here");
@@ -80,19 +81,18 @@ int main(int argc, char** argv) {
     }
     const exc::Model model = exc::build_model(settings.machine);
     exc::app::FirmwareNodeConfig fc;
-    fc.kind = settings.controller.kind;  // the scene's controller.type unless --controller says otherwise
+    fc.controller = settings.controller;  // the scene's controller.type unless --controller says otherwise
     if (!controller.empty()) {
-      if (settings.controller.kind_given && *exc::control::kControllerKinds.named(controller) != settings.controller.kind) {
+      if (settings.controller.law_given && controller != settings.controller.law) {
         std::cerr << "excavator-firmware: --controller " << controller << " conflicts with the scene's controller.type "
-                  << exc::control::to_string(settings.controller.kind) << " (" << scene_path << "); give one of them\n";
+                  << settings.controller.law << " (" << scene_path << "); give one of them\n";
         return 2;
       }
-      fc.kind = *exc::control::kControllerKinds.named(controller);
+      fc.controller.law = controller;
     }
-    fc.controller = settings.controller;
     fc.site_map = settings.terrain;
     fc.wait_for_start = wait_for_start;
-    const char* const kind_name = exc::control::to_string(fc.kind);
+    const char* const law_name = fc.controller.law.c_str();
 
     const double period_s = settings.controller.period;
     const auto period_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));
@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
     run.max_overrun_fraction = max_overrun_fraction;
     run.stop_hold_s = fc.controller.blend_time;
     std::printf("excavator-firmware: %s on %s, %lld cycles of %.3g ms, %s; sensor wait %.3g ms; floating point: %s%s%s\n",
-                kind_name, iface.c_str(), static_cast<long long>(run.cycles), period_s * 1e3,
+                law_name, iface.c_str(), static_cast<long long>(run.cycles), period_s * 1e3,
                 realtime ? "real time (absolute deadlines)" : "lockstep with the plant", wait_ms,
                 exc::app::kFloatModes.name_of(exc::app::float_mode_of_thread()), rt_notes.empty() ? "" : "; ",
                 rt_notes.c_str());
@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
 
     const exc::app::RunnerOutcome outcome = exc::app::run_firmware(node, *io.bus, run, g_signals, stdout);
     if (io.publisher) io.publisher->stop();
-    const exc::app::RunContext context{node,     outcome, kind_name, realtime, period_s, port.rx_stats().rejected(),
+    const exc::app::RunContext context{node,     outcome, law_name, realtime, period_s, port.rx_stats().rejected(),
                                        io.publisher.get(), overflow};
     exc::app::print_run_summary(context, stdout);
     if (!json_path.empty()) {

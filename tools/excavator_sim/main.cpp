@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "app/float_environment.hpp"
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "report/in_process_run.hpp"
 #include "output_files/output_file.hpp"
 #include "sweep/robustness.hpp"
@@ -54,8 +54,8 @@ int main(int argc, char** argv) {
   bool quiet = false;
   run->add_option("scene", scene_path, "scene file (YAML), e.g. scenes/dig.yaml")->required();
   run->add_option("--controller", controllers,
-                  "controller(s) to run: " + exc::control::kControllerKinds.names() +
-                      " (default: the scene's controller.type, else pid and adaptive, and flow on a valve-commanded scene whose task holds the swing)")
+                  "controller(s) to run (default: the scene's controller.type, else pid and adaptive, and flow on a "
+                  "valve-commanded scene whose task holds the swing):\n" + exc::control::controller_registry().help())
       ->delimiter(',');
   run->add_option("--out", out_dir, "output directory (default: out/<scene name>)");
   run->add_option("--json", json_path, "also write the summary as JSON to this file");
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
   robust->add_option("scene", robust_scene, "scene file (YAML), e.g. scenes/dig.yaml (default: the spec's)");
   robust->add_option("--spec", robust_spec, "the sweep spec whose variants run")->capture_default_str();
   robust->add_option("--controller", robust_controllers,
-                     "controller(s): " + exc::control::kControllerKinds.names() + " (default: the spec's, pid and adaptive)")
+                     "controller(s): " + exc::control::controller_registry().names() + " (default: the spec's, pid and adaptive)")
       ->delimiter(',');
   robust->add_option("--json", robust_json, "write the table as JSON to this file");
   robust->add_option("--duration", robust_duration, "simulated seconds per run (default: the scene's duration)")

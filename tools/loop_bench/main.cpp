@@ -17,7 +17,7 @@
 
 #include "app/float_environment.hpp"
 #include "bench/closed_loop_bench.hpp"
-#include "control/controller_kinds.hpp"
+#include "control/controller_registry.hpp"
 #include "model/scene_common.hpp"
 #include "option_checks.hpp"
 #include "output_files/output_file.hpp"
@@ -59,9 +59,9 @@ int main(int argc, char** argv) {
       ->group("");
     if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
 
-  const auto kind = control::kControllerKinds.named(controller);
-  if (!kind) {
-    std::fprintf(stderr, "excavator-loop-bench: unknown controller '%s'\n", controller.c_str());
+  if (!control::controller_registry().find(controller)) {
+    std::fprintf(stderr, "excavator-loop-bench: unknown controller '%s' (allowed: %s)\n", controller.c_str(),
+                 control::controller_registry().names().c_str());
     return 2;
   }
   if (pin) {
@@ -75,7 +75,7 @@ int main(int argc, char** argv) {
     const sim::SceneBundle bundle = sim::load_scene_bundle(scene_path);
     const double load_s = bench::cpu_seconds(CLOCK_THREAD_CPUTIME_ID) - load0;
     sim::LockstepOptions options;
-    options.controller = *kind;
+    options.controller = controller;
     options.duration = duration;
     const std::string log = "/tmp/loop-bench-" + std::to_string(getpid()) + ".lcm";
     if (child) {

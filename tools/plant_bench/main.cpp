@@ -15,6 +15,7 @@
 #include "app/float_environment.hpp"
 #include "bench/plant_drivers.hpp"
 #include "output_files/output_file.hpp"
+#include "sim_plant/integration_methods.hpp"
 #include "sim_plant/plant.hpp"
 
 using namespace exc;
@@ -93,10 +94,10 @@ int main(int argc, char** argv) {
   std::printf("## Plant step time, dig scene with ideal force actuators at 1 kHz (step = cycle = 1 ms), per "
               "integrator x formulation\n\n");
   std::printf("| method | formulation | median us | p99 us | max us | real-time factor | finished |\n|---|---|---|---|---|---|---|\n");
-  for (const auto& [m, method_name, method_what] : kIntegrationMethods.entries) {
+  for (const IntegrationMethodEntry& method : integration_methods().entries()) {
     for (const auto& [f, formulation_name, formulation_what] : kFormulations.entries) {
       Scene s = forces;
-      s.integrator.method = m;
+      s.integrator.method = method.name;
       s.integrator.formulation = f;
       TaskDriver driver(task, s.machine);
       Plant p(s);
@@ -114,7 +115,7 @@ int main(int argc, char** argv) {
       const Stats st = stats(us);
       double total = 0;
       for (double x : us) total += x;
-      std::printf("| %s | %s | %.2f | %.2f | %.1f | %.0fx | %s |\n", to_string(m), to_string(f), st.median, st.p99,
+      std::printf("| %s | %s | %.2f | %.2f | %.1f | %.0fx | %s |\n", method.name.c_str(), to_string(f), st.median, st.p99,
                   st.max, p.state().time / (total * 1e-6), ok ? "yes" : p.status().text());
     }
   }
@@ -127,7 +128,7 @@ int main(int argc, char** argv) {
   std::printf("\n## Hydraulic step, dig scene through its valves (%s / %s, %g ms; chambers: 8 scalar solves per "
               "substep)\n\n| pressures | median us | p99 us | max us | chamber iterations per step: mean, p99 "
               "(per solve) | real-time factor | finished |\n|---|---|---|---|---|---|---|\n",
-              to_string(base.integrator.method), to_string(base.integrator.formulation), base.integrator.step * 1e3);
+              base.integrator.method.c_str(), to_string(base.integrator.formulation), base.integrator.step * 1e3);
   for (const auto& [pm, pm_name, pm_what] : kPressureMethods.entries) {
     Scene s = base;
     s.actuators.fidelity = ActuatorFidelity::hydraulic;
@@ -192,17 +193,17 @@ int main(int argc, char** argv) {
   std::printf("\n## Dig scene with ideal force actuators (%s / %s, %g ms): real-time factor %.0fx over the whole run "
               "(1 s in %.2f ms), %.0fx at the median step of %.2f us (target >= 200x: 1 s in 5 ms); deepest %.2f m, %g "
               "re-anchorings\n",
-              to_string(forces.integrator.method), to_string(forces.integrator.formulation), forces.integrator.step * 1e3,
+              forces.integrator.method.c_str(), to_string(forces.integrator.formulation), forces.integrator.step * 1e3,
               best, 1e3 / best, forces.cycle * 1e6 / best_median, best_median, depth, reanchors);
 
   std::printf("\n## Largest stable step in stiff clay (tip 0.1 m in, moving into it, 2 s; bisection)\n\n");
   std::printf("| method | formulation | largest stable step ms | first failure |\n|---|---|---|---|\n");
-  for (const auto& [m, method_name, method_what] : kIntegrationMethods.entries) {
+  for (const IntegrationMethodEntry& method : integration_methods().entries()) {
     for (const auto& [f, formulation_name, formulation_what] : kFormulations.entries) {
       double lo = 0, hi = 0;
       std::string why, why_hi;
       for (double h = 1e-3; h <= 1.0; h *= 2) {
-        if (stable_in_stiff_clay(base, m, f, h, why)) {
+        if (stable_in_stiff_clay(base, method.name, f, h, why)) {
           lo = h;
         } else {
           hi = h;
@@ -213,7 +214,7 @@ int main(int argc, char** argv) {
       if (hi > 0 && lo > 0) {
         for (int i = 0; i < 6; ++i) {
           const double mid = std::sqrt(lo * hi);
-          if (stable_in_stiff_clay(base, m, f, mid, why)) lo = mid;
+          if (stable_in_stiff_clay(base, method.name, f, mid, why)) lo = mid;
           else {
             hi = mid;
             why_hi = why;
@@ -221,7 +222,7 @@ int main(int argc, char** argv) {
         }
       }
       const std::string short_why = why_hi.empty() ? "none up to 1 s" : why_hi.substr(why_hi.find(": ") + 2, 70);
-      std::printf("| %s | %s | %.1f | %s |\n", to_string(m), to_string(f), lo * 1e3, short_why.c_str());
+      std::printf("| %s | %s | %.1f | %s |\n", method.name.c_str(), to_string(f), lo * 1e3, short_why.c_str());
     }
   }
   return 0;
