@@ -14,6 +14,11 @@ struct CanFrame {
   bool brs = false;            // FD only: bit-rate switch, the data phase at the data bit rate
   std::uint8_t data[kCanFdMaxLength] = {};  // payload; bytes at and beyond len are zero when sent by this HAL
   std::int64_t timestamp_ns = 0;  // receive time, CLOCK_MONOTONIC ns (0 when the backend has none)
+  // The frame's exact on-wire time (frame_time_ns) as its sender timed it, carried with the frame so
+  // that a receiver on an in-process bus does not time the same bits again; 0: not known (a frame
+  // from a kernel socket, one built by hand, one whose bits a bus changed after it was timed), and the
+  // receiver times it itself.
+  std::int64_t wire_ns = 0;
 };
 
 // The payload lengths a frame can have: 0..8 bytes, and for CAN FD the DLC codes 9..15 mean 12, 16,

@@ -47,18 +47,19 @@ bool CanPortEnd::transmit(const MessageSpec& message, std::uint8_t counter, cons
   const EncodeReport report = encode_message(message, counter, values, frame);
   tx_.saturated += report.saturated;
   tx_.non_finite += report.non_finite;
+  frame.wire_ns = frame_time_ns(frame);  // timed once: the receivers take it from the frame
   if (!bus_.send(frame)) {
     ++tx_.send_failed;
     return false;
   }
   ++tx_.frames_sent;
-  tx_.bus_ns += static_cast<std::uint64_t>(frame_time_ns(frame));
+  tx_.bus_ns += static_cast<std::uint64_t>(frame.wire_ns);
   return true;
 }
 
 bool CanPortEnd::receive_valid(CanFrame& frame, const MessageSpec*& message) {
   while (bus_.receive(frame)) {
-    rx_bus_ns_ += static_cast<std::uint64_t>(frame_time_ns(frame));
+    rx_bus_ns_ += static_cast<std::uint64_t>(frame.wire_ns != 0 ? frame.wire_ns : frame_time_ns(frame));
     if (codec_.accept(frame, message) != RxVerdict::ok) continue;
     last_valid_rx_ns_ = frame.timestamp_ns != 0 ? frame.timestamp_ns : monotonic_now_ns();
     return true;

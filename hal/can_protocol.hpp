@@ -25,6 +25,13 @@ struct SignalSpec {
   double min;
   double max;
   const char* unit;
+  // Derived from the fields above when the table is built (the codec's per-signal work, every frame):
+  // the field's mask, the raw values it can hold, and whether it lies in the 8-byte word from its
+  // first byte within the 64-byte payload (every signal of the protocol does).
+  std::uint64_t raw_mask = length >= 64 ? ~0ULL : ((1ULL << length) - 1);
+  std::int64_t raw_min = is_signed ? -(std::int64_t{1} << (length - 1)) : 0;
+  std::int64_t raw_max = is_signed ? (std::int64_t{1} << (length - 1)) - 1 : static_cast<std::int64_t>(raw_mask);
+  bool one_word = length != 0 && length <= 64 && start % 8 + length <= 64 && start / 8 + 8 <= 64;
 };
 
 // Which command set a frame belongs to (the DBC attribute ExcCommandSet); the three are exclusive.

@@ -44,6 +44,7 @@ bool FaultInjectingBus::send(const CanFrame& frame) {
     CanFrame damaged = frame;
     const auto bit = static_cast<unsigned>(random_() % (8u * damaged.len));
     damaged.data[bit / 8] = static_cast<std::uint8_t>(damaged.data[bit / 8] ^ (1u << (bit % 8)));
+    damaged.wire_ns = 0;  // other bits, other stuffing: the receiver times what it got
     result = inner_.send(damaged);
   } else if (u < config_.drop_fraction + config_.corrupt_fraction + config_.delay_fraction) {
     if (held_count_ < kDelayCapacity) {

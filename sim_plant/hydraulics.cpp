@@ -119,8 +119,13 @@ double HydraulicCircuit::piston_leakage_flow(double coefficient, double dp, doub
 void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   HydraulicReport& r = report_;
   HydraulicEnergy& e = r.energy;
+  if (dt != lag_dt_) {
+    pilot_lag_gain_ = spool_lag_gain(hp_.pilot_cutoff_time, dt);
+    spool_lag_gain_ = spool_lag_gain(hp_.valve_time_constant, dt);
+    lag_dt_ = dt;
+  }
   // The safety hardware: the pilot supply (first order) and the engine's flow (linear run-down).
-  pilot_ += ((pilot_on_ ? 1.0 : 0.0) - pilot_) * spool_lag_gain(hp_.pilot_cutoff_time, dt);
+  pilot_ += ((pilot_on_ ? 1.0 : 0.0) - pilot_) * pilot_lag_gain_;
   engine_ = std::clamp(engine_ + (engine_on_ ? dt : -dt) / hp_.engine_rundown_time, 0.0, 1.0);
   const bool holding_closed = holding_valves_closed();
   r.pilot_supply = pilot_;
@@ -128,7 +133,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   r.holding_valves_closed = holding_closed;
   // Spools: lag toward the target (what the pilots push, as far as the supply gives them), then the
   // dead zone of the direction they moved in.
-  const double lag_gain = spool_lag_gain(hp_.valve_time_constant, dt);
+  const double lag_gain = spool_lag_gain_;
   for (int i = 0; i < kNumActive; ++i) {
     spool_[i] = i == stuck_ ? stuck_spool_ : spool_lag(spool_[i], target_[i] * pilot_, lag_gain);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);

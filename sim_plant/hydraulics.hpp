@@ -21,6 +21,7 @@
 // (Machine::hydraulics).
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 #include "model/hydraulic_geometry.hpp"
@@ -149,6 +150,9 @@ class HydraulicCircuit {
   double pilot_ = 1, engine_ = 1;
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();
   Vec4 v_a_ = Vec4::Zero(), v_b_ = Vec4::Zero();  // chamber volumes at the end of the last substep
+  // The two first-order lags' gains (pilot supply, spools) for the step `lag_dt_`: the plant's step
+  // is fixed, so the two exp() are taken once, not every substep (NaN: none yet).
+  double lag_dt_ = std::numeric_limits<double>::quiet_NaN(), pilot_lag_gain_ = 0, spool_lag_gain_ = 0;
   HydraulicReport report_;
 };
 

@@ -7,6 +7,6 @@
 namespace exc::plant {
 
 double kinetic_energy(const Model& model, const Workspace& ws);
-double potential_energy(const Model& model, Workspace& ws);  // fills the world poses it needs
+double potential_energy(const Model& model, const Workspace& ws);
 
 }  // namespace exc::plant

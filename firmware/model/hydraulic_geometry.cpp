@@ -4,26 +4,6 @@
 
 namespace exc {
 
-void orifice_flow(double dp, double laminar_pressure, double& flow, double& dflow_ddp) {
-  const double a = std::abs(dp);
-  if (a < laminar_pressure) {
-    // Linear branch meeting sqrt at dp = laminar_pressure (same value there).
-    const double s = 1.0 / std::sqrt(laminar_pressure);
-    flow = dp * s;
-    dflow_ddp = s;
-  } else {
-    const double r = std::sqrt(a);
-    flow = dp > 0 ? r : -r;
-    dflow_ddp = 0.5 / r;
-  }
-}
-
-double orifice_unit_flow(double dp, double laminar_pressure) {
-  double f, df;
-  orifice_flow(dp, laminar_pressure, f, df);
-  return f;
-}
-
 HydraulicGeometry hydraulic_geometry(const Machine& machine) {
   const HydraulicParameters& h = machine.hydraulics;
   const Vec4 effort_min = machine.effort_min(), effort_max = machine.effort_max(), speed_max = machine.speed_max();

@@ -11,15 +11,35 @@
 //              K_out = A v_max / q(valve_pressure_drop);
 // with q(dp) the orifice law for unit gain and opening (hydraulics.md): Q = K a sqrt(dp), linear
 // below hydraulics.laminar_pressure. Start-up code, except the orifice law (used every substep).
+#include <cmath>
+
 #include "model/machine.hpp"
 
 namespace exc {
 
 // Flow for unit gain and opening, and its derivative with respect to dp. Linear below the laminar
 // pressure (meeting the square root there) so that the flow and its derivative stay finite at dp = 0.
-void orifice_flow(double dp, double laminar_pressure, double& flow, double& dflow_ddp);
+// Inline: the plant's chamber solver and the firmware's valve loop and pressure monitor call it a few
+// dozen times a cycle with arguments the compiler can often fold.
+inline void orifice_flow(double dp, double laminar_pressure, double& flow, double& dflow_ddp) {
+  const double a = std::abs(dp);
+  if (a < laminar_pressure) {
+    // Linear branch meeting sqrt at dp = laminar_pressure (same value there).
+    const double s = 1.0 / std::sqrt(laminar_pressure);
+    flow = dp * s;
+    dflow_ddp = s;
+  } else {
+    const double r = std::sqrt(a);
+    flow = dp > 0 ? r : -r;
+    dflow_ddp = 0.5 / r;
+  }
+}
 // The flow alone.
-double orifice_unit_flow(double dp, double laminar_pressure);
+inline double orifice_unit_flow(double dp, double laminar_pressure) {
+  double f, df;
+  orifice_flow(dp, laminar_pressure, f, df);
+  return f;
+}
 
 // Per function, swing, boom, arm, bucket; side A is the bore side (extends) and the swing's port A
 // (swings counter-clockwise), side B the annulus and port B.

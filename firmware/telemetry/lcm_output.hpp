@@ -8,13 +8,15 @@
 #include <string>
 
 typedef struct _lcm_t lcm_t;
+typedef struct _lcm_eventlog_t lcm_eventlog_t;
 
 namespace exc::telemetry {
 
 class LcmOutput {
  public:
   // Opens the provider named by `url`: udpm://239.255.76.67:7667?ttl=0 for live use with
-  // lcm-logger and lcm-spy, file://run.lcm?mode=w to write a log file with no other process.
+  // lcm-logger and lcm-spy, file://run.lcm?mode=w to write a log file with no other process (by
+  // LCM's log writer, eventlog.h, directly: the same file as its file provider writes).
   // Returns nullptr and sets `error` (naming the URL and the accepted forms) if LCM refuses it.
   static std::shared_ptr<LcmOutput> open(const std::string& url, std::string* error);
 
@@ -27,8 +29,11 @@ class LcmOutput {
   const std::string& url() const { return url_; }
 
  private:
-  LcmOutput(lcm_t* lcm, std::string url) : lcm_(lcm), url_(std::move(url)) {}
-  lcm_t* lcm_;
+  LcmOutput(lcm_t* lcm, lcm_eventlog_t* log, std::string url) : lcm_(lcm), log_(log), url_(std::move(url)) {}
+  lcm_t* lcm_;           // a provider (udpm://, memq://, file:// with options), or
+  lcm_eventlog_t* log_;  // for file://PATH?mode=w, LCM's log writer itself (lcm_output.cpp)
+  static constexpr std::size_t kLogBufferBytes = 64 * 1024;
+  std::unique_ptr<char[]> buffer_;  // the log file's stdio buffer
   std::string url_;
   std::mutex mutex_;
 };

@@ -48,6 +48,40 @@ TEST_CASE("hal/crc8 SAE J1850 matches its published check value") {
   CHECK(crc8_sae_j1850(&empty, 0) == 0x00);  // init 0xFF xor 0xFF
 }
 
+TEST_CASE("hal/crc8 eight bytes at a time equals the bit-by-bit definition at every length") {
+  // The polynomial division one bit at a time (init 0xFF, poly 0x1D, final xor 0xFF), independent of
+  // the codec's tables, over random payloads of every length a frame can have and across the 8-byte
+  // blocks the codec folds at once.
+  auto bitwise = [](const std::uint8_t* bytes, std::size_t length) {
+    unsigned crc = 0xFF;
+    for (std::size_t i = 0; i < length; ++i) {
+      for (int b = 7; b >= 0; --b) {
+        const unsigned in = (bytes[i] >> b) & 1u, top = (crc >> 7) & 1u;
+        crc = (crc << 1) & 0xFFu;
+        if ((in ^ top) != 0) crc ^= 0x1Du;
+      }
+    }
+    return static_cast<std::uint8_t>(crc ^ 0xFF);
+  };
+  std::mt19937 random(34);
+  std::uint8_t bytes[kCanFdMaxLength + 2];
+  for (int trial = 0; trial < 50; ++trial) {
+    for (auto& b : bytes) b = static_cast<std::uint8_t>(random());
+    for (std::size_t length = 0; length <= sizeof bytes; ++length) {
+      CAPTURE(length);
+      CHECK(crc8_sae_j1850(bytes, length) == bitwise(bytes, length));
+    }
+    // frame_checksum is the same CRC over the identifier's two bytes (little-endian), then the payload.
+    const std::uint32_t id = random() & 0x7FFu;
+    std::uint8_t with_id[2 + kCanFdMaxLength];
+    with_id[0] = static_cast<std::uint8_t>(id & 0xFF);
+    with_id[1] = static_cast<std::uint8_t>(id >> 8);
+    std::memcpy(with_id + 2, bytes, kCanFdMaxLength);
+    for (std::size_t length = 0; length < kCanFdMaxLength; ++length)
+      CHECK(frame_checksum(id, bytes, length) == bitwise(with_id, length + 2));
+  }
+}
+
 TEST_CASE("hal/codec tables match excavator.dbc message by message and signal by signal") {
   exc::test::DbcNetwork network;
   const auto dbc = exc::test::read_dbc(EXC_CAN_DBC_FILE, &network);

@@ -8,6 +8,7 @@
 
 #include "app/allocation_counter.hpp"
 #include "port_fixtures.hpp"
+#include "hal/can_bus_load.hpp"
 #include "hal/can_ports.hpp"
 #include "hal/clock.hpp"
 #include "hal/fault_injecting_bus.hpp"
@@ -293,6 +294,40 @@ TEST_CASE("hal/ports loop survives corrupted frames and counts every one") {
   CHECK(r.firmware_rx.corrupt == bench.pl_bus.stats().corrupted);
   CHECK(r.plant_rx.corrupt == bench.fw_bus.stats().corrupted);
   CHECK(r.complete > 0.94 * r.cycles);
+}
+
+TEST_CASE("hal/ports time every frame received at its exact on-wire length, one corrupted on the way as it arrived") {
+  // The sender times each frame once and the frame carries it; a bus that flips a bit must make the
+  // receiver time what it got (another stuffing). A third node sees every frame as the plant does and
+  // times each one afresh: the plant's count must be its sum.
+  SimClock clock;
+  MemoryBusHub hub{&SimClock::read, &clock};
+  MemoryBusNode* fw_node = hub.attach();
+  MemoryBusNode* pl_node = hub.attach();
+  MemoryBusNode* observer = hub.attach();
+  FaultInjection faults;
+  faults.corrupt_fraction = 0.3;
+  faults.seed = 5;
+  FaultInjectingBus fw_bus(*fw_node, faults);
+  FirmwareCanPort firmware(fw_bus);
+  PlantCanPort plant(*pl_node);
+  std::uint64_t observed_ns = 0;
+  for (std::uint64_t k = 0; k < 2000; ++k) {
+    clock.now_ns += kCyclePeriodNs;
+    firmware.send_sync(k);
+    firmware.write(command_for(k, CommandMode::pilot));
+    std::uint64_t cycle = 0;
+    while (plant.poll_sync(cycle)) {
+    }
+    CanFrame frame;
+    while (observer->receive(frame)) observed_ns += static_cast<std::uint64_t>(frame_time_ns(frame));
+  }
+  REQUIRE(fw_bus.stats().corrupted > 100);
+  // The test's power: the corrupted frames' stuffing changed the bus time, so a receiver that took the
+  // sender's time for them would count another sum.
+  REQUIRE(observed_ns != firmware.tx_stats().bus_ns);
+  CHECK(plant.rx_bus_ns() == observed_ns);
+  CHECK(plant.rx_stats().corrupt == fw_bus.stats().corrupted);
 }
 
 TEST_CASE("hal/ports loop survives delayed (reordered) frames") {
