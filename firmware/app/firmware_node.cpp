@@ -239,8 +239,7 @@ void FirmwareNode::take_supervisor_commands() {
     operator_stop_on_rest_ = true;
     if (mode == control::Mode::track && !path_stop_.active()) begin_path_stop(time());
   }
-  const bool path_moving = path_stop_.active() && !path_stop_.done(time() - path_stop_start_);
-  if (operator_stop_on_rest_ && !path_moving && !fault_) {
+  if (operator_stop_on_rest_ && !path_stop_moving(time()) && !fault_) {
     operator_stop_on_rest_ = false;
     raise(FirmwareFault::operator_stop);
     pending_time_ = operator_stop_time_;  // detected when its frame came, whatever the deceleration took
@@ -250,8 +249,12 @@ void FirmwareNode::take_supervisor_commands() {
   }
 }
 
+bool FirmwareNode::path_stop_moving(double t) const {
+  return path_stop_.active() && !path_stop_.done(t - path_stop_start_);
+}
+
 void FirmwareNode::begin_path_stop(double t) {
-  const double tau0 = t - track_start_ + task_.start_time();
+  const double tau0 = unslowed_task_time(t);
   Vec4 q, yd, ydd;
   task_.trajectory.evaluate(tau0, q, yd, ydd);
   path_stop_.begin(tau0, yd, model_.machine.speed_max(), config_.controller.stop_ramp_time);
@@ -262,7 +265,7 @@ double FirmwareNode::path_time_at(double t, double& rate, double& rate_dot) cons
   if (!path_stop_.active()) {
     rate = 1;
     rate_dot = 0;
-    return t - track_start_ + task_.start_time();
+    return unslowed_task_time(t);
   }
   double tau = 0;
   path_stop_.path_time(t - path_stop_start_, tau, rate, rate_dot);
@@ -301,8 +304,7 @@ void FirmwareNode::end_cycle() {
 
   // A stop request decelerates a tracking machine along its path first; it holds once the path is at rest.
   if (stop_requested_ && machine_.mode() == control::Mode::track && !path_stop_.active()) begin_path_stop(t);
-  const bool path_moving = path_stop_.active() && !path_stop_.done(t - path_stop_start_);
-  double rate = 1, rate_dot = 0;
+  double rate = 1, rate_dot = 0;  // for compute_command, which takes them again after the transition
   const double tau = path_time_at(t, rate, rate_dot);
 
   control::StateMachineInputs in;
@@ -312,7 +314,7 @@ void FirmwareNode::end_cycle() {
   // The task starts once. After a safe stop the machine holds where it is when the sensors are back:
   // resuming would restart the path from its first point, a step command nobody asked for.
   in.track_requested = t >= config_.track_delay && safe_stops_ == 0 && (start_received_ || !config_.wait_for_start);
-  in.stop_requested = stop_requested_ && !path_moving;
+  in.stop_requested = stop_requested_ && !path_stop_moving(t);
   // Once the task has ended it stays ended: hold must not re-enter track and restart the path.
   in.trajectory_finished = finished_ || (machine_.mode() == control::Mode::track && tau >= task_.end_time());
   in.fault = fault_;

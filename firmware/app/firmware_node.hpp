@@ -190,7 +190,9 @@ class FirmwareNode {
   void take_supervisor_commands();
   // The stop along the path (control/path_stop.hpp) from loop time t, and the path time at t.
   void begin_path_stop(double t);
+  bool path_stop_moving(double t) const;  // a stop along the path is slowing the path at loop time t
   double path_time_at(double t, double& rate, double& rate_dot) const;
+  double unslowed_task_time(double t) const { return t - track_start_ + task_.start_time(); }
   // The velocity plausibility monitor on this cycle's valve command (valve interface).
   void check_plausibility(bool restarted);
   // What the flow plausibility monitor measures: positions, the oil columns' compression F / K_h
