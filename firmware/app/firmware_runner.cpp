@@ -34,19 +34,25 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
   hal::DeadlineSleeper sleeper(period_ns);
   std::int64_t last_wake = 0;
   bool grid_started = false;
-  std::int64_t stop_cycle = -1;  // cycle of the stop request: the machine then holds, and the run ends
+  std::int64_t request_cycle = -1;  // cycle of the stop request
+  std::int64_t still_cycle = -1;    // first cycle after it with the path at rest: the hold's time counts from here
   for (std::int64_t k = 0; k < options.cycles && stop_requests.load() < 2; ++k) {
-    if (stop_requests.load() == 1 && stop_cycle < 0) {
+    if (stop_requests.load() == 1 && request_cycle < 0) {
       outcome.stop_requested = true;
       // A tracking machine is brought to hold first; in any other mode there is nothing to stop.
       if (!node.tracking()) break;
       node.request_stop();
-      stop_cycle = k;
+      request_cycle = k;
       if (progress)
-        std::fprintf(progress, "excavator-firmware: stop requested: holding for %.2f s, then exiting\n",
+        std::fprintf(progress,
+                     "excavator-firmware: stop requested: decelerating along the path, then holding for %.2f s, "
+                     "then exiting\n",
                      options.stop_hold_s);
     }
-    if (stop_cycle >= 0 && static_cast<double>(k - stop_cycle) * period_s > options.stop_hold_s) break;
+    // The node starts the deceleration in the request's cycle: from the next one on, a node no
+    // longer slowing its path stands (or was stopped by a fault).
+    if (request_cycle >= 0 && still_cycle < 0 && k > request_cycle && !node.stopping_on_path()) still_cycle = k;
+    if (still_cycle >= 0 && static_cast<double>(k - still_cycle) * period_s > options.stop_hold_s) break;
     if (options.realtime && grid_started) {
       sleeper.wait_next();
       const std::int64_t now = hal::monotonic_now_ns();

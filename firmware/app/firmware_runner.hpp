@@ -23,7 +23,7 @@ struct RunnerOptions {
   std::int64_t sensor_wait_ns = 250'000'000;       // a cycle's wait for sensors once the plant has answered
   std::int64_t startup_wait_ns = 60'000'000'000;   // the wait until its first answer
   double max_overrun_fraction = 0.01;              // real time: late wake-ups + skipped periods allowed
-  double stop_hold_s = 0;                          // after a stop request: hold this long, then end
+  double stop_hold_s = 0;  // after a stop request and the deceleration along the path: hold this long, then end
 };
 
 // Real time lets the sensor wait run to 10 % of the period before the next deadline: the longest
@@ -39,7 +39,7 @@ struct RunnerOutcome {
 };
 
 // Runs the cycle until options.cycles are done or stop_requests says so: at 1 a tracking machine
-// is brought to hold for stop_hold_s and the run ends (any other mode ends at once), at 2 the run
+// decelerates along its path, holds for stop_hold_s and the run ends (any other mode ends at once), at 2 the run
 // ends now. Mode changes are written to progress (may be null). Returns the verdict: a run that
 // never tracked, went to its safe state or (real time) missed more deadlines than allowed failed.
 RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOptions& options,

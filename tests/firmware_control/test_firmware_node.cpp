@@ -107,11 +107,13 @@ struct AnsweringBus final : hal::CanBus {
   std::atomic<int>* stop_requests = nullptr;
   std::uint64_t stop_at_cycle = 0, stall_at_cycle = 0;  // 0: never
   std::int64_t stall_ns = 0;
+  std::uint64_t hold_from = 0;  // the first cycle after stop_at_cycle the node was seen in hold (0: never)
   explicit AnsweringBus(Loop& l) : loop(l) {}
   bool send(const hal::CanFrame& frame) override { return loop.fw_bus->send(frame); }
   bool receive(hal::CanFrame& frame) override { return loop.fw_bus->receive(frame); }
   bool wait_readable(std::int64_t) override {
     const std::uint64_t k = loop.node.cycle();
+    if (hold_from == 0 && stop_requests && k > stop_at_cycle && loop.node.mode() == Mode::hold) hold_from = k;
     if (stop_requests && k == stop_at_cycle) stop_requests->fetch_add(1);
     if (k == stall_at_cycle && stall_ns > 0) {
       const std::int64_t until = hal::monotonic_now_ns() + stall_ns;
@@ -721,7 +723,7 @@ TEST_CASE("firmware/runner: a lockstep run does its cycles, tracks, and leaves t
   CHECK_FALSE(loop.command.emergency_stop);
 }
 
-TEST_CASE("firmware/runner: a stop request holds a tracking machine for the hold time, then ends, and before tracking ends at once") {
+TEST_CASE("firmware/runner: a stop request decelerates a tracking machine along its path, holds it for the hold time, then ends, and before tracking ends at once") {
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   cfg.controller.law = "pid";
@@ -740,9 +742,13 @@ TEST_CASE("firmware/runner: a stop request holds a tracking machine for the hold
     CHECK(out.ok);
     CHECK(loop.node.mode() == Mode::hold);
     // The request came while cycle 2000 waited: seen at the next cycle's start; the machine slows
-    // along its path and holds, and the run ends stop_hold_s after the request.
-    CHECK(out.cycles >= 2000 + 500);
-    CHECK(out.cycles <= 2000 + 503);
+    // along its path (at most (pi / 2) stop_ramp_time) and holds, and the run ends stop_hold_s after
+    // the hold began, so the machine stands for all of it.
+    REQUIRE(bus.hold_from > 2001);
+    CHECK(static_cast<double>(bus.hold_from - 2001) * 1e-3 <= 0.5 * M_PI * cfg.controller.stop_ramp_time + 2e-3);
+    CHECK(out.cycles >= bus.hold_from + 500);
+    CHECK(out.cycles <= bus.hold_from + 503);
+    MESSAGE("stop requested at cycle 2000: in hold from " << bus.hold_from << ", run ended at " << out.cycles);
   }
   {
     Loop loop(model, sim::kFreeMotionTask, cfg);
