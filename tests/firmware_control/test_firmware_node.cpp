@@ -321,6 +321,34 @@ TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over
   }
 }
 
+TEST_CASE("firmware/node: zero heap allocations through a stop along the path (request, deceleration, hold) in the dig task") {
+  REQUIRE(exc::app::allocation_counting_works());
+  const Model model = build_model(reference_machine());
+  for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
+    app::FirmwareNodeConfig cfg;
+    cfg.controller.law = kind;
+    Loop loop(model, sim::kDigTask, cfg);
+    loop.cycle();  // start-up cycle outside the count (first touch)
+    std::size_t allocations = 0;
+    int slowing = 0;
+    {
+      exc::app::AllocationCounter counter;
+      exc::app::EigenNoMallocScope no_eigen_malloc;
+      for (int k = 0; k < 6000; ++k) {
+        if (k == 4000) loop.node.request_stop();
+        loop.cycle();
+        slowing += loop.node.stopping_on_path() ? 1 : 0;
+      }
+      allocations = counter.count();
+    }
+    INFO(kind);
+    CHECK(allocations == 0);
+    CHECK(slowing > 0);  // the path was slowed, not cut
+    CHECK(loop.node.mode() == Mode::hold);
+    CHECK_FALSE(loop.node.trajectory_finished());
+  }
+}
+
 TEST_CASE("firmware/node: every frame the firmware sends keeps the DBC's cycle time in a capture, FW_EMERGENCY repeating while the safe state lasts") {
   // The schedule comes from the DBC file (read by the tests' own reader), the frames from a listener
   // on the bus, as candump would see them.
