@@ -151,11 +151,18 @@ SceneBundle SceneChanges::read() const {
   } else {
     b.scene = plant_sections_ ? plant::read_scene(scene, nominal_machine) : source_.nominal.scene;
   }
-  // The firmware's sections read against the machine file (its task checked as the file's is); the
-  // controller alone when only it changed (the task's effort check is the costly part of the reading).
-  b.firmware = firmware_sections_ ? app::read_firmware_settings(scene, nominal_machine) : source_.nominal.firmware;
-  if (controller_ && !firmware_sections_) b.firmware.controller = control::read_controller_config(scene, nominal_machine.machine);
-  if (firmware_machine_) b.firmware.machine = read_machine(nominal_machine.document.with_root(*firmware_machine_));
+  // The firmware's sections read against its own machine (the file's, or the file's with the case's
+  // firmware.machine.* values), so what the controller derives from the machine at load (the valve
+  // stage's spool lead and force-loop time constants) follows the firmware's model, not the file's;
+  // the controller alone when only it changed (the task's effort check is the costly part of the reading).
+  if (firmware_machine_) {
+    SceneMachine firmware{nominal_machine.file, nominal_machine.document.with_root(*firmware_machine_), {}};
+    firmware.machine = read_machine(firmware.document);
+    b.firmware = app::read_firmware_settings(scene, firmware);
+  } else {
+    b.firmware = firmware_sections_ ? app::read_firmware_settings(scene, nominal_machine) : source_.nominal.firmware;
+    if (controller_ && !firmware_sections_) b.firmware.controller = control::read_controller_config(scene, nominal_machine.machine);
+  }
   check_command_fits(scene, b);
   finish(b);  // its effective configuration left empty: a case's is its scene's with the values it sets
   return b;

@@ -102,6 +102,16 @@ TEST_CASE("tools/sweep knobs: a value set by a setting's path reaches the side t
   const SceneBundle b = model_oil.read();
   CHECK(b.firmware.machine.hydraulics.bulk_modulus == 3e8);
   CHECK(b.scene.machine.hydraulics.bulk_modulus == nominal.scene.machine.hydraulics.bulk_modulus);
+  // What the controller derives from the machine at load follows the firmware's model: its spools
+  // 0.1 s (the file's 0.03 s) give the force loop's time constant 0.1 s and the lead's target a third.
+  SceneChanges model_spools(dig());
+  model_spools.set("firmware.machine.hydraulics.valve_time_constant", YAML::Node("0.1"));
+  const SceneBundle spools = model_spools.read();
+  REQUIRE(nominal.firmware.machine.hydraulics.valve_time_constant == doctest::Approx(0.03));
+  CHECK(spools.firmware.machine.hydraulics.valve_time_constant == 0.1);
+  CHECK(spools.firmware.controller.valves.force_time_constant == doctest::Approx(0.1));
+  CHECK(spools.firmware.controller.valves.spool_lag_target == doctest::Approx(0.1 / 3));
+  CHECK(nominal.firmware.controller.valves.force_time_constant == doctest::Approx(0.03));
   SceneChanges controller(dig());
   controller.set("controller.valves.force_time_constant", YAML::Node("0.01"));
   CHECK(controller.read().firmware.controller.valves.force_time_constant == 0.01);
