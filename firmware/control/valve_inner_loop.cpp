@@ -76,23 +76,30 @@ std::uint8_t ValveInnerLoop::off_map(const Vec4& p_a, const Vec4& p_b) const {
   return bits;
 }
 
-Vec4 ValveInnerLoop::hydraulic_stiffness(const Vec4& q) const {
+void ValveInnerLoop::column_stiffness(int i, double q, double& s_a, double& s_b) const {
   const HydraulicGeometry& g = model_.geometry;
   const HydraulicParameters& h = model_.hydraulics;
+  double v_a = h.swing_volume, v_b = h.swing_volume;
+  if (i > 0) {
+    const double stroke = std::clamp(q - model_.q_min[i], 0.0, model_.q_max[i] - model_.q_min[i]);
+    v_a = h.dead_volume + g.area_a[i] * stroke;
+    v_b = h.dead_volume + g.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
+  }
+  s_a = g.area_a[i] * g.area_a[i] / v_a;
+  s_b = g.area_b[i] * g.area_b[i] / v_b;
+}
+
+Vec4 ValveInnerLoop::hydraulic_stiffness(const Vec4& q) const {
   Vec4 k;
   for (int i = 0; i < kNumActive; ++i) {
-    double v_a = h.swing_volume, v_b = h.swing_volume;
-    if (i > 0) {
-      const double stroke = std::clamp(q[i] - model_.q_min[i], 0.0, model_.q_max[i] - model_.q_min[i]);
-      v_a = h.dead_volume + g.area_a[i] * stroke;
-      v_b = h.dead_volume + g.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
-    }
-    k[i] = h.bulk_modulus * (g.area_a[i] * g.area_a[i] / v_a + g.area_b[i] * g.area_b[i] / v_b);
+    double s_a = 0, s_b = 0;
+    column_stiffness(i, q[i], s_a, s_b);
+    k[i] = model_.hydraulics.bulk_modulus * (s_a + s_b);
   }
   return k;
 }
 
-double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) const {
+double ValveInnerLoop::opening_for(int i, double u, double q, double p_a, double p_b) const {
   if (u == 0) return 0;
   const HydraulicGeometry& g = model_.geometry;
   const HydraulicParameters& h = model_.hydraulics;
@@ -103,15 +110,29 @@ double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) cons
   const double k_in = extend ? g.meter_in_a[i] : g.meter_in_b[i];
   const double area_in = extend ? g.area_a[i] : g.area_b[i];
   const double flow_in = k_in * orifice(drop_in, h.laminar_pressure);
-  double a = flow_in > 0 ? area_in * std::abs(u) / flow_in : 2.0;  // stalled at the relief: fully open
-  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills
-  // the other side. Only while that side is down at the make-up (within the laminar pressure of
-  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed. Between the
-  // two (up to three laminar pressures above tank) the openings blend, so the map has no step.
+  if (!(flow_in > 0)) return extend ? 2.0 : -2.0;  // stalled at the relief: fully open
   const double p_in = extend ? p_a : p_b, p_out = extend ? p_b : p_a;
   const double k_out = extend ? g.meter_out_b[i] : g.meter_out_a[i];
   const double area_out = extend ? g.area_b[i] : g.area_a[i];
   const double flow_out = k_out * orifice(p_out - h.tank_pressure, h.laminar_pressure);
+  // Resisting load: one spool meters both sides, and while the force loop holds the force the two
+  // chambers' pressures move together (A_in dp_in = A_out dp_out), so the piston runs at the
+  // average of the speeds the meter-in and the meter-out pass at this opening, weighted by the
+  // columns' stiffnesses A^2 / V:
+  //   qd = a (s_in w_in + s_out w_out) / (s_in + s_out),  w = flow per unit opening / area.
+  // Steady, w_out = w_in (the meter-out's pressure settles where it passes the piston's flow). Where
+  // the motion starts or turns, the outlet side's pressure is not yet there, and the meter-in alone
+  // would leave the flow that pressurises both chambers to the position loop (the bucket's error
+  // with no soil, docs/control.md).
+  double s_a = 0, s_b = 0;
+  column_stiffness(i, q, s_a, s_b);
+  const double s_in = extend ? s_a : s_b, s_out = extend ? s_b : s_a;
+  const double speed_per_opening = (s_in * flow_in / area_in + s_out * flow_out / area_out) / (s_in + s_out);
+  double a = std::abs(u) / speed_per_opening;
+  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills
+  // the other side. Only while that side is down at the make-up (within the laminar pressure of
+  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed. Between the
+  // two (up to three laminar pressures above tank) the openings blend, so the map has no step.
   if (flow_out > 0) {
     const double metered_out = std::min(a, area_out * std::abs(u) / flow_out);
     const double w = std::clamp((p_in - h.tank_pressure - h.laminar_pressure) / (2 * h.laminar_pressure), 0.0, 1.0);
@@ -146,7 +167,6 @@ const ValveCommand& ValveInnerLoop::from_velocity(const Vec4& velocity, const Ve
 }
 
 void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
-  (void)q;
   ValveCommand& c = command_;
   c.limited = 0;
   c.demanded_flow = 0;
@@ -154,7 +174,7 @@ void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
   const double band = settings_.opening_band;
   for (int i = 0; i < kNumActive; ++i) {
     if ((in_position_ >> i) & 1u) c.velocity[i] = 0;
-    double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], p_a[i], p_b[i]) : 0.0;
+    double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], q[i], p_a[i], p_b[i]) : 0.0;
     if (std::abs(a) >= 1) {
       a = a > 0 ? 1.0 : -1.0;
       c.limited |= static_cast<std::uint8_t>(1u << i);

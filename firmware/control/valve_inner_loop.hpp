@@ -109,8 +109,9 @@ class ValveInnerLoop {
   std::uint8_t at_relief(const Vec4& p_a, const Vec4& p_b) const;
   // K_h(q) of each function (N/m per m/s of flow mismatch, i.e. N/m; swing N m/rad).
   Vec4 hydraulic_stiffness(const Vec4& q) const;
-  // The opening that passes the velocity u at these pressures (before the dead zone), unclamped.
-  double opening_for(int i, double u, double p_a, double p_b) const;
+  // The opening that moves function i at the velocity u at its position q and these pressures
+  // (before the dead zone), unclamped.
+  double opening_for(int i, double u, double q, double p_a, double p_b) const;
   const ValveCommand& last() const { return command_; }
   const ValveLoopSettings& settings() const { return settings_; }
   const Vec4& spool_model() const { return spool_lead_.delivered(); }  // the lead's spool positions
@@ -118,6 +119,8 @@ class ValveInnerLoop {
 
  private:
   void finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b);
+  // The oil columns' A_A^2 / V_A and A_B^2 / V_B of function i at position q (1/m; swing D^2 / V).
+  void column_stiffness(int i, double q, double& s_a, double& s_b) const;
 
   ValveLoopModel model_;
   ValveLoopSettings settings_;
