@@ -54,11 +54,10 @@ ValveLoopModel valve_loop_model(const Machine& nominal);
 struct ValveLoopSettings {
   double force_time_constant = 0.03;  // s, T_f: the force loop's time constant (the spool's lag, docs/control.md)
   double spool_lag_target = 0.01;     // s, T_t the spool lead aims for (0: no lead)
-  // s, T_i of the force loop's integral (0: none, the default). The meter-out throttles the return
-  // side in proportion to the flow, so a proportional force loop settles short of a force step (a
-  // third short on the boom); the integral takes the rest, for an outer law that commands forces.
-  // Under the computed-torque laws it hands the position back to their soft gains and the dig's
-  // bucket error grows 3-20x (docs/control.md), so position tracking leaves it off.
+  // s, T_i of the force loop's integral (0: none, the default): what the proportional loop leaves of
+  // a force step (7.6 % on the boom), for an outer law that commands forces. Under the
+  // computed-torque laws it hands the position back to their soft gains and the dig's bucket error
+  // grew 3-20x (docs/control.md), so position tracking leaves it off.
   double force_integral_time = 0;
   double opening_band = 0.002;        // opening below which the dead-zone inverse is linear
   // 1/s: the flow feedforward v_ff = qd_d - position_gain e also corrects the position, as the flow

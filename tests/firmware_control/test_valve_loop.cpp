@@ -59,6 +59,9 @@ ValveLoopSettings no_lead() {
 
 const Vec4 kMid(0, 1.5, 1.5, 1.5);
 const Vec4 kLowP = Vec4::Constant(1e6);  // a modest load on either side: the meter-in governs
+// Both chambers where a steady motion holds them: the outlet's meter-out passes what the meter-in
+// does (5 MPa across it, the round machine's rating), so the map is the meter-in's in either direction.
+const Vec4 kSteadyP = Vec4::Constant(0.3e6 + 5e6);
 
 }  // namespace
 
@@ -197,7 +200,7 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
     for (double frac : {0.05, 0.3, 0.9, -0.05, -0.3, -0.9}) {
       Vec4 u = Vec4::Zero();
       u[i] = frac * speed[i];
-      const ValveCommand& c = loop.from_velocity(u, kMid, kLowP, kLowP);
+      const ValveCommand& c = loop.from_velocity(u, kMid, kSteadyP, kSteadyP);
       // The plant's metering opening of this spool: (|s| - z) / (1 - z) past the dead zone z.
       const double z = frac > 0 ? m.hydraulics.dead_zone_extend[i] : m.hydraulics.dead_zone_retract[i];
       const double opened = (std::abs(c.spool[i]) - z) / (1 - z);
@@ -209,12 +212,12 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
     Vec4 u = Vec4::Zero();
     u[i] = 1e-3 * s.opening_band * speed[i];
     const double z = m.hydraulics.dead_zone_extend[i];
-    CHECK(loop.from_velocity(u, kMid, kLowP, kLowP).spool[i] ==
+    CHECK(loop.from_velocity(u, kMid, kSteadyP, kSteadyP).spool[i] ==
           doctest::Approx(1e-3 * (z + (1 - z) * s.opening_band)));
-    CHECK(loop.from_velocity(Vec4::Zero(), kMid, kLowP, kLowP).spool[i] == 0.0);
+    CHECK(loop.from_velocity(Vec4::Zero(), kMid, kSteadyP, kSteadyP).spool[i] == 0.0);
     // Twice the speed limit: fully open, flagged.
     u[i] = 2 * speed[i];
-    const ValveCommand& sat = loop.from_velocity(u, kMid, kLowP, kLowP);
+    const ValveCommand& sat = loop.from_velocity(u, kMid, kSteadyP, kSteadyP);
     CHECK(sat.spool[i] == 1.0);
     CHECK(sat.limited == (1u << i));
   }
@@ -222,7 +225,7 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
 
 TEST_CASE("firmware/valve stage sends the spool command as pilot pressures on the end it opens") {
   ValveInnerLoop loop(simple_model(), no_lead(), kPeriod);
-  const ValveCommand& c = loop.from_velocity(Vec4(0.5, -0.15, 0, 0.35), kMid, kLowP, kLowP);
+  const ValveCommand& c = loop.from_velocity(Vec4(0.5, -0.15, 0, 0.35), kMid, kSteadyP, kSteadyP);
   CHECK(c.pilot_a[0] == doctest::Approx(c.spool[0] * 5e6));
   CHECK(c.pilot_b[0] == 0.0);
   CHECK(c.pilot_a[1] == 0.0);
@@ -288,8 +291,8 @@ TEST_CASE("firmware/valve stage's spool lead makes the 30 ms spool answer with i
   const double target = 0.15 + 0.85 * 0.3;
   double y_lead = 0, y_plain = 0, t_lead = -1, t_plain = -1;
   for (int k = 1; k <= 200; ++k) {
-    y_lead = spool_step(y_lead, lead.from_velocity(u, kMid, kLowP, kLowP).spool[1]);
-    y_plain = spool_step(y_plain, plain.from_velocity(u, kMid, kLowP, kLowP).spool[1]);
+    y_lead = spool_step(y_lead, lead.from_velocity(u, kMid, kSteadyP, kSteadyP).spool[1]);
+    y_plain = spool_step(y_plain, plain.from_velocity(u, kMid, kSteadyP, kSteadyP).spool[1]);
     if (t_lead < 0 && y_lead >= 0.632 * target) t_lead = k * kPeriod;
     if (t_plain < 0 && y_plain >= 0.632 * target) t_plain = k * kPeriod;
   }
@@ -302,11 +305,11 @@ TEST_CASE("firmware/valve stage counts the pumps' flow the openings ask for") {
   const ValveLoopModel m = simple_model();
   ValveInnerLoop loop(m, no_lead(), kPeriod);
   const Vec4 speed(1.0, 0.3, 0.5, 0.7);
-  const ValveCommand& half = loop.from_velocity(0.2 * speed, kMid, kLowP, kLowP);
+  const ValveCommand& half = loop.from_velocity(0.2 * speed, kMid, kSteadyP, kSteadyP);
   const double expected = 0.2 * (m.geometry.area_a.dot(speed));
   CHECK(half.demanded_flow == doctest::Approx(expected));
   CHECK(half.pump_limited == (expected > m.hydraulics.pump_flow));
-  const ValveCommand& full = loop.from_velocity(0.99 * speed, kMid, kLowP, kLowP);
+  const ValveCommand& full = loop.from_velocity(0.99 * speed, kMid, kSteadyP, kSteadyP);
   CHECK(full.demanded_flow == doctest::Approx(0.99 * m.geometry.area_a.dot(speed)));
   CHECK(full.pump_limited);  // 0.020 m^3/s against 0.007
 }
