@@ -32,12 +32,14 @@ ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSetti
       settings_(settings),
       spool_lead_(settings.spool_lag_target > 0 ? model.hydraulics.valve_time_constant : 0.0,
                   settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()),
-      period_(period) {}
+      period_(period),
+      level_alpha_(1.0 - std::exp(-period / (5 * settings.force_time_constant))) {}
 
 void ValveInnerLoop::reset() {
   spool_lead_.reset(Vec4::Zero());
   in_position_ = 0;
   force_integral_.setZero();
+  level_primed_ = false;
   command_ = ValveCommand{};
 }
 
@@ -76,23 +78,35 @@ std::uint8_t ValveInnerLoop::off_map(const Vec4& p_a, const Vec4& p_b) const {
   return bits;
 }
 
-Vec4 ValveInnerLoop::hydraulic_stiffness(const Vec4& q) const {
+void ValveInnerLoop::column_stiffness(int i, double q, double& s_a, double& s_b) const {
   const HydraulicGeometry& g = model_.geometry;
   const HydraulicParameters& h = model_.hydraulics;
+  double v_a = h.swing_volume, v_b = h.swing_volume;
+  if (i > 0) {
+    const double stroke = std::clamp(q - model_.q_min[i], 0.0, model_.q_max[i] - model_.q_min[i]);
+    v_a = h.dead_volume + g.area_a[i] * stroke;
+    v_b = h.dead_volume + g.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
+  }
+  s_a = g.area_a[i] * g.area_a[i] / v_a;
+  s_b = g.area_b[i] * g.area_b[i] / v_b;
+}
+
+Vec4 ValveInnerLoop::hydraulic_stiffness(const Vec4& q) const {
   Vec4 k;
   for (int i = 0; i < kNumActive; ++i) {
-    double v_a = h.swing_volume, v_b = h.swing_volume;
-    if (i > 0) {
-      const double stroke = std::clamp(q[i] - model_.q_min[i], 0.0, model_.q_max[i] - model_.q_min[i]);
-      v_a = h.dead_volume + g.area_a[i] * stroke;
-      v_b = h.dead_volume + g.area_b[i] * (model_.q_max[i] - model_.q_min[i] - stroke);
-    }
-    k[i] = h.bulk_modulus * (g.area_a[i] * g.area_a[i] / v_a + g.area_b[i] * g.area_b[i] / v_b);
+    double s_a = 0, s_b = 0;
+    column_stiffness(i, q[i], s_a, s_b);
+    k[i] = model_.hydraulics.bulk_modulus * (s_a + s_b);
   }
   return k;
 }
 
-double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) const {
+double ValveInnerLoop::opening_for(int i, double u, double q, double p_a, double p_b) const {
+  return opening_for(i, u, q, p_a, p_b, p_a, p_b);
+}
+
+double ValveInnerLoop::opening_for(int i, double u, double q, double p_a, double p_b, double level_a,
+                                   double level_b) const {
   if (u == 0) return 0;
   const HydraulicGeometry& g = model_.geometry;
   const HydraulicParameters& h = model_.hydraulics;
@@ -103,15 +117,30 @@ double ValveInnerLoop::opening_for(int i, double u, double p_a, double p_b) cons
   const double k_in = extend ? g.meter_in_a[i] : g.meter_in_b[i];
   const double area_in = extend ? g.area_a[i] : g.area_b[i];
   const double flow_in = k_in * orifice(drop_in, h.laminar_pressure);
-  double a = flow_in > 0 ? area_in * std::abs(u) / flow_in : 2.0;  // stalled at the relief: fully open
-  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills
-  // the other side. Only while that side is down at the make-up (within the laminar pressure of
-  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed. Between the
-  // two (up to three laminar pressures above tank) the openings blend, so the map has no step.
+  if (!(flow_in > 0)) return extend ? 2.0 : -2.0;  // stalled at the relief: fully open
   const double p_in = extend ? p_a : p_b, p_out = extend ? p_b : p_a;
   const double k_out = extend ? g.meter_out_b[i] : g.meter_out_a[i];
   const double area_out = extend ? g.area_b[i] : g.area_a[i];
   const double flow_out = k_out * orifice(p_out - h.tank_pressure, h.laminar_pressure);
+  // Resisting load: one spool meters both sides. At a held force the two chambers' pressures move
+  // together (A_in dp_in = A_out dp_out), so the piston runs at the mean of the speeds the meter-in
+  // and the meter-out pass at this opening, weighted by the columns' stiffnesses s = A^2 / V:
+  //   qd = a (s_in w_in + s_out w_out) / (s_in + s_out),  w = flow per unit opening / area,
+  // which also makes the force loop's dF/dt = K_h (u - qd) exact. Steady, w_out = w_in (the outlet
+  // settles where its meter-out passes the piston's flow) and this is the meter-in's map. Where a
+  // motion starts or turns the outlet is not there yet, and the meter-in's map alone left the oil
+  // that pressurises both chambers to the position correction: most of the bucket's error with no
+  // soil (docs/control.md). w_out is taken at the outlet's level (update_levels), not its reading.
+  double s_a = 0, s_b = 0;
+  column_stiffness(i, q, s_a, s_b);
+  const double s_in = extend ? s_a : s_b, s_out = extend ? s_b : s_a;
+  const double flow_out_level = k_out * orifice((extend ? level_b : level_a) - h.tank_pressure, h.laminar_pressure);
+  const double speed_per_opening = (s_in * flow_in / area_in + s_out * flow_out_level / area_out) / (s_in + s_out);
+  double a = std::abs(u) / speed_per_opening;
+  // Meter-out: an overrunning load drives the return flow through it faster than the meter-in fills
+  // the other side. Only while that side is down at the make-up (within the laminar pressure of
+  // tank): a resisting load keeps it above, and then the meter-in alone sets the speed. Between the
+  // two (up to three laminar pressures above tank) the openings blend, so the map has no step.
   if (flow_out > 0) {
     const double metered_out = std::min(a, area_out * std::abs(u) / flow_out);
     const double w = std::clamp((p_in - h.tank_pressure - h.laminar_pressure) / (2 * h.laminar_pressure), 0.0, 1.0);
@@ -145,16 +174,39 @@ const ValveCommand& ValveInnerLoop::from_velocity(const Vec4& velocity, const Ve
   return command_;
 }
 
+// The pressures the map's meter-out term reads. The valve's flows move m = V_A p_A / A_A + V_B p_B / A_B,
+// the piston's motion does not (it compresses one side as it relieves the other): m is taken as
+// measured, the force F = A_A p_A - A_B p_B low-passed at a fifth of the force loop's bandwidth (as
+// position_gain's default). The measured outlet pressure itself carries the oil column's ringing;
+// read directly, the map cancelled the meter-out's damping of it (the flow law's boom rang to its
+// relief lifting out of stiff clay on a 14 degree slope: worst error 6.4 -> 12.5 mm).
+void ValveInnerLoop::update_levels(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
+  const Vec4& f = command_.force;
+  if (!level_primed_) force_slow_ = f;
+  else force_slow_ += level_alpha_ * (f - force_slow_);
+  level_primed_ = true;
+  const HydraulicGeometry& g = model_.geometry;
+  for (int i = 0; i < kNumActive; ++i) {
+    double s_a = 0, s_b = 0;
+    column_stiffness(i, q[i], s_a, s_b);
+    const double aa = g.area_a[i], ab = g.area_b[i];
+    const double va = aa * aa / s_a, vb = ab * ab / s_b;
+    const double m = va * p_a[i] / aa + vb * p_b[i] / ab;
+    level_b_[i] = (m - va * force_slow_[i] / (aa * aa)) / (va * ab / (aa * aa) + vb / ab);
+    level_a_[i] = (force_slow_[i] + ab * level_b_[i]) / aa;
+  }
+}
+
 void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
-  (void)q;
   ValveCommand& c = command_;
+  update_levels(q, p_a, p_b);
   c.limited = 0;
   c.demanded_flow = 0;
   Vec4 spool;
   const double band = settings_.opening_band;
   for (int i = 0; i < kNumActive; ++i) {
     if ((in_position_ >> i) & 1u) c.velocity[i] = 0;
-    double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], p_a[i], p_b[i]) : 0.0;
+    double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], q[i], p_a[i], p_b[i], level_a_[i], level_b_[i]) : 0.0;
     if (std::abs(a) >= 1) {
       a = a > 0 ? 1.0 : -1.0;
       c.limited |= static_cast<std::uint8_t>(1u << i);

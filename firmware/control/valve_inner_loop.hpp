@@ -10,10 +10,14 @@
 //                flow feedforward), equal to qd while the machine tracks, with the position error's
 //                correction K_x e (position_gain) that a stiff oil column needs.
 //   (a flow law, FlowPositionControl, gives u directly and skips the force loop)
-//   orifice map  the opening that passes the flow A u: the pressure-compensated meter-in
-//                a_in = A_in |u| / (K_in f(min(margin, p_relief - p_load))) and, for an overrunning
-//                load, the meter-out a_out = A_out |u| / (K_out f(p_out - p_tank)) that holds it
-//                back; a = min(a_in, a_out), at most 1 (the valve's limit: flagged, anti-windup).
+//   orifice map  the opening that moves the piston at u: per unit opening the pressure-compensated
+//                meter-in passes w_in = K_in f(min(margin, p_relief - p_load)) / A_in and the
+//                meter-out w_out = K_out f(p_out - p_tank) / A_out; at a held force the piston runs at
+//                their mean weighted by the columns' A^2 / V, so a = |u| (s_in + s_out) /
+//                (s_in w_in + s_out w_out) (w_out at the outlet's level: the pressurising of both
+//                chambers where a motion starts or turns). For an overrunning load the meter-out
+//                a_out = A_out |u| / (K_out f(p_out - p_tank)) holds it back; a = min(a, a_out), at
+//                most 1 (the valve's limit: flagged, anti-windup).
 //   dead zone    spool s = sign(a) (z + (1 - z) |a|) with the nominal dead zone z of the direction,
 //                linear through zero over |a| < opening_band (a narrow band above the command's
 //                noise: any continuous inverse leaves the valve shut for |a| below about the band, a
@@ -50,11 +54,10 @@ ValveLoopModel valve_loop_model(const Machine& nominal);
 struct ValveLoopSettings {
   double force_time_constant = 0.03;  // s, T_f: the force loop's time constant (the spool's lag, docs/control.md)
   double spool_lag_target = 0.01;     // s, T_t the spool lead aims for (0: no lead)
-  // s, T_i of the force loop's integral (0: none, the default). The meter-out throttles the return
-  // side in proportion to the flow, so a proportional force loop settles short of a force step (a
-  // third short on the boom); the integral takes the rest, for an outer law that commands forces.
-  // Under the computed-torque laws it hands the position back to their soft gains and the dig's
-  // bucket error grows 3-20x (docs/control.md), so position tracking leaves it off.
+  // s, T_i of the force loop's integral (0: none, the default): what the proportional loop leaves of
+  // a force step (7.6 % on the boom), for an outer law that commands forces. Under the
+  // computed-torque laws it hands the position back to their soft gains and the dig's bucket error
+  // grew 3-20x (docs/control.md), so position tracking leaves it off.
   double force_integral_time = 0;
   double opening_band = 0.002;        // opening below which the dead-zone inverse is linear
   // 1/s: the flow feedforward v_ff = qd_d - position_gain e also corrects the position, as the flow
@@ -109,8 +112,9 @@ class ValveInnerLoop {
   std::uint8_t at_relief(const Vec4& p_a, const Vec4& p_b) const;
   // K_h(q) of each function (N/m per m/s of flow mismatch, i.e. N/m; swing N m/rad).
   Vec4 hydraulic_stiffness(const Vec4& q) const;
-  // The opening that passes the velocity u at these pressures (before the dead zone), unclamped.
-  double opening_for(int i, double u, double p_a, double p_b) const;
+  // The opening that moves function i at the velocity u at its position q and these pressures
+  // (before the dead zone), unclamped; the outlet's level taken as its reading.
+  double opening_for(int i, double u, double q, double p_a, double p_b) const;
   const ValveCommand& last() const { return command_; }
   const ValveLoopSettings& settings() const { return settings_; }
   const Vec4& spool_model() const { return spool_lead_.delivered(); }  // the lead's spool positions
@@ -118,6 +122,13 @@ class ValveInnerLoop {
 
  private:
   void finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b);
+  // The oil columns' A_A^2 / V_A and A_B^2 / V_B of function i at position q (1/m; swing D^2 / V).
+  void column_stiffness(int i, double q, double& s_a, double& s_b) const;
+  // The same with the outlet's level apart from its reading (update_levels).
+  double opening_for(int i, double u, double q, double p_a, double p_b, double level_a, double level_b) const;
+  // The chambers' levels the map's meter-out term reads: the valve-driven part of the measured
+  // pressures at the slow force (the .cpp says why).
+  void update_levels(const Vec4& q, const Vec4& p_a, const Vec4& p_b);
 
   ValveLoopModel model_;
   ValveLoopSettings settings_;
@@ -125,6 +136,10 @@ class ValveInnerLoop {
   std::uint8_t in_position_ = 0;  // bit i: function i centred, in position
   double period_ = 1e-3;
   Vec4 force_integral_ = Vec4::Zero();  // the force loop's integral, as a flow per piston area
+  double level_alpha_ = 1.0;  // the slow force's filter gain per call, 1 - exp(-period / (5 T_f))
+  Vec4 level_a_ = Vec4::Zero(), level_b_ = Vec4::Zero();  // Pa, the chambers' levels (update_levels)
+  Vec4 force_slow_ = Vec4::Zero();
+  bool level_primed_ = false;
   ValveCommand command_;
 };
 

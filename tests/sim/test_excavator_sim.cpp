@@ -507,7 +507,7 @@ TEST_CASE("tools/excavator-sim: a scene's controller.type chooses the controller
   fs::remove(unknown);
 }
 
-TEST_CASE("tools/excavator-sim truck loading: five cycles of all four actuators, a per-cycle record for each controller, PID the same every pass and the adaptive law better after its first") {
+TEST_CASE("tools/excavator-sim truck loading: five cycles of all four actuators, a per-cycle record for each controller, PID the same every pass and the adaptive law, which learns the soil from the measured force within its first dig, as good from its first pass and at least 2x better than PID on arm and bucket") {
   const Run r = run_sim("run " + std::string(EXC_SOURCE_DIR) +
                         "/scenes/truck_loading.yaml --controller pid,adaptive --quiet --no-report --json s.json");
   INFO(r.err);
@@ -528,9 +528,20 @@ TEST_CASE("tools/excavator-sim truck loading: five cycles of all four actuators,
   for (std::size_t k = 1; k < 5; ++k)
     CHECK(pid[k]["rms_error"]["bucket"].get<double>() ==
           doctest::Approx(pid[0]["rms_error"]["bucket"].get<double>()).epsilon(0.02));
-  // The adaptive law starts its second pass from what it learnt in the first.
+  // The adaptive law's composite update identifies the soil from the measured cylinder forces during
+  // the first dig, so its first pass is as good as the later ones (no pass worse than the first by
+  // more than 2 %: nothing drifts), and every pass at least 2x better than PID's on arm and bucket.
+  // (Before the valve stage metered the chambers' pressurising, the first pass carried a start-up
+  // error the later passes did not; the 50-pass test below holds the estimates themselves.)
   const auto& ad = j["adaptive"]["cycles"];
-  CHECK(ad[1]["rms_error"]["bucket"].get<double>() < ad[0]["rms_error"]["bucket"].get<double>());
+  for (std::size_t k = 0; k < 5; ++k) {
+    CAPTURE(k);
+    for (const char* a : {"arm", "bucket"}) {
+      CAPTURE(a);
+      CHECK(ad[k]["rms_error"][a].get<double>() <= 1.02 * ad[0]["rms_error"][a].get<double>());
+      CHECK(2 * ad[k]["rms_error"][a].get<double>() <= pid[k]["rms_error"][a].get<double>());
+    }
+  }
   CHECK(r.out.find("per work cycle") != std::string::npos);
 }
 
