@@ -28,5 +28,11 @@ struct DryFrictionImpulses {
 // slipping as before needs one sweep).
 DryFrictionImpulses dry_friction_impulses(const Mat4& inverse_mass, const Vec4& free_velocity, const Vec4& bound,
                                           const Vec4& guess = Vec4::Zero());
+// The same with each impulse in [lower_i, upper_i] (lower <= 0 <= upper; both 0: no friction there).
+// A function pressed on an end stop takes the stop's reaction in the same solve: one side unbounded
+// (+inf on its upper stop, -inf on its lower), so the friction of the functions coupled to it acts on
+// the motion the stop leaves them. Stuck where the impulse lies strictly inside its interval.
+DryFrictionImpulses dry_friction_impulses(const Mat4& inverse_mass, const Vec4& free_velocity, const Vec4& lower,
+                                          const Vec4& upper, const Vec4& guess);
 
 }  // namespace exc::plant

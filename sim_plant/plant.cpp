@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "model/loop_closure.hpp"
 #include "sim_plant/coulomb_friction.hpp"
@@ -207,7 +208,17 @@ Vec4 Plant::apply_dry_friction(const MechanicalState& before) {
     mass_matrix(model_, ws_, M);
     inverse_mass = M.inverse();
   }
-  const DryFrictionImpulses r = dry_friction_impulses(inverse_mass, mech_.qd_a, bound, dry_impulse_);
+  // A function that stood on an end stop and is pushed into it (a stuck spool at relief): the stop's
+  // reaction joins the solve. Left to apply_limits after it, the push's acceleration of the functions
+  // coupled to it within the step was still in the velocities friction saw, so their friction opposed
+  // a motion the stop then took away and did no net work (a boom and arm ringing on for seconds).
+  // Arrivals from free motion stay apply_limits's, which books their impact.
+  Vec4 lower = -bound, upper = bound;
+  for (int i = 0; i < kNumActive; ++i) {
+    if (before.q_a[i] >= q_max_[i] && mech_.qd_a[i] > 0) upper[i] = std::numeric_limits<double>::infinity();
+    if (before.q_a[i] <= q_min_[i] && mech_.qd_a[i] < 0) lower[i] = -std::numeric_limits<double>::infinity();
+  }
+  const DryFrictionImpulses r = dry_friction_impulses(inverse_mass, mech_.qd_a, lower, upper, dry_impulse_);
   dry_impulse_ = r.impulse;
   state_.friction_stuck = r.stuck;
   state_.friction_sweeps = r.sweeps;
