@@ -931,6 +931,10 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
     CHECK(tables.find(row) != std::string::npos);
   }
   CHECK(tables.find("| H3 sensor watchdog |") != std::string::npos);  // bus_burst's stops, under their hazard
+  // The documented --requirements column: the watchdog's row names its requirement.
+  REQUIRE(std::system((in_dir + "/usr/bin/python3 " + EXC_SOURCE_DIR +
+                       "/tools/sweep/campaign_tables.py merged --requirements > req.md 2> req.err").c_str()) == 0);
+  CHECK(read_text_file(dir / "req.md").find("| H3 sensor watchdog | 20 ms watchdog (H3) |") != std::string::npos);
 }
 
 TEST_CASE("tools/excavator-sim sweep refuses a spec naming both scene and scenes, and pump_loss on a scene without pumps before any run") {

@@ -2,6 +2,7 @@
 """The safety campaign's two tables in Markdown, from a merged sweep (docs/safety.md, the README).
 
 usage: campaign_tables.py DIR [--requirements]
+  --requirements  a column with each safety function's reaction-time requirement (docs/safety.md)
   reads DIR/sweep.json (excavator-sim sweep-merge's "safety_functions" and "campaign") and prints
   per safety function (the fault that took the stop) and per fault kind: runs, worst detection,
   worst time to rest, runs stopped but never at rest, emergency stops; PID and adaptive side by side.
@@ -13,17 +14,18 @@ import sys
 
 LAWS = ("pid", "adaptive")
 # The hazard each safety function serves (docs/safety.md), in the concept's order.
+# With --requirements, each function's reaction-time requirement (docs/safety.md's hazard table).
 FUNCTIONS = (
-    ("velocity implausible", "H1 flow plausibility"),
-    ("tracking error", "H2 tracking-error limit"),
-    ("sensor timeout", "H3 sensor watchdog"),
-    ("pressure implausible", "H4 pressure plausibility"),
-    ("plant fault", "H6 the machine's own fault"),
-    ("plant emergency", "H6 the machine's emergency"),
-    ("plant holding", "H6 the machine holding"),
-    ("deadline overrun", "H7 missed deadlines"),
-    ("operator stop", "H9 operator stop"),
-    ("none", "no stop (tracked, or neither)"),
+    ("velocity implausible", "H1 flow plausibility", "100 ms / 1.5 s (H1)"),
+    ("tracking error", "H2 tracking-error limit", "one cycle past the limit (H2)"),
+    ("sensor timeout", "H3 sensor watchdog", "20 ms watchdog (H3)"),
+    ("pressure implausible", "H4 pressure plausibility", "3 sets range/step, 500 moving sets frozen (H4)"),
+    ("plant fault", "H6 the machine's own fault", "the cycle the frame arrives (H6)"),
+    ("plant emergency", "H6 the machine's emergency", "the cycle the frame arrives (H6)"),
+    ("plant holding", "H6 the machine holding", "5 sensor sets (H6)"),
+    ("deadline overrun", "H7 missed deadlines", "the cycle after the last miss (H7)"),
+    ("operator stop", "H9 operator stop", "the cycle the frame arrives (H9)"),
+    ("none", "no stop (tracked, or neither)", "-"),
 )
 
 
@@ -49,9 +51,12 @@ def kinds(rows):
 
 
 def main(argv):
-    if len(argv) != 2 or argv[1] in ("-h", "--help"):
+    args = [a for a in argv[1:] if a != "--requirements"]
+    requirements = len(args) < len(argv) - 1
+    if len(args) != 1 or args[0] in ("-h", "--help") or args[0].startswith("-"):
         print(__doc__.strip())
-        return 0 if len(argv) == 2 else 2
+        return 0 if args in (["-h"], ["--help"]) else 2
+    argv = [argv[0], args[0]]
     path = os.path.join(argv[1], "sweep.json")
     try:
         with open(path) as f:
@@ -65,20 +70,21 @@ def main(argv):
               % path, file=sys.stderr)
         return 2
     laws = [law for law in LAWS if law in functions]
-    print("| safety function (the fault that took the stop) | runs %s | fault kinds behind it | worst detection "
-          "| worst time to rest | never at rest | estop |" % " / ".join(laws))
-    print("|---|---|---|---|---|---|---|")
-    known = {name for name, _ in FUNCTIONS}
-    names = [(n, label) for n, label in FUNCTIONS] + [(n, n) for law in laws for n in functions[law] if n not in known]
+    print("| safety function (the fault that took the stop) |%s runs %s | fault kinds behind it | worst detection "
+          "| worst time to rest | never at rest | estop |" % (" requirement |" if requirements else "", " / ".join(laws)))
+    print("|---|---|---|---|---|---|---|" + ("---|" if requirements else ""))
+    known = {name for name, _, _ in FUNCTIONS}
+    names = list(FUNCTIONS) + [(n, n, "-") for law in laws for n in functions[law] if n not in known]
     seen = set()
-    for name, label in names:
+    for name, label, requirement in names:
         rows = [functions[law].get(name) for law in laws]
         if name in seen or not any(rows):
             continue
         seen.add(name)
-        print("| %s | %s | %s | %s | %s | %s | %s |" % (
-            label, pair(rows, "runs"), kinds(rows), pair(rows, "worst_detection", seconds),
-            pair(rows, "worst_time_to_rest", seconds), pair(rows, "never_at_rest"), pair(rows, "estop")))
+        print("| %s |%s %s | %s | %s | %s | %s | %s |" % (
+            label, (" %s |" % requirement) if requirements else "", pair(rows, "runs"), kinds(rows),
+            pair(rows, "worst_detection", seconds), pair(rows, "worst_time_to_rest", seconds),
+            pair(rows, "never_at_rest"), pair(rows, "estop")))
     print()
     print("| fault | runs per law | %s | worst detection | worst time to rest | estop %s |"
           % (" | ".join("%s tracked / safe / neither" % law for law in laws), " / ".join(laws)))
