@@ -88,7 +88,7 @@ OpenLoopResult run_open_loop(const BenchScene& s, const EffortProfile& profile, 
     scene.checks.energy_tolerance = 1e12;
     scene.checks.energy_relative_tolerance = 1e6;
   }
-  scene.actuators.fidelity = plant::ActuatorFidelity::ideal;
+  scene.actuators.fidelity = "ideal";
   scene.sensors.position_noise.setZero();
   scene.sensors.velocity_noise.setZero();
   plant::Plant plant(scene);
@@ -156,9 +156,10 @@ constexpr std::array<int, 6> kCylinderBodies = {kBoomBarrel, kBoomRod, kArmBarre
 }  // namespace
 
 void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators) {
-  const bool hydraulic = actuators.fidelity == plant::ActuatorFidelity::hydraulic;
-  control::set_command_interface(c, hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort);
-  c.actuator_lag = actuators.fidelity == plant::ActuatorFidelity::limited ? actuators.lag : 0.0;
+  const plant::ActuatorFidelityEntry& fidelity = plant::fidelity_of(actuators);
+  control::set_command_interface(c, fidelity.takes_valves() ? control::CommandInterface::valve
+                                                            : control::CommandInterface::effort);
+  c.actuator_lag = fidelity.effort_lag ? fidelity.effort_lag(actuators) : 0.0;
   if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
 }
 

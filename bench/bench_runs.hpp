@@ -73,7 +73,7 @@ double rms_distance(const std::vector<Vec3>& a, const std::vector<Vec3>& b);
 
 struct ClosedLoopVariant {
   std::string controller = "adaptive";  // the law's registered name
-  plant::ActuatorFidelity fidelity = plant::ActuatorFidelity::ideal;
+  std::string fidelity = "ideal";  // actuators.fidelity
   bool soil = true;                 // false: soil removed from the scene
   bool dry_friction_and_leakage = true;  // false: the hydraulic machine with viscous friction only (the old plant)
   bool massless_cylinders = false;  // cylinder bodies at 1e-3 of their mass (earlier works' model)
@@ -90,8 +90,9 @@ struct ClosedLoopResult {
   double tracking_max = 0;        // worst joint, m or rad
 };
 
-// The firmware's settings for the machine it drives: the valve interface for the hydraulic fidelity,
-// efforts otherwise, with the limited actuators' lag compensated (and none for ideal ones).
+// The firmware's settings for the machine it drives: the valve interface for a fidelity that takes
+// valve commands (hydraulic), efforts otherwise, with the fidelity's effort lag compensated (limited's;
+// none for ideal ones).
 void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators);
 
 // The firmware's settings for a closed-loop run of `scene` (the plant's side of s, changed): the

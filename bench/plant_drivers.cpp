@@ -25,7 +25,7 @@ bool stable_in_stiff_clay(const Scene& base, const std::string& m, Formulation f
   s.terrain = Terrain{};
   s.terrain.height = 1.93;
   s.soil = soil_preset(SoilPreset::stiff_clay);
-  s.actuators.fidelity = ActuatorFidelity::ideal;
+  s.actuators.fidelity = "ideal";
   Plant p(s);
   ActuatorCommand c;
   c.value = p.hold_effort();

@@ -95,7 +95,7 @@ double pressure_rms(const std::vector<Pressures>& a, const std::vector<Pressures
 }  // namespace
 
 ValveInput recorded_dig(const BenchScene& dig, double duration) {
-  if (dig.scene.actuators.fidelity != plant::ActuatorFidelity::hydraulic)
+  if (!plant::fidelity_of(dig.scene.actuators).has(plant::kHydraulicCircuit))
     throw std::invalid_argument(dig.name + ": the pressure-integration chart needs a hydraulic scene");
   const app::FirmwareSettings fw = bench_firmware(dig, dig.scene);
   sim::LockstepOptions o;

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "bench_common.hpp"
+#include "control/controller_registry.hpp"
 #include "output_files/output_file.hpp"
 #include "sweep/sweep.hpp"
 
@@ -148,7 +149,8 @@ StabilityMaps stability_maps(const std::string& sweeps_dir, const std::string& s
     const std::string knob = set.key();
     const json value = set.value();
     for (const std::string& c : control.controllers) {
-      if (c == "pid" && knob == "adaptation_scale") continue;  // PID adapts nothing
+      // A law that adapts nothing (PID) has no adaptation rate to scale.
+      if (knob == "adaptation_scale" && control::controller_registry().at(c).adapts == control::Adapts::no) continue;
       ControlStability row;
       row.controller = c;
       row.axis = knob == "model_mass" ? "model_mass_error" : knob;

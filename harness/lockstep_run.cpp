@@ -117,9 +117,9 @@ std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene) {
   const bool needs_hydraulics = kind == FaultSchedule::Kind::pump_loss || kind == FaultSchedule::Kind::spool_stuck ||
                                 kind == FaultSchedule::Kind::pressure_stuck || kind == FaultSchedule::Kind::pressure_jump ||
                                 kind == FaultSchedule::Kind::pressure_drift;
-  if (!needs_hydraulics || scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic) return "";
+  if (!needs_hydraulics || plant::fidelity_of(scene.actuators).has(plant::kHydraulicCircuit)) return "";
   return std::string(to_string(kind)) + " needs the hydraulic machine; " + scene.file + " has actuators " +
-         plant::to_string(scene.actuators.fidelity);
+         scene.actuators.fidelity;
 }
 
 std::int64_t lockstep_cycles(const plant::Scene& scene, double duration) {
@@ -195,7 +195,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   const std::vector<double>& starts = firmware.task.cycle_starts;
   std::vector<CycleRecord> cycles_acc(std::max<std::size_t>(1, starts.size()));
   std::vector<std::array<double, 4>> cycle_sum_sq(cycles_acc.size(), std::array<double, 4>{});
-  const bool hydraulic = scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
+  const bool hydraulic = plant.fidelity().has(plant::kHydraulicCircuit);
   result.hydraulic = hydraulic;
   if (const std::string why = fault_misfit(options.fault.kind, scene); !why.empty())
     throw std::invalid_argument("fault: " + why);

@@ -54,8 +54,8 @@ void set_at(std::optional<YAML::Node>& tree, const YAML::Node& original, const s
 // could only fail at its first command (or never track), so the file is refused at load, placed as
 // the settings reader places any error (at the key, or at its section when the key is absent).
 void check_command_fits(const settings::Document& scene, const SceneBundle& b) {
-  const bool hydraulic = b.scene.actuators.fidelity == plant::ActuatorFidelity::hydraulic;
-  const control::CommandInterface wanted = hydraulic ? control::CommandInterface::valve : control::CommandInterface::effort;
+  const bool valves = plant::fidelity_of(b.scene.actuators).takes_valves();
+  const control::CommandInterface wanted = valves ? control::CommandInterface::valve : control::CommandInterface::effort;
   const control::CommandInterface given = b.firmware.controller.command_interface;
   if (given == wanted) return;
   settings::SectionReader top(scene);
@@ -63,8 +63,8 @@ void check_command_fits(const settings::Document& scene, const SceneBundle& b) {
   controller.fail("command_interface",
                   std::string("is ") + control::kCommandInterfaces.name_of(given) +
                       (controller.has("command_interface") ? "" : " (not given: the default)") + " but actuators.fidelity is " +
-                      plant::to_string(b.scene.actuators.fidelity) + ", which takes " +
-                      (hydraulic ? "valve (pilot pressure) commands" : "efforts") +
+                      b.scene.actuators.fidelity + ", which takes " +
+                      (valves ? "valve (pilot pressure) commands" : "efforts") +
                       "; set command_interface: " + control::kCommandInterfaces.name_of(wanted));
 }
 

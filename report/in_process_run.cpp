@@ -26,8 +26,8 @@ void check_controller_names(const std::vector<std::string>& names) {
 std::string describe_setup(const SceneBundle& bundle) {
   const plant::Scene& sc = bundle.scene;
   std::ostringstream o;
-  o << "actuators " << plant::to_string(sc.actuators.fidelity);
-  if (sc.actuators.fidelity == plant::ActuatorFidelity::limited) o << " (effort lag " << sc.actuators.lag * 1e3 << " ms)";
+  o << "actuators " << sc.actuators.fidelity;
+  if (const auto lag = plant::fidelity_of(sc.actuators).effort_lag) o << " (effort lag " << lag(sc.actuators) * 1e3 << " ms)";
   const control::ControllerConfig& c = bundle.firmware.controller;
   if (c.command_interface == control::CommandInterface::valve) {
     o << ", firmware commands the valves (pilot pressures; force loop T_f " << c.valves.force_time_constant * 1e3

@@ -1,74 +1,51 @@
 #pragma once
-// The actuators at three fidelities (machine.md, "Hydraulics"; hydraulics.md):
-//   ideal      the commanded swing torque and cylinder forces act as given (the paper);
-//   limited    efforts clamped to the relief limits, a first-order lag, speed limits and end stops
-//              (the last two are applied by the plant to the state after each substep);
-//   hydraulic  the machine's hydraulics (hydraulics.hpp): pumps with flow sharing, pilot-operated
-//              spools with lag and dead zones, chamber pressures, reliefs, make-up valves, the swing
-//              motor; commanded by spool opening or pilot pressures; the effort is p_A A_A - p_B A_B.
-#include "model/machine.hpp"
-#include "settings/enum_table.hpp"
-#include "sim_plant/hydraulics.hpp"
+// The machine's actuators at the scene's fidelity (actuator_fidelity.hpp: the registry of fidelities;
+// actuator_fidelities.cpp: the shipped ideal, limited and hydraulic). The model holds what every
+// fidelity shares: the machine's hydraulic circuit (run by the fidelities that have
+// kHydraulicCircuit, else kept for the cylinder areas of the sensors' pressure channels), the effort
+// that acted over the last substep, and the fidelity's own dynamics.
+#include <memory>
+
 #include "model/hydraulic_geometry.hpp"
+#include "model/machine.hpp"
+#include "sim_plant/actuator_fidelity.hpp"
+#include "sim_plant/hydraulics.hpp"
 
 namespace exc::plant {
 
-enum class ActuatorFidelity { ideal, limited, hydraulic };
-// The names a scene's actuators.fidelity takes.
-inline constexpr settings::EnumTable<ActuatorFidelity, 3> kActuatorFidelities{{{
-    {ActuatorFidelity::ideal, "ideal", "the commanded efforts act as given (the paper)"},
-    {ActuatorFidelity::limited, "limited", "efforts clamped to the relief limits, a first-order lag, speed limits, end stops"},
-    {ActuatorFidelity::hydraulic, "hydraulic", "the machine's hydraulics (pumps, spools, chambers, reliefs), valve commands"},
-}}};
-inline const char* to_string(ActuatorFidelity f) { return kActuatorFidelities.name_of(f); }
-
-// The scene's `actuators:` section. The hydraulic machine's numbers are the machine file's
-// (Machine::hydraulics): a scene chooses how the actuators are modelled, the machine what they are.
-struct ActuatorParameters {
-  ActuatorFidelity fidelity = ActuatorFidelity::ideal;
-  double lag = 0.02;                  // s, limited: effort time constant (0: none)
-};
-
-// What the controller sends each cycle:
-//   effort  swing torque (N m) and cylinder forces (N) in 'value', positive pushes longer;
-//   valve   signed spool openings -1..1 in 'value' (positive extends / swings counter-clockwise);
-//   pilot   pilot pressures 0..hydraulics.pilot_full_stroke (Pa) on each spool's A end (opens
-//           P->A: extends / swings counter-clockwise) and B end, as a real valve block takes them.
-struct ActuatorCommand {
-  enum Mode { effort, valve, pilot } mode = effort;
-  Vec4 value = Vec4::Zero();
-  Vec4 pilot_a = Vec4::Zero(), pilot_b = Vec4::Zero();
-};
-const char* to_string(ActuatorCommand::Mode m);
-
 class ActuatorModel {
  public:
-  ActuatorModel() = default;
-  // Throws SettingsError when machine.hydraulics is outside its ranges (hydraulic fidelity);
-  // `pressures` integrates the chambers (chamber.hpp).
+  // Throws SettingsError when machine.hydraulics is outside its ranges (a fidelity with
+  // kHydraulicCircuit), std::invalid_argument for an unregistered fidelity; `pressures` integrates
+  // the chambers (chamber.hpp).
   ActuatorModel(const Machine& machine, const ActuatorParameters& params,
                 PressureMethod pressures = PressureMethod::backward_euler);
+  // The fidelity's dynamics hold a reference to the circuit: not copied, not moved.
+  ActuatorModel(const ActuatorModel&) = delete;
+  ActuatorModel& operator=(const ActuatorModel&) = delete;
 
   const ActuatorParameters& parameters() const { return params_; }
+  // The fidelity's entry (a copy: the registry may grow after the plant is built).
+  const ActuatorFidelityEntry& fidelity() const { return fidelity_; }
 
   // Start: applied effort = 'hold' (hydraulic: chamber pressures that give it), spools centred.
   void reset(const Vec4& q_a, const Vec4& hold);
   // The command of this cycle (the plant checks the mode against the fidelity first).
-  void set_command(const ActuatorCommand& command);
+  void set_command(const ActuatorCommand& command) { dynamics_->set_command(command); }
 
   // The effort held on the machine over the next substep of length dt, from the state now: ideal
   // the command; limited the exact mean of its lag's response over the substep (so the command acts
   // within the cycle it is sent in: no delay beyond the lag); hydraulic the chamber pressures now.
-  Vec4 effort_over(double dt, const Vec4& q_a);
+  Vec4 effort_over(double dt, const Vec4& q_a) { return applied_ = dynamics_->effort_over(dt, q_a); }
   // The effort at this instant (limited: the lag's state; hydraulic: from the pressures).
-  Vec4 effort(const Vec4& q_a) const;
+  Vec4 effort(const Vec4& q_a) const { return dynamics_->effort(q_a); }
   // The effort effort_over() last returned (the one that acted over the last substep).
   const Vec4& applied() const { return applied_; }
   // Advance the actuator states over dt with the machine's motion (lag, spool, pressures).
-  void advance(double dt, const Vec4& q_a, const Vec4& qd_a);
+  void advance(double dt, const Vec4& q_a, const Vec4& qd_a) { dynamics_->advance(dt, q_a, qd_a); }
 
   const HydraulicCircuit& hydraulics() const { return circuit_; }
-  // Fault injection (hydraulic): a spool stuck whatever the command (HydraulicCircuit::stick_spool).
+  // Fault injection (kHydraulicCircuit): a spool stuck whatever the command (HydraulicCircuit::stick_spool).
   void stick_spool(int function, double spool) { circuit_.stick_spool(function, spool); }
   void release_spool() { circuit_.release_spool(); }
   void set_pump_flow_scale(double scale) { circuit_.set_pump_flow_scale(scale); }
@@ -84,11 +61,11 @@ class ActuatorModel {
 
  private:
   ActuatorParameters params_;
+  ActuatorFidelityEntry fidelity_;
   Vec4 effort_min_ = Vec4::Zero(), effort_max_ = Vec4::Zero();
-  ActuatorCommand command_;
-  Vec4 lagged_ = Vec4::Zero();  // limited: the lag's state
   Vec4 applied_ = Vec4::Zero();
   HydraulicCircuit circuit_;
+  std::unique_ptr<ActuatorDynamics> dynamics_;
 };
 
 }  // namespace exc::plant

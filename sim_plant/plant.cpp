@@ -68,19 +68,19 @@ void Plant::reset() {
 }
 
 bool Plant::accept_command(const ActuatorCommand& command) {
-  const ActuatorFidelity fidelity = scene_.actuators.fidelity;
-  const bool hydraulic = fidelity == ActuatorFidelity::hydraulic;
+  const ActuatorFidelityEntry& fidelity = actuators_.fidelity();
   if (!command.value.allFinite() || !command.pilot_a.allFinite() || !command.pilot_b.allFinite()) {
     set_failure(status_, PlantFailure::bad_command, state_.time, state_.cycle,
                 "the command holds NaN or Inf; send finite values");
     return false;
   }
   // A command of a kind the actuators cannot use stops the plant: running on would silently ignore it.
-  if (hydraulic == (command.mode == ActuatorCommand::effort)) {
+  if (!fidelity.takes(command.mode)) {
     set_failure(status_, PlantFailure::bad_command, state_.time, state_.cycle,
-                "%s commands for actuators.fidelity %s; %s", to_string(command.mode), to_string(fidelity),
-                hydraulic ? "hydraulic actuators take valve openings -1..1 or pilot pressures, not efforts"
-                          : "ideal and limited actuators take efforts (N m, N), not valve or pilot commands");
+                "%s commands for actuators.fidelity %s; %s actuators take %s", to_string(command.mode),
+                fidelity.name.c_str(), fidelity.name.c_str(),
+                fidelity.takes_valves() ? "valve openings -1..1 or pilot pressures, not efforts"
+                                        : "efforts (N m, N), not valve or pilot commands");
     return false;
   }
   if (command.mode == ActuatorCommand::valve && command.value.cwiseAbs().maxCoeff() > 1.0 + 1e-12) {
@@ -102,7 +102,7 @@ bool Plant::accept_command(const ActuatorCommand& command) {
   return true;
 }
 
-// End stops and the flow (speed) limit of limited and hydraulic actuators: inelastic, so the state
+// End stops (fidelities with kEndStops) and the flow (speed) limit (kSpeedLimits): inelastic, so the state
 // stays on its stroke. A cylinder through its stop is put back on it, and its velocity into the stop
 // removed, both along M_a^-1 e_i: an inelastic contact of the coupled coordinates (the other joints
 // keep the momentum the stop does not absorb; kinetic energy can only fall). Clamping the one
@@ -112,7 +112,9 @@ bool Plant::accept_command(const ActuatorCommand& command) {
 // on its stop (v = 0) loses nothing. The limited actuators' speed limit acts the same way (below),
 // and its loss is booked there too. Returns true if the state was changed.
 bool Plant::apply_limits(const Vec4& qd_start) {
-  if (scene_.actuators.fidelity == ActuatorFidelity::ideal) return false;
+  const bool end_stops = actuators_.fidelity().has(kEndStops);
+  const bool speed_limits = actuators_.fidelity().has(kSpeedLimits);
+  if (!end_stops && !speed_limits) return false;
   bool changed = false;
   bool have_inverse = false;
   Mat4 m_inv = Mat4::Identity();
@@ -131,7 +133,7 @@ bool Plant::apply_limits(const Vec4& qd_start) {
   };
   for (int i = 0; i < kNumActive; ++i) {
     const bool below = mech_.q_a[i] < q_min_[i], above = mech_.q_a[i] > q_max_[i];
-    if (below || above) {
+    if (end_stops && (below || above)) {
       changed = true;
       const Mat4& mi = inverse();
       const double stop = below ? q_min_[i] : q_max_[i];
@@ -149,7 +151,7 @@ bool Plant::apply_limits(const Vec4& qd_start) {
       }
     }
     const double v = mech_.qd_a[i];
-    if (scene_.actuators.fidelity == ActuatorFidelity::limited && std::abs(v) > speed_max_[i]) {
+    if (speed_limits && std::abs(v) > speed_max_[i]) {
       // The flow limit as an impulse along M_a^-1 e_i (the same as the end stop's): it takes the
       // excess d off this joint and lets the coupled joints keep their momentum (setting the one
       // coordinate instead can add energy through the mass matrix's coupling). The positions give
@@ -263,7 +265,7 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
   actuators_.set_command(command);
   const double h = scene_.integrator.step;
   const bool augmented = scene_.integrator.formulation != Formulation::independent;
-  const bool hydraulic = scene_.actuators.fidelity == ActuatorFidelity::hydraulic;
+  const bool hydraulic = actuators_.fidelity().has(kHydraulicCircuit);
   Evaluation start;
   for (int k = 0; k < substeps_; ++k) {
     const double t = state_.time + (k + 1) * h;
@@ -305,7 +307,8 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
     in.implicit_converged = out.converged;
     in.q_min = q_min_;
     in.q_max = q_max_;
-    in.fidelity = scene_.actuators.fidelity;
+    in.fidelity = actuators_.fidelity().name.c_str();
+    in.end_stops = actuators_.fidelity().has(kEndStops);
     in.integrator = &scene_.integrator;
     if (report.ok()) {
       account_work(tau, before, start, rho_, rhod_);
@@ -369,7 +372,7 @@ void Plant::fill_state(const Evaluation& last) {
   state_.in_soil = soil_.in_soil();
   state_.depth = soil_.depth(rho_);
   state_.reanchor_count = soil_.reanchor_count();
-  const bool hydraulic = scene_.actuators.fidelity == ActuatorFidelity::hydraulic;
+  const bool hydraulic = actuators_.fidelity().has(kHydraulicCircuit);
   state_.effort = hydraulic ? actuators_.effort(mech_.q_a) : actuators_.applied();
   state_.spool = actuators_.spool();
   state_.pressure_a = actuators_.pressure_a();

@@ -56,13 +56,13 @@ class Plant {
 
   // Fault injection (the fault campaign): the soil stiffer by `scale` from now on (1: the scene's).
   void set_soil_stiffness_scale(double scale) { soil_.set_stiffness_scale(scale, scene_.soil); }
-  // Fault injection (hydraulic fidelity): the spool of `function` (0 swing .. 3 bucket) stuck at
+  // Fault injection (a fidelity with kHydraulicCircuit): the spool of `function` (0 swing .. 3 bucket) stuck at
   // `spool` (-1..1) whatever is commanded, from the next step until release_spool() or reset().
   void stick_spool(int function, double spool) { actuators_.stick_spool(function, spool); }
   void release_spool() { actuators_.release_spool(); }
   // The hydraulic machine's pumps deliver `scale` of their flow from now on (1: the machine's).
   void set_pump_flow_scale(double scale) { actuators_.set_pump_flow_scale(scale); }
-  // The machine's safety hardware (hydraulic fidelity; HydraulicCircuit): the pilot cut-off and the
+  // The machine's safety hardware (kHydraulicCircuit; HydraulicCircuit): the pilot cut-off and the
   // engine stop. Their state: hydraulics() of actuators(), or PlantNode's PlantState bits.
   void set_pilot_supply(bool on) { actuators_.set_pilot_supply(on); }
   void set_engine_running(bool on) { actuators_.set_engine_running(on); }
@@ -75,6 +75,8 @@ class Plant {
   const SensorReading& sensors() const { return sensors_.latest(); }
   const PlantStatus& status() const { return status_; }
   const Scene& scene() const { return scene_; }
+  // The scene's actuator fidelity: what its actuators take and do (actuator_fidelity.hpp).
+  const ActuatorFidelityEntry& fidelity() const { return actuators_.fidelity(); }
   const Model& model() const { return model_; }
   const Workspace& workspace() const { return ws_; }  // the dynamics' buffers at the last evaluation
   // Efforts that hold the initial state still (gravity only): the hydraulic chambers start there.

@@ -132,14 +132,14 @@ bool run_plant_checks(const CheckSettings& settings, const CheckInputs& in, Plan
                 to_string(integ.formulation), integ.step);
     return false;
   }
-  if (in.fidelity == ActuatorFidelity::ideal) {
+  if (!in.end_stops) {
     for (int i = 1; i < kNumActive; ++i) {
       const double below = in.q_min[i] - st.q_a[i], above = st.q_a[i] - in.q_max[i];
       if (below > settings.end_stop_margin || above > settings.end_stop_margin) {
         set_failure(status, PlantFailure::end_stop, in.time, in.cycle,
-                    "the %s cylinder was driven through its end stop (%.4f m, stroke %.3f..%.3f m); ideal actuators "
+                    "the %s cylinder was driven through its end stop (%.4f m, stroke %.3f..%.3f m); %s actuators "
                     "have no end stops: command it back inside, or use actuators.fidelity limited or hydraulic",
-                    kActiveNames[i], st.q_a[i], in.q_min[i], in.q_max[i]);
+                    kActiveNames[i], st.q_a[i], in.q_min[i], in.q_max[i], in.fidelity);
         return false;
       }
     }

@@ -62,7 +62,8 @@ struct CheckInputs {
   ModelReport model_report;
   bool implicit_converged = true;
   Vec4 q_min = Vec4::Zero(), q_max = Vec4::Zero();
-  ActuatorFidelity fidelity = ActuatorFidelity::ideal;
+  const char* fidelity = "";  // actuators.fidelity's name
+  bool end_stops = false;      // the fidelity stops the cylinders at their strokes' ends (kEndStops)
   const IntegratorSettings* integrator = nullptr;
   // Hydraulic chamber pressures (Pa, swing motor ports first) and the range they must stay in;
   // null for the other fidelities.

@@ -124,10 +124,11 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
                          cycle - last_command_cycle_ > static_cast<std::uint64_t>(config_.command_timeout_cycles);
   // The firmware's safe state is "valves centred" (valve command of zeros); a force-commanded
   // plant has no valves, so it brakes instead.
-  const bool hydraulic = plant_.scene().actuators.fidelity == plant::ActuatorFidelity::hydraulic;
+  const bool valves = plant_.fidelity().takes_valves();
+  const bool hydraulic = plant_.fidelity().has(plant::kHydraulicCircuit);
   bool centred = true;
   for (double v : command_.value) centred = centred && v == 0;
-  const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && centred && !hydraulic;
+  const bool firmware_holds = command_.valid && command_.mode == hal::CommandMode::valve && centred && !valves;
   const bool machine_fault = fault_.kind == InjectedFault::Kind::machine_fault;
   const bool hold = timed_out || command_.emergency_stop || firmware_holds || machine_fault;
   if (hold && !holding_) ++holds_;
@@ -145,8 +146,8 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   // mismatched setup fails at once instead of running on with the commands ignored.
   plant::ActuatorCommand actuator;
   if (hold) {
-    actuator.mode = hydraulic ? plant::ActuatorCommand::valve : plant::ActuatorCommand::effort;
-    if (!hydraulic) actuator.value = hold_effort();  // valves: centred (zeros)
+    actuator.mode = valves ? plant::ActuatorCommand::valve : plant::ActuatorCommand::effort;
+    if (!valves) actuator.value = hold_effort();  // valves: centred (zeros)
   } else {
     switch (command_.mode) {
       case hal::CommandMode::effort: actuator.mode = plant::ActuatorCommand::effort; break;
@@ -213,7 +214,7 @@ void PlantNode::publish_state() {
   }
   m.in_soil = s.in_soil;
   m.depth = s.depth;
-  if (plant_.scene().actuators.fidelity == plant::ActuatorFidelity::hydraulic) {
+  if (plant_.fidelity().has(plant::kHydraulicCircuit)) {
     for (int j = 0; j < 4; ++j) {
       m.pressure_a[j] = s.pressure_a[j];
       m.pressure_b[j] = s.pressure_b[j];

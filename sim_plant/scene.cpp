@@ -100,7 +100,7 @@ Scene read_scene(const settings::Document& doc, const SceneMachine& machine) {
   init.finish();
 
   SectionReader act = top.section("actuators", "how the actuators are modelled (their numbers: the machine file)");
-  act.choice("fidelity", s.actuators.fidelity, kActuatorFidelities, "the actuator model");
+  act.choice("fidelity", s.actuators.fidelity, actuator_fidelities(), "the actuator model");
   act.number("lag", s.actuators.lag, {0, 1}, "s", "limited: effort time constant");
   act.finish();
 

@@ -21,13 +21,13 @@ ControllerRegistry shipped_controllers() {
   r.add({"pid", "closed-chain inverse dynamics + PID (the paper's baseline)", build_law<ComputedTorquePid>,
          kAnyInterface, DefaultRun::yes});
   r.add({"adaptive", "adaptive computed torque with the soil regressor (paper eqs. 12-28)",
-         build_law<AdaptiveComputedTorque>, kAnyInterface, DefaultRun::yes});
+         build_law<AdaptiveComputedTorque>, kAnyInterface, DefaultRun::yes, Adapts::yes});
   r.add({"slotine_li", "Slotine-Li passivity-based adaptive law (needs no acceleration)", build_law<SlotineLi>,
-         kAnyInterface, DefaultRun::no});
+         kAnyInterface, DefaultRun::no, Adapts::yes});
   r.add({"flow",
          "flow-based position control: valve flow from the desired velocity plus position feedback, no model (the "
          "industry's baseline; valve-commanded machines only)",
-         build_law<FlowPositionControl>, kValveInterface, DefaultRun::yes, flow_task_misfit});
+         build_law<FlowPositionControl>, kValveInterface, DefaultRun::yes, Adapts::no, flow_task_misfit});
   return r;
 }
 

@@ -36,12 +36,17 @@ enum InterfaceSet : std::uint8_t { kEffortInterface = 1, kValveInterface = 2, kA
 // valve-commanded machine, the industry's baseline).
 enum class DefaultRun : std::uint8_t { no, yes };
 
+// Whether the law adapts parameter estimates at ControllerConfig::adaptation_rate (what a sweep's
+// adaptation_scale changes; the stability map leaves a law that adapts nothing out of that axis).
+enum class Adapts : std::uint8_t { no, yes };
+
 struct ControllerEntry {
   std::string name;
   std::string what;
   ControllerFactory make = nullptr;
   std::uint8_t interfaces = kAnyInterface;
   DefaultRun default_run = DefaultRun::no;
+  Adapts adapts = Adapts::no;
   // Why the law cannot run this task ("" when it can; null: it can run any task). A default set
   // leaves such a law out and says why; asked for by name it still runs.
   std::string (*task_misfit)(const Task& task) = nullptr;

@@ -18,7 +18,7 @@ const Vec4 kMid(0.0, 2.2, 2.8, 2.0);  // a mid-stroke q_a
 TEST_CASE("plant/limited actuator follows a first-order lag (closed-form step response)") {
   const Machine m = reference_machine();
   ActuatorParameters p;
-  p.fidelity = ActuatorFidelity::limited;
+  p.fidelity = "limited";
   p.lag = 0.05;
   ActuatorModel a(m, p);
   a.reset(kMid, Vec4::Zero());
@@ -36,7 +36,7 @@ TEST_CASE("plant/limited actuator follows a first-order lag (closed-form step re
 TEST_CASE("plant/limited actuator clamps efforts to the relief limits (area x 34.3 MPa)") {
   const Machine m = reference_machine();
   ActuatorParameters p;
-  p.fidelity = ActuatorFidelity::limited;
+  p.fidelity = "limited";
   p.lag = 0;
   ActuatorModel a(m, p);
   a.reset(kMid, Vec4::Zero());
@@ -61,7 +61,7 @@ TEST_CASE("plant/hydraulic closed valve: the chamber pressure follows the oil sp
   m.hydraulics.bulk_modulus = 1.2e9;
   const HydraulicParameters& h = m.hydraulics;
   ActuatorParameters p;
-  p.fidelity = ActuatorFidelity::hydraulic;
+  p.fidelity = "hydraulic";
   ActuatorModel a(m, p);
   a.reset(kMid, Vec4(0, 3e5, 1e5, 5e4));
   const Vec4 pa0 = a.pressure_a(), pb0 = a.pressure_b();
@@ -89,7 +89,7 @@ TEST_CASE("plant/hydraulic spool follows its first-order lag") {
   Machine m = reference_machine();
   m.hydraulics.valve_time_constant = 0.03;
   ActuatorParameters p;
-  p.fidelity = ActuatorFidelity::hydraulic;
+  p.fidelity = "hydraulic";
   ActuatorModel a(m, p);
   a.reset(kMid, Vec4::Zero());
   ActuatorCommand c;

@@ -51,7 +51,7 @@ RunResult run(const Scene& scene, double seconds) {
 }  // namespace
 
 TEST_CASE("plant/free motion keeps its energy with every integrator and formulation") {
-  for (const char* m : test::kMethods) {
+  for (const std::string& m : test::methods()) {
     for (const char* f : test::kFormulations) {
       CAPTURE(std::string(m));
       CAPTURE(std::string(f));
@@ -150,7 +150,7 @@ TEST_CASE("plant/independent and augmented formulations agree on the same motion
 }
 
 TEST_CASE("plant/every integrator at 1 ms is within millimetres of a fine-step reference") {
-  auto scene = [](const char* m, const char* f, double h) {
+  auto scene = [](const std::string& m, const std::string& f, double h) {
     SceneText t;
     t.method = m;
     t.formulation = f;
@@ -166,7 +166,7 @@ TEST_CASE("plant/every integrator at 1 ms is within millimetres of a fine-step r
     return Vec2(p.state().rho);
   };
   const Vec2 reference = final_tip(scene("rk4", "independent", 1e-4));
-  for (const char* m : test::kMethods) {
+  for (const std::string& m : test::methods()) {
     for (const char* f : test::kFormulations) {
       const double err = (final_tip(scene(m, f, 1e-3)) - reference).norm();
       MESSAGE(std::string(m) << " / " << f << " at 1 ms: tip error after 2 s = " << err * 1e3 << " mm");

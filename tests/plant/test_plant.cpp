@@ -27,19 +27,21 @@ using namespace exc::plant;
 TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, formulation, fidelity, pressure method)") {
   REQUIRE(exc::app::allocation_counting_works());
   struct Config {
-    const char *method, *formulation, *actuators, *integrator = "";
+    std::string method, formulation, actuators, integrator;
   };
   std::vector<Config> configs;
-  for (const char* m : exc::plant::test::kMethods)
-    for (const char* f : exc::plant::test::kFormulations) configs.push_back({m, f, "fidelity: ideal"});
-  configs.push_back({"semi_implicit_euler", "independent", "fidelity: limited"});
-  configs.push_back({"semi_implicit_euler", "independent", "fidelity: hydraulic"});
-  configs.push_back({"semi_implicit_euler", "independent", "fidelity: hydraulic", "pressure_method: forward_euler"});
+  for (const std::string& m : exc::plant::test::methods())
+    for (const char* f : exc::plant::test::kFormulations) configs.push_back({m, f, "fidelity: ideal", ""});
+  for (const ActuatorFidelityEntry& a : actuator_fidelities().entries()) {
+    configs.push_back({"semi_implicit_euler", "independent", "fidelity: " + a.name, ""});
+    if (a.has(kHydraulicCircuit))
+      configs.push_back({"semi_implicit_euler", "independent", "fidelity: " + a.name, "pressure_method: forward_euler"});
+  }
   for (const Config& c : configs) {
-    CAPTURE(std::string(c.method));
-    CAPTURE(std::string(c.formulation));
-    CAPTURE(std::string(c.actuators));
-    CAPTURE(std::string(c.integrator));
+    CAPTURE(c.method);
+    CAPTURE(c.formulation);
+    CAPTURE(c.actuators);
+    CAPTURE(c.integrator);
     exc::plant::test::SceneText t;
     t.extra_integrator = c.integrator;
     t.method = c.method;
@@ -51,9 +53,9 @@ TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, form
                 "latency_cycles: 2, position_quantum: [1e-4, 1e-4, 1e-4, 1e-4]";
     Plant p(t.scene());
     ActuatorCommand cmd;
-    const bool hydraulic = std::string(c.actuators) == "fidelity: hydraulic";
-    cmd.mode = hydraulic ? ActuatorCommand::valve : ActuatorCommand::effort;
-    cmd.value = hydraulic ? Vec4::Zero() : Vec4(p.hold_effort());
+    const bool valves = p.fidelity().takes_valves();
+    cmd.mode = valves ? ActuatorCommand::valve : ActuatorCommand::effort;
+    cmd.value = valves ? Vec4::Zero() : Vec4(p.hold_effort());
     p.step(cmd);  // first step outside the counter: nothing lazily allocated may hide
     std::size_t allocations = 0;
     int steps = 0;
@@ -115,7 +117,7 @@ TEST_CASE("plant/end stop: ideal actuators report a cylinder driven through it, 
 }
 
 TEST_CASE("plant/step time per integrator: the median keeps pace with the 1 kHz cycle four times over (printed)") {
-  for (const char* m : exc::plant::test::kMethods) {
+  for (const std::string& m : exc::plant::test::methods()) {
     for (const char* f : exc::plant::test::kFormulations) {
       exc::plant::test::SceneText t;
       t.method = m;

@@ -19,7 +19,7 @@ const std::string kBase = "name: t\nduration: 1\ninitial_state: {q_a: [0, 2.4626
 TEST_CASE("plant/scene minimal file loads with the documented defaults") {
   const Scene s = read_scene(settings::Document::parse(kBase, "ok.yaml"));
   CHECK(s.name == "t");
-  CHECK(s.actuators.fidelity == ActuatorFidelity::ideal);
+  CHECK(s.actuators.fidelity == "ideal");
   CHECK(s.integrator.method == "semi_implicit_euler");
   CHECK(s.integrator.formulation == Formulation::independent);
   CHECK(s.integrator.step == 1e-3);

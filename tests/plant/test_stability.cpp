@@ -15,7 +15,7 @@ namespace {
 
 // The reference pose with its tip 0.1 m deep in a stiff soil (10x stiffer and 50x more damped than
 // stiff clay: a full bucket pressed against rock), moving into it, efforts holding the weight.
-Scene stiff_soil_scene(const char* method, const char* formulation, double h) {
+Scene stiff_soil_scene(const std::string& method, const std::string& formulation, double h) {
   test::SceneText t = test::SceneText::stepped(method, formulation, h);
   t.terrain = "height: 1.93";
   t.soil = "stiffness: [2e6, 2e6], damping: [5e5, 5e5], mass: [200, 200]";
@@ -53,7 +53,7 @@ Outcome run(const Scene& s, double seconds) {
 
 TEST_CASE("plant/stability limit of every integrator with stiff soil is found, reported, and safe below") {
   const double steps[] = {1e-3, 2e-3, 4e-3, 8e-3, 16e-3, 32e-3, 64e-3, 128e-3, 256e-3, 512e-3};
-  for (const char* m : test::kMethods) {
+  for (const std::string& m : test::methods()) {
     for (const char* f : test::kFormulations) {
       CAPTURE(std::string(m));
       CAPTURE(std::string(f));

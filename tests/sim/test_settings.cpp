@@ -78,7 +78,7 @@ const char* const kScenes[] = {"dig.yaml", "free_motion.yaml", "truck_loading.ya
 TEST_CASE("tools/settings: each enumerated field's row in the docs lists exactly its table's names") {
   using namespace exc;
   CHECK(names_in_row("scene-schema.md", "soil.preset", 2) == names_of(plant::kSoilPresets));
-  CHECK(names_in_row("scene-schema.md", "actuators.fidelity", 2) == names_of(plant::kActuatorFidelities));
+  CHECK(names_in_row("scene-schema.md", "actuators.fidelity", 2) == names_of(plant::actuator_fidelities()));
   CHECK(names_in_row("scene-schema.md", "integrator.method", 2) == names_of(plant::integration_methods()));
   CHECK(names_in_row("scene-schema.md", "integrator.formulation", 2) == names_of(plant::kFormulations));
   CHECK(names_in_row("scene-schema.md", "integrator.pressure_method", 2) == names_of(plant::kPressureMethods));

@@ -77,7 +77,7 @@ int main(int argc, char** argv) {
     exc::app::PlantNode node(plant, port, publisher.get());
     exc::app::InjectedFault stuck;
     if (!stuck_function.empty()) {
-      if (plant.scene().actuators.fidelity != exc::plant::ActuatorFidelity::hydraulic)
+      if (!plant.fidelity().has(exc::plant::kHydraulicCircuit))
         throw std::invalid_argument("--stuck-spool needs the hydraulic machine; the scene's actuators are not");
       stuck.kind = exc::app::InjectedFault::Kind::valve_stuck;
       stuck.joint = stuck_function == "swing" ? 0 : stuck_function == "boom" ? 1 : stuck_function == "arm" ? 2 : 3;

@@ -64,7 +64,7 @@ int main(int argc, char** argv) {
     // One run, nothing else: under callgrind, Plant::step's inclusive count over its calls is the
     // hydraulic step's cost in instructions.
     Scene s = base;
-    s.actuators.fidelity = ActuatorFidelity::hydraulic;
+    s.actuators.fidelity = "hydraulic";
     const ValveDriver driver(task, s.machine);
     Plant p(s);
     ActuatorCommand c;
@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
 
   // The mechanics' cost: the scene with ideal force actuators, driven by the task's efforts.
   Scene forces = base;
-  forces.actuators.fidelity = ActuatorFidelity::ideal;
+  forces.actuators.fidelity = "ideal";
   std::printf("## Plant step time, dig scene with ideal force actuators at 1 kHz (step = cycle = 1 ms), per "
               "integrator x formulation\n\n");
   std::printf("| method | formulation | median us | p99 us | max us | real-time factor | finished |\n|---|---|---|---|---|---|---|\n");
@@ -123,7 +123,7 @@ int main(int argc, char** argv) {
   // The hydraulic step: the scene as shipped (hydraulic, its own integrator) driven through its
   // valves, with each way of integrating the pressures; the real-time factor is the best of
   // 'repeats' runs, the step statistics from all of them.
-  if (base.actuators.fidelity != ActuatorFidelity::hydraulic)
+  if (!fidelity_of(base.actuators).has(kHydraulicCircuit))
     std::printf("\n(the scene is not hydraulic: the hydraulic rows run it with actuators.fidelity hydraulic)\n");
   std::printf("\n## Hydraulic step, dig scene through its valves (%s / %s, %g ms; chambers: 8 scalar solves per "
               "substep)\n\n| pressures | median us | p99 us | max us | chamber iterations per step: mean, p99 "
@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
               base.integrator.method.c_str(), to_string(base.integrator.formulation), base.integrator.step * 1e3);
   for (const auto& [pm, pm_name, pm_what] : kPressureMethods.entries) {
     Scene s = base;
-    s.actuators.fidelity = ActuatorFidelity::hydraulic;
+    s.actuators.fidelity = "hydraulic";
     s.integrator.pressure_method = pm;
     const ValveDriver driver(task, s.machine);
     std::vector<double> us, iterations;

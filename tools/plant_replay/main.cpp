@@ -110,7 +110,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "Runs a scene open-loop from a CSV of efforts (zero-order hold) and writes the plant's state at every "
       "cycle.\nCSV columns: t,swing,boom,arm,bucket: swing torque (N m) and cylinder forces (N, positive pushes "
-      "longer); for actuators.fidelity hydraulic, valve openings -1..1 instead. An optional header line (its first "
+      "longer); for an actuators.fidelity that takes valve commands (hydraulic), valve openings -1..1 instead. An optional header line (its first "
       "cell not a number), blank lines and lines starting with # are skipped.",
       "excavator-plant-replay"};
   std::string scene_path, efforts_path, out_path;
@@ -126,7 +126,7 @@ int main(int argc, char** argv) {
   exc::plant::Scene scene;
   try {
     scene = exc::plant::load_scene(scene_path);
-    rows = read_efforts(efforts_path, scene.actuators.fidelity == exc::plant::ActuatorFidelity::hydraulic);
+    rows = read_efforts(efforts_path, exc::plant::fidelity_of(scene.actuators).takes_valves());
   } catch (const std::exception& e) {
     std::cerr << "excavator-plant-replay: " << e.what() << "\n";
     return 2;
@@ -151,8 +151,7 @@ int main(int argc, char** argv) {
                "kinetic_energy,potential_energy,energy_error,constraint_residual,p_a_boom,p_a_arm,p_a_bucket,"
                "p_b_boom,p_b_arm,p_b_bucket\n");
   exc::plant::ActuatorCommand cmd;
-  cmd.mode = scene.actuators.fidelity == exc::plant::ActuatorFidelity::hydraulic ? exc::plant::ActuatorCommand::valve
-                                                                                 : exc::plant::ActuatorCommand::effort;
+  cmd.mode = plant.fidelity().takes_valves() ? exc::plant::ActuatorCommand::valve : exc::plant::ActuatorCommand::effort;
   const long cycles = std::lround(duration / scene.cycle);
   std::size_t row = 0;
   int rc = 0;
