@@ -144,10 +144,14 @@ SceneBundle SceneChanges::read() const {
   // Each member assigned once, into a new bundle: assigning a YAML node that shares the nominal's tree
   // (Scene::effective) would overwrite that tree.
   SceneBundle b;
+  // The machine file's tree with a side's values set, read as that side's machine.
+  const auto changed_machine = [&nominal_machine](const YAML::Node& tree) {
+    SceneMachine m{nominal_machine.file, nominal_machine.document.with_root(tree), {}};
+    m.machine = read_machine(m.document);
+    return m;
+  };
   if (plant_machine_) {
-    SceneMachine plant{nominal_machine.file, nominal_machine.document.with_root(*plant_machine_), {}};
-    plant.machine = read_machine(plant.document);
-    b.scene = plant::read_scene(scene, plant);
+    b.scene = plant::read_scene(scene, changed_machine(*plant_machine_));
   } else {
     b.scene = plant_sections_ ? plant::read_scene(scene, nominal_machine) : source_.nominal.scene;
   }
@@ -156,9 +160,7 @@ SceneBundle SceneChanges::read() const {
   // stage's spool lead and force-loop time constants) follows the firmware's model, not the file's;
   // the controller alone when only it changed (the task's effort check is the costly part of the reading).
   if (firmware_machine_) {
-    SceneMachine firmware{nominal_machine.file, nominal_machine.document.with_root(*firmware_machine_), {}};
-    firmware.machine = read_machine(firmware.document);
-    b.firmware = app::read_firmware_settings(scene, firmware);
+    b.firmware = app::read_firmware_settings(scene, changed_machine(*firmware_machine_));
   } else {
     b.firmware = firmware_sections_ ? app::read_firmware_settings(scene, nominal_machine) : source_.nominal.firmware;
     if (controller_ && !firmware_sections_) b.firmware.controller = control::read_controller_config(scene, nominal_machine.machine);
