@@ -95,6 +95,7 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
                        config.controller.period, control::effort_limits_of(model.machine)),
       valves_(control::valve_loop_model(model.machine), config.controller.valves, config.controller.period),
       plausibility_(config.controller.plausibility, config.controller.period),
+      frozen_position_(config.controller.plausibility),
       pressure_monitor_(model.machine, config.controller.pressure_plausibility, config.controller.period),
       control_timing_("control", 100.0),
       cycle_timing_("cycle", config.controller.period * 1e6),
@@ -627,12 +628,20 @@ void FirmwareNode::check_plausibility(bool restarted) {
   const control::ValveCommand& v = valves_.last();
   const FlowMeasurement m = flow_measurement();
   const std::uint8_t found = plausibility_.update(!restarted, v.velocity, m.position, m.compression, m.at_relief);
-  if (found == 0 || fault_ || !plausibility_.settings().enabled) return;
+  const std::uint8_t frozen = frozen_position_.update(!restarted, plausibility_, m.position, m.at_relief);
+  if ((found | frozen) == 0 || fault_ || !plausibility_.settings().enabled) return;
   int j = 0;
-  while (((found >> j) & 1) == 0) ++j;
+  while ((((found | frozen) >> j) & 1) == 0) ++j;
   raise(FirmwareFault::velocity_implausible);
   const char* const unit = j == 0 ? "rad" : "m";
   const double window = plausibility_.settings().window;
+  if (((found >> j) & 1) == 0) {
+    std::snprintf(pending_text_, sizeof pending_text_,
+                  "position frozen at t = %.3f s: %s read %.5f %s for %d sets, asked %.3f %s/s", time(),
+                  kActiveNames[static_cast<std::size_t>(j)], m.position[j], unit, frozen_position_.settings().frozen_sets,
+                  plausibility_.expected()[j], unit);
+    return;
+  }
   // (fits pending_text_: the times first, the figures after)
   std::snprintf(pending_text_, sizeof pending_text_,
                 "flow implausible at t = %.3f s: %s took %.4f %s over %.2f s, asked %.4f (velocity %.3f, flow asked %.3f)", time(),

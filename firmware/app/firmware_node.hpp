@@ -16,6 +16,7 @@
 #include "control/path_stop.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
+#include "control/frozen_position.hpp"
 #include "control/perf_counter.hpp"
 #include "control/pressure_plausibility.hpp"
 #include "control/state_estimator.hpp"
@@ -122,6 +123,7 @@ class FirmwareNode {
   const control::ValveCommand& last_valve_command() const { return valves_.last(); }
   // The velocity plausibility monitor (valve interface): expected velocities, residuals, margins.
   const control::VelocityPlausibility& plausibility() const { return plausibility_; }
+  const control::FrozenPosition& frozen_position() const { return frozen_position_; }
   // The chamber pressures' plausibility monitor (valve interface): margins, longest frozen runs.
   const control::PressurePlausibility& pressure_plausibility() const { return pressure_monitor_; }
   std::uint64_t pump_limited_cycles() const { return pump_limited_cycles_; }
@@ -224,6 +226,7 @@ class FirmwareNode {
   control::ActuatorLagCompensator lag_compensator_;
   control::ValveInnerLoop valves_;
   control::VelocityPlausibility plausibility_;
+  control::FrozenPosition frozen_position_;  // the reading that stops while its function is driven
   control::PressurePlausibility pressure_monitor_;
   std::uint64_t pump_limited_cycles_ = 0;
   bool pump_warning_ = false;

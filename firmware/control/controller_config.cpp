@@ -86,6 +86,10 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   pl.number("window", c.plausibility.window, {1e-3, 10}, "s", "high-pass time constant of the delivered and commanded displacements");
   pl.number("lag", c.plausibility.lag, {0, 1}, "s", "first-order lag the commands are expected through");
   pl.number("debounce", c.plausibility.debounce, {1e-3, 1}, "s", "how long the residual must stay outside the band");
+  pl.whole("frozen_sets", c.plausibility.frozen_sets, 2, 1000000, "",
+           "sensor sets in a row a position reading may stay bit-identical while its function is driven and the oil shows neither as motion nor as compression");
+  pl.numbers("frozen_speed", c.plausibility.frozen_speed, {1e-5, 10}, "",
+             "rad/s (swing), m/s: the commanded speed above which a reading must change (default: kFrozenSpeedShare of its top speed)");
   pl.finish();
   SectionReader pp = r.section("pressure_plausibility",
                                "the chamber pressures' range, steps and stuck-at readings, valve interface (docs/safety.md, H4)");
@@ -174,6 +178,7 @@ ControllerConfig controller_defaults(const Machine& nominal) {
   c.valves.force_time_constant = std::max(nominal.hydraulics.valve_time_constant, 0.005);
   c.valves.spool_lag_target = nominal.hydraulics.valve_time_constant / 3;
   c.plausibility.velocity_floor = kPlausibilityVelocityShare * nominal.speed_max();
+  c.plausibility.frozen_speed = kFrozenSpeedShare * nominal.speed_max();
   return c;
 }
 

@@ -145,6 +145,9 @@ struct ControllerConfig {
 // shipped hydraulic scenes' fault-free figures stay inside it (test firmware/plausibility prints the
 // margins), and a spool stuck at a share s of its opening is found after about share / s windows.
 inline constexpr double kPlausibilityVelocityShare = 0.1;
+// Of a function's top speed: driven faster, its position reading must change within
+// plausibility.frozen_sets (0.2 s at 2 %: the bucket's 10 um quantum 280 times over).
+inline constexpr double kFrozenSpeedShare = 0.02;
 ControllerConfig controller_defaults(const Machine& nominal);
 // Reads the `controller:` section into c (a field the section does not give keeps c's value, which
 // is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,

@@ -38,6 +38,10 @@ struct PlausibilitySettings {
   double window = 0.1;             // s, the high-pass time constant of both displacements
   double lag = 0.02;               // s, the response the commands are filtered with (spool, sensing)
   double debounce = 0.01;          // s the test must fail in a row
+  // The frozen reading test (frozen_position.hpp): sensor sets in a row, and the asked speed per
+  // function above which a motion must show (default: kFrozenSpeedShare of its top speed).
+  int frozen_sets = 200;
+  Vec4 frozen_speed = Vec4::Constant(0.01);
 };
 
 class VelocityPlausibility {
@@ -103,6 +107,8 @@ class VelocityPlausibility {
   const Vec4& expected() const { return expected_; }     // the lagged commanded flow per area
   const Vec4& delivered() const { return delivered_; }   // high-passed displacement that arrived
   Vec4 asked() const { return asked_pos_ - asked_neg_; }  // high-passed displacement asked for, net
+  const Vec4& asked_positive() const { return asked_pos_; }  // ... each way (both >= 0)
+  const Vec4& asked_negative() const { return asked_neg_; }
   const Vec4& excess() const { return excess_; }
   // The largest test value over its floor seen per function (1: the edge), for margins in reports.
   const Vec4& worst_ratio() const { return worst_ratio_; }

@@ -86,7 +86,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
                           << "), worst time to rest of those at rest " << worst_rest << " s (" << worst_rest_case << ")");
 }
 
-TEST_CASE("firmware/plausibility: without a fault the velocity monitor never trips on the shipped hydraulic scenes under every law they run, its margins printed") {
+TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the frozen-reading test never trip on the shipped hydraulic scenes under every law they run, their margins printed") {
   // The shipped scenes that drive the hydraulic machine through its valves, the laws each runs
   // without faulting (flow-based control lags a moving swing past its tracking limit: not run there).
   for (const auto& sc : plant::test::kShippedHydraulicScenes) {
@@ -94,20 +94,24 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor never tri
     for (const std::string law : kLaws) {
       if (law == "flow" && sc.swing_moves) continue;
       Vec4 worst = Vec4::Zero();
+      int longest_frozen = 0;  // the frozen-reading test's longest run of counted sets, any function
       sim::LockstepOptions o;
       o.controller = law;
-      o.node_observer = [&worst](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+      o.node_observer = [&worst, &longest_frozen](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
         worst = node.plausibility().worst_ratio();
+        for (int i = 0; i < 4; ++i) longest_frozen = std::max(longest_frozen, node.frozen_position().run(i));
       };
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
       const std::string what = std::string(sc.scene) + ", " + law;
       INFO(what << ": " << r.failure);
-      MESSAGE(what << ": largest test value / floor per function " << worst.transpose()
+      MESSAGE(what << ": largest test value / floor per function " << worst.transpose() << "; frozen-reading test's longest run "
+                   << longest_frozen << " of " << b.firmware.controller.plausibility.frozen_sets << " sets"
                        << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
       // The monitor's own criterion: outside its floor for its debounce time in a row. A single
       // cycle beyond the floor is no fault (the printed figure is the largest single cycle's).
       CHECK(r.first_fault_code != static_cast<int>(app::FirmwareFault::velocity_implausible));
       CHECK(r.safe_stops == 0);
+      CHECK(longest_frozen < b.firmware.controller.plausibility.frozen_sets);
     }
   }
 }
@@ -220,4 +224,48 @@ TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machin
   CHECK_FALSE(run.record.task_finished);
   MESSAGE("operator stop at 3 s: machine at rest from " << run.last_moving_stopped << " s, released at " << run.left_stop
                                                       << " s; escalated to the emergency stop: " << std::string(run.estop ? "yes" : "no"));
+}
+
+TEST_CASE("firmware/plausibility: a frozen position reading while its function is driven is found by the frozen-reading test and stopped before the machine is far off its path, where the one-sided flow test alone let it go 0.2 m") {
+  // The safety campaign's worst case of its kind: the free motion, the bucket's reading frozen at
+  // 2.976 s for 0.86 s. The law drives the bucket on after a reading that no longer moves; the oil it
+  // asks for arrives as real motion the firmware cannot see, so the flow test (oil that arrived
+  // unasked) is silent. Without the frozen-reading test the true bucket error passed the 0.2 m
+  // tracking limit unseen; with it the firmware stops within frozen_sets (and the lag) of the freeze.
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/free_motion.yaml");
+  const double start = 2.976376358589948;
+  for (const std::string law : {"pid", "adaptive"}) {
+    for (const bool frozen_test : {true, false}) {
+      sim::SceneBundle c = b;
+      if (!frozen_test) c.firmware.controller.plausibility.frozen_sets = 1000000;
+      sim::LockstepOptions o;
+      o.controller = law;
+      o.duration = 5.0;
+      o.fault.kind = sim::FaultSchedule::Kind::sensor_freeze;
+      o.fault.start = start;
+      o.fault.duration = 0.8598560886172655;
+      o.fault.joint = 3;
+      double worst_at_stop = -1;
+      o.observer = [&](std::int64_t, const plant::Plant&, const app::FirmwareNode& node) {
+        if (worst_at_stop < 0 && node.mode() == control::Mode::safe_stop) worst_at_stop = std::abs(node.q_desired()[3] - node.sensors().position[3]);
+      };
+      const sim::RunRecord r = sim::run_lockstep(c.scene, c.firmware, o);
+      const std::string name = law + (frozen_test ? ", frozen-reading test on" : ", frozen-reading test off");
+      INFO(name << ": " << r.failure);
+      MESSAGE(name << ": " << (r.first_safe_stop_time >= 0 ? "stopped " + std::to_string(r.first_fault_detected_time - start) + " s after the freeze" : std::string("no stop"))
+                   << ", the bucket's true worst error " << r.max_error[3] * 1e3 << " mm");
+      if (frozen_test) {
+        REQUIRE(r.first_safe_stop_time >= 0);
+        CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible));
+        CHECK(r.failure.find("position frozen") != std::string::npos);
+        // frozen_sets (0.2 s) after the asked displacement first doubles what arrived (the flow
+        // monitor's 0.1 s window and the commands' 20 ms lag).
+        CHECK(r.first_fault_detected_time - start <= 0.2 + 0.1);
+        CHECK(r.estop);
+        CHECK(r.max_error[3] < 0.1);
+      } else {
+        CHECK(r.max_error[3] > 0.2);  // what the test exists for
+      }
+    }
+  }
 }
