@@ -637,7 +637,7 @@ void FirmwareNode::check_plausibility(bool restarted) {
   const double window = plausibility_.settings().window;
   if (((found >> j) & 1) == 0) {
     std::snprintf(pending_text_, sizeof pending_text_,
-                  "position frozen at t = %.3f s: %s read %.5f %s for %d sets, asked %.3f %s/s", time(),
+                  "no motion at t = %.3f s: %s read %.5f %s for %d sets while asked %.3f %s/s", time(),
                   kActiveNames[static_cast<std::size_t>(j)], m.position[j], unit, frozen_position_.settings().frozen_sets,
                   plausibility_.expected()[j], unit);
     return;

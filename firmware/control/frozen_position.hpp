@@ -12,8 +12,10 @@
 //     over the window), no chamber of it at a relief, and
 //   of the displacement asked its way over the flow monitor's window, less than half arrived as
 //     motion or compression;
-// frozen_sets such sets in a row are a fault (the flow monitor's, emergency stop). Fixed-size state,
-// no allocation.
+// frozen_sets such sets in a row are a fault (the flow monitor's, emergency stop: "no motion"). A
+// function that truly does not move while driven (a spool stuck near centre, a dead actuator) shows
+// the same and is found the same way: the firmware cannot tell the two apart, and both are faults.
+// Fixed-size state, no allocation.
 #include <cmath>
 #include <cstdint>
 
