@@ -2,9 +2,13 @@
 // The standstill monitor's creep test (docs/safety.md): a quantity's mean rate over back-to-back
 // windows of a set length; a function creeps when its mean rate exceeds its limit and has not fallen
 // by `slowing` against the window before (a function braking slows from window to window, a ringing
-// one averages out, a stuck spool's creep does neither). Fixed-size, no allocation.
+// one averages out, a stuck spool's creep does neither), or, from the first window on, exceeds
+// `fast` times its limit whatever the window before: a function still that fast on average a whole
+// window into a stop is not braking (a stuck spool's motion, ringing on its oil spring, can fall by
+// the slowing share from one window to the next and never stop). Fixed-size, no allocation.
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "model/types.hpp"
 
@@ -16,7 +20,8 @@ class CreepWindow {
 
   // One sample x at `cycle`; returns the functions found creeping (bit i) when a window closes, 0
   // otherwise. A limit of infinity leaves a function out.
-  std::uint8_t update(const Vec4& x, std::uint64_t cycle, double period, double length, const Vec4& limit, double slowing) {
+  std::uint8_t update(const Vec4& x, std::uint64_t cycle, double period, double length, const Vec4& limit, double slowing,
+                      double fast = std::numeric_limits<double>::infinity()) {
     if (!started_) {
       origin_ = x;
       origin_cycle_ = cycle;
@@ -27,9 +32,11 @@ class CreepWindow {
     if (window_ < length) return 0;
     const Vec4 mean = (x - origin_) / window_;
     std::uint8_t creeping = 0;
-    for (int i = 0; i < 4 && windows_ > 0; ++i)
-      if (std::abs(mean[i]) > limit[i] && std::abs(mean[i]) > (1 - slowing) * std::abs(mean_[i]))
+    for (int i = 0; i < 4; ++i) {
+      const bool not_slowing = windows_ > 0 && std::abs(mean[i]) > (1 - slowing) * std::abs(mean_[i]);
+      if (std::abs(mean[i]) > limit[i] && (not_slowing || std::abs(mean[i]) > fast * limit[i]))
         creeping |= static_cast<std::uint8_t>(1u << i);
+    }
     mean_ = mean;
     ++windows_;
     origin_ = x;

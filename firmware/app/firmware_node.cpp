@@ -149,17 +149,19 @@ void FirmwareNode::check_standstill(bool complete) {
     // swing trapped on its oil spring for seconds.
     const std::uint8_t cylinders =
         cylinder_creep_.update(m.position + m.compression, cycle_, period_, kStandstillWindow,
-                               Vec4(kOut, kStandstillCylinderRate, kStandstillCylinderRate, kStandstillCylinderRate), kStandstillSlowing);
+                               Vec4(kOut, kStandstillCylinderRate, kStandstillCylinderRate, kStandstillCylinderRate), kStandstillSlowing,
+                               kStandstillFastFactor);
     // The swing on its motion alone, over windows as long as its oil spring's period, which its
     // ringing averages out of: a spool stuck just past its dead zone creeps on, not slowing.
     const std::uint8_t swing = swing_creep_.update(m.position, cycle_, period_, kStandstillSwingWindow,
-                                                   Vec4(kStandstillSwingRate, kOut, kOut, kOut), kStandstillSlowing);
+                                                   Vec4(kStandstillSwingRate, kOut, kOut, kOut), kStandstillSlowing,
+                                                   kStandstillFastFactor);
     for (int j = 1; j < 4 && why[0] == 0; ++j)
       if ((cylinders >> j) & 1)
-        std::snprintf(why, sizeof why, "%s takes %.4f m/s on average over %.1f s, not slowing", kActiveNames[static_cast<std::size_t>(j)],
+        std::snprintf(why, sizeof why, "%s takes %.4f m/s on average over %.1f s, not stopping", kActiveNames[static_cast<std::size_t>(j)],
                       cylinder_creep_.mean()[j], cylinder_creep_.window());
     if (why[0] == 0 && (swing & 1))
-      std::snprintf(why, sizeof why, "swing moves %.4f rad/s on average over %.1f s, not slowing", swing_creep_.mean()[0],
+      std::snprintf(why, sizeof why, "swing moves %.4f rad/s on average over %.1f s, not stopping", swing_creep_.mean()[0],
                     swing_creep_.window());
   }
   if (why[0] == 0) return;

@@ -269,3 +269,38 @@ TEST_CASE("firmware/plausibility: a frozen position reading while its function i
     }
   }
 }
+
+TEST_CASE("firmware/standstill: a swing spool stuck just past its dead zone, found by the tracking limit, keeps the swing moving through the controlled stop: the standstill monitor escalates it and the parking brake holds") {
+  // The safety campaign's case: the free motion, the swing's spool stuck at 0.193 (dead zone 0.15)
+  // from 5.815 s. The tracking limit stops the firmware (controlled: valves centred), but the spool
+  // keeps passing oil and the swing swings on, ringing on its oil spring at 50-180 mrad/s. Its mean
+  // speed fell by a third from one 2.5 s window to the next, which the creep test read as braking;
+  // a mean ten times the standstill rate a whole window into the stop is not braking.
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/free_motion.yaml");
+  for (const std::string law : {"pid", "adaptive"}) {
+    sim::LockstepOptions o;
+    o.controller = law;
+    o.duration = 12.6;
+    o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
+    o.fault.start = 5.814950679714288;
+    o.fault.duration = 1e9;
+    o.fault.joint = 0;
+    o.fault.magnitude = 0.19340007372785273;
+    bool escalated = false;
+    o.node_observer = [&escalated](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+      escalated = escalated || node.stop_escalated();
+    };
+    const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
+    INFO(law << ": " << r.failure);
+    MESSAGE(law << ": stopped at " << r.first_safe_stop_time << " s (" << r.failure << "), escalated " << escalated
+                << ", at rest from " << r.machine_at_rest_time << " s");
+    REQUIRE(r.first_safe_stop_time >= 0);
+    CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+    CHECK(escalated);
+    CHECK(r.estop);
+    REQUIRE(r.machine_at_rest_time >= 0);
+    // The first swing window closes kStandstillDelay + kStandstillSwingWindow after the stop; the
+    // brake then holds the swing within a second.
+    CHECK(r.machine_at_rest_time - r.first_safe_stop_time < app::kStandstillDelay + app::kStandstillSwingWindow + 1.0);
+  }
+}
