@@ -79,8 +79,9 @@ inline constexpr double kStandstillWindow = 0.5;           // s
 inline constexpr double kStandstillCylinderRate = 0.002;  // m/s
 inline constexpr double kStandstillSwingWindow = 2.5;      // s
 inline constexpr double kStandstillSwingRate = 0.002;     // rad/s
-// A mean this many times the rate over a whole window escalates whether or not it fell against the
-// window before (CreepWindow): 20 mm/s over 0.5 s, 20 mrad/s over 2.5 s, well after any braking.
+// A mean this many times the rate over a whole window, going one way through it, escalates whether or
+// not it fell against the window before (CreepWindow): 20 mm/s over 0.5 s, 20 mrad/s over 2.5 s, well
+// after any braking; a ring turns within the window.
 inline constexpr double kStandstillFastFactor = 10;
 
 const char* to_string(FirmwareFault fault);
