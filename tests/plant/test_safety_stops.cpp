@@ -24,6 +24,17 @@ namespace {
 const char* const kLaws[] = {"pid", "adaptive",
                                              "slotine_li", "flow"};
 
+// The spool of `joint` (0 swing .. 3 bucket) stuck at `opening` from `start` for `duration` s.
+sim::FaultSchedule stuck_spool(int joint, double opening, double start, double duration) {
+  sim::FaultSchedule f;
+  f.kind = sim::FaultSchedule::Kind::spool_stuck;
+  f.start = start;
+  f.duration = duration;
+  f.joint = joint;
+  f.magnitude = opening;
+  return f;
+}
+
 }  // namespace
 
 TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent, detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
@@ -45,11 +56,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
         sim::LockstepOptions o;
         o.controller = law;
         o.duration = t_stick + 4.0;
-        o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
-        o.fault.start = t_stick;
-        o.fault.duration = 1e9;  // to the run's end
-        o.fault.joint = joint;
-        o.fault.magnitude = opening;
+        o.fault = stuck_spool(joint, opening, t_stick, 1e9);  // to the run's end
         const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
         const std::string name = law + ", " + kActiveNames[static_cast<std::size_t>(joint)] +
                                  " stuck at " + std::to_string(opening);
@@ -167,11 +174,7 @@ TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the 
   sim::LockstepOptions o;
   o.controller = "pid";
   o.duration = 8.0;
-  o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
-  o.fault.start = 3.0;
-  o.fault.duration = 0.5;
-  o.fault.joint = 2;
-  o.fault.magnitude = 0.4;
+  o.fault = stuck_spool(2, 0.4, 3.0, 0.5);
   const double t_ack = 7.0;
   SUBCASE("acknowledged by the frame") {
     o.supervisor = {{t_ack, hal::SupervisorCommand::acknowledge}};
@@ -281,11 +284,7 @@ TEST_CASE("firmware/standstill: a swing spool stuck just past its dead zone, fou
     sim::LockstepOptions o;
     o.controller = law;
     o.duration = 12.6;
-    o.fault.kind = sim::FaultSchedule::Kind::spool_stuck;
-    o.fault.start = 5.814950679714288;
-    o.fault.duration = 1e9;
-    o.fault.joint = 0;
-    o.fault.magnitude = 0.19340007372785273;
+    o.fault = stuck_spool(0, 0.19340007372785273, 5.814950679714288, 1e9);
     bool escalated = false;
     o.node_observer = [&escalated](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
       escalated = escalated || node.stop_escalated();
