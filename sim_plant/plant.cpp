@@ -216,7 +216,7 @@ Vec4 Plant::apply_dry_friction(const MechanicalState& before) {
   // a motion the stop then took away and did no net work (a boom and arm ringing on for seconds).
   // Arrivals from free motion stay apply_limits's, which books their impact.
   Vec4 lower = -bound, upper = bound;
-  for (int i = 0; i < kNumActive; ++i) {
+  for (int i = 0; i < kNumActive && actuators_.fidelity().has(kEndStops); ++i) {
     if (before.q_a[i] >= q_max_[i] && mech_.qd_a[i] > 0) upper[i] = std::numeric_limits<double>::infinity();
     if (before.q_a[i] <= q_min_[i] && mech_.qd_a[i] < 0) lower[i] = -std::numeric_limits<double>::infinity();
   }
