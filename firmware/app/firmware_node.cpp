@@ -307,8 +307,9 @@ void FirmwareNode::end_cycle() {
 
   // A stop request decelerates a tracking machine along its path first; it holds once the path is at rest.
   if (stop_requested_ && machine_.mode() == control::Mode::track && !path_stop_.active()) begin_path_stop(t);
-  double rate = 1, rate_dot = 0;  // for compute_command, which takes them again after the transition
-  const double tau = path_time_at(t, rate, rate_dot);
+  // The path time before the transition, for the end-of-task test; compute_command takes it again
+  // after it (a transition into track restarts the path's clock).
+  const double tau = path_time_at(t);
 
   control::StateMachineInputs in;
   in.t = t;

@@ -194,6 +194,10 @@ class FirmwareNode {
   void begin_path_stop(double t);
   bool path_stop_moving(double t) const;  // a stop along the path is slowing the path at loop time t
   double path_time_at(double t, double& rate, double& rate_dot) const;
+  double path_time_at(double t) const {
+    double rate = 1, rate_dot = 0;
+    return path_time_at(t, rate, rate_dot);
+  }
   double unslowed_task_time(double t) const { return t - track_start_ + task_.start_time(); }
   // The velocity plausibility monitor on this cycle's valve command (valve interface).
   void check_plausibility(bool restarted);
