@@ -56,8 +56,7 @@ def main(argv):
     if len(args) != 1 or args[0] in ("-h", "--help") or args[0].startswith("-"):
         print(__doc__.strip())
         return 0 if args in (["-h"], ["--help"]) else 2
-    argv = [argv[0], args[0]]
-    path = os.path.join(argv[1], "sweep.json")
+    path = os.path.join(args[0], "sweep.json")
     try:
         with open(path) as f:
             merged = json.load(f)
