@@ -149,7 +149,10 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.number("watchdog_timeout", c.watchdog_timeout, {1e-4, 10}, "s", "without a valid sensor frame -> safe stop");
   r.whole("max_missed_deadlines", c.max_missed_deadlines, 1, 100000, "",
           "real time: wake-ups in a row after their deadline that are a fault (controlled stop)");
-  r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "", "rad (swing), m: above it the firmware faults");
+  c.tracking_error_limit_derived = !r.value_given("tracking_error_limit");
+  if (c.tracking_error_limit_derived) c.tracking_error_limit = default_tracking_error_limit(c.command_interface);
+  r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "",
+            "rad (swing), m: above it the firmware faults (default on valves: 5x what the machine reaches)");
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
   r.number("stop_ramp_time", c.stop_ramp_time, {0, 10}, "s",
            "a stop along the path decelerates each function by at most its top speed per this time (0: at once)");
@@ -182,6 +185,13 @@ ControllerConfig controller_defaults(const Machine& nominal) {
   return c;
 }
 
+Vec4 default_tracking_error_limit(CommandInterface interface) {
+  if (interface != CommandInterface::valve) return ControllerConfig{}.tracking_error_limit;
+  Vec4 limit;
+  for (int j = 0; j < 4; ++j) limit[j] = kTrackingLimitMultiple * kValveMachineReach[j];
+  return limit;
+}
+
 double valve_adaptation_scale(const ControllerConfig& c) { return c.period / c.valves.force_time_constant; }
 
 void set_command_interface(ControllerConfig& c, CommandInterface interface) {
@@ -190,6 +200,7 @@ void set_command_interface(ControllerConfig& c, CommandInterface interface) {
     c.adaptation_rate *= interface == CommandInterface::valve ? valve_adaptation_scale(c) : 1 / valve_adaptation_scale(c);
     c.tracking_dead_zone = interface == CommandInterface::valve ? c.valves.hold_window : Vec4::Zero();
   }
+  if (c.tracking_error_limit_derived) c.tracking_error_limit = default_tracking_error_limit(interface);
   c.command_interface = interface;
 }
 

@@ -31,6 +31,29 @@ TEST_CASE("firmware/controller config: a scene without controller gets the embed
   CHECK(c.theta_min == d.theta_min);
 }
 
+TEST_CASE("firmware/controller config: the tracking-error limit defaults by command interface, 5x the valve machine's reach on valves, and a given one is kept through an interface switch") {
+  auto read = [](const std::string& yaml) {
+    return read_controller_config(settings::Document::parse(yaml, "scene.yaml"), reference_machine());
+  };
+  const ControllerConfig effort = read("name: x");
+  const ControllerConfig valve = read("controller: {command_interface: valve}");
+  const ControllerConfig given = read("controller: {command_interface: valve, tracking_error_limit: [0.3, 0.4, 0.5, 0.6]}");
+  // The effort interface (the paper's force actuators): the fixed limits.
+  CHECK(effort.tracking_error_limit == (Vec4() << 0.1, 0.2, 0.2, 0.2).finished());
+  // Valves: 5 x swing 7.8 mrad, boom 7.4 mm, arm 19.1 mm, bucket 10.4 mm (the generalisation sweeps).
+  CHECK(valve.tracking_error_limit[0] == doctest::Approx(0.039));
+  CHECK(valve.tracking_error_limit[1] == doctest::Approx(0.037));
+  CHECK(valve.tracking_error_limit[2] == doctest::Approx(0.0955));
+  CHECK(valve.tracking_error_limit[3] == doctest::Approx(0.052));
+  CHECK(given.tracking_error_limit == (Vec4() << 0.3, 0.4, 0.5, 0.6).finished());
+  // A bench variant switching the interface carries a derived limit with it, a given one not.
+  ControllerConfig switched = effort, kept = given;
+  set_command_interface(switched, CommandInterface::valve);
+  set_command_interface(kept, CommandInterface::effort);
+  CHECK(switched.tracking_error_limit == valve.tracking_error_limit);
+  CHECK(kept.tracking_error_limit == given.tracking_error_limit);
+}
+
 TEST_CASE("firmware/controller config parses every field") {
   const ControllerConfig c = read_controller_config(settings::Document::parse(R"(
 controller:

@@ -20,6 +20,10 @@ using namespace exc;
 
 namespace {
 
+// The effort interface's fixed tracking limits (0.1 rad, 0.2 m): loose on the valve machine, whose
+// default is 5x what it reaches (controller_config.hpp), for tests about what the limit would pre-empt.
+const Vec4 kLooseTrackingLimit = control::default_tracking_error_limit(control::CommandInterface::effort);
+
 // The valve-driving laws the dig scene runs (flow-based control included: the dig's swing is still).
 const char* const kLaws[] = {"pid", "adaptive",
                                              "slotine_li", "flow"};
@@ -110,17 +114,56 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       };
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
       const std::string what = std::string(sc.scene) + ", " + law;
+      // The tracking limit's margin: the firmware's own error (what it judges) against its limit.
+      Vec4 tracking_share;
+      for (int j = 0; j < 4; ++j) tracking_share[j] = r.measured_max_error[j] / b.firmware.controller.tracking_error_limit[j];
       INFO(what << ": " << r.failure);
       MESSAGE(what << ": largest test value / floor per function " << worst.transpose() << "; frozen-reading test's longest run "
-                   << longest_frozen << " of " << b.firmware.controller.plausibility.frozen_sets << " sets"
-                       << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
+                   << longest_frozen << " of " << b.firmware.controller.plausibility.frozen_sets
+                   << " sets; largest tracking error / limit " << tracking_share.transpose()
+                   << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
       // The monitor's own criterion: outside its floor for its debounce time in a row. A single
       // cycle beyond the floor is no fault (the printed figure is the largest single cycle's).
       CHECK(r.first_fault_code != static_cast<int>(app::FirmwareFault::velocity_implausible));
       CHECK(r.safe_stops == 0);
       CHECK(longest_frozen < b.firmware.controller.plausibility.frozen_sets);
+      // The default limit is 5x the worst of 1300 unseen runs: a shipped scene within half of it.
+      CHECK(tracking_share.maxCoeff() < 0.5);
     }
   }
+}
+
+TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x what the machine reaches, stops a boom stuck half open with the velocity monitor off within 0.3 s, where the effort interface's fixed 0.2 m took 1.4 s") {
+  // Issue 32: with the fixed 0.2 m limit (17x the valve machine's worst error) the tracking error
+  // found a stuck boom spool after 1.45 s. The dig scene, the boom's spool stuck at +0.5 from 3 s
+  // (extending at about 0.13 m/s against a path that goes the other way), the flow monitor off so
+  // that the tracking limit is the only monitor: the default limit's 37 mm is crossed within
+  // about (37 mm + the path's own motion) / 0.13 m/s, the loose one's 200 mm five times later.
+  sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  b.firmware.controller.plausibility.enabled = false;
+  b.firmware.controller.plausibility.frozen_sets = 1000000;
+  REQUIRE(b.firmware.controller.command_interface == control::CommandInterface::valve);
+  CHECK(b.firmware.controller.tracking_error_limit[1] == doctest::Approx(5 * 0.0074));
+  double found[2] = {-1, -1};
+  for (int loose = 0; loose < 2; ++loose) {
+    sim::SceneBundle c = b;
+    if (loose) c.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
+    sim::LockstepOptions o;
+    o.controller = "adaptive";
+    o.duration = 6.0;
+    o.fault = stuck_spool(1, 0.5, 3.0, 1e9);
+    const sim::RunRecord r = sim::run_lockstep(c.scene, c.firmware, o);
+    INFO(r.failure);
+    REQUIRE(r.first_safe_stop_time >= 0);
+    CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+    CHECK(r.failure.find("tracking error: boom") != std::string::npos);
+    found[loose] = r.first_safe_stop_time - 3.0;
+    MESSAGE(std::string(loose ? "effort interface's 0.2 m" : "valve default 37 mm") << ": stopped " << found[loose]
+                                                                          << " s after the stick; the boom's true worst error "
+                                                                          << r.max_error[1] * 1e3 << " mm");
+  }
+  CHECK(found[0] < 0.3);
+  CHECK(found[1] > 1.0);
 }
 
 namespace {
@@ -240,6 +283,9 @@ TEST_CASE("firmware/plausibility: a frozen position reading while its function i
   for (const std::string law : {"pid", "adaptive"}) {
     for (const bool frozen_test : {true, false}) {
       sim::SceneBundle c = b;
+      // The default limit on valves (52 mm on the bucket) finds this freeze itself, 0.25 s in, as
+      // a tracking error; the test is about the frozen-reading test where the limit is loose.
+      c.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
       if (!frozen_test) c.firmware.controller.plausibility.frozen_sets = 1000000;
       sim::LockstepOptions o;
       o.controller = law;
