@@ -563,6 +563,10 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
       if (task_start)
         std::snprintf(pending_text_, sizeof pending_text_, "tracking error at the task's start: %s %.4f %s from its first point > limit %.4f",
                       name, std::abs(out_.e[j]), unit, limit);
+      else if (pump_warning_)  // the likely cause, named: a path that asks more than the pumps give lags
+        std::snprintf(pending_text_, sizeof pending_text_,
+                      "tracking error: %s %.4f %s > limit %.4f at t = %.3f s, the pumps short of flow since t = %.3f s", name,
+                      std::abs(out_.e[j]), unit, limit, t, pump_warning_start_);
       else
         std::snprintf(pending_text_, sizeof pending_text_, "tracking error: %s %.4f %s > limit %.4f at t = %.3f s", name,
                       std::abs(out_.e[j]), unit, limit, t);

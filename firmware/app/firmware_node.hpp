@@ -263,10 +263,10 @@ class FirmwareNode {
   bool fault_ = false;
   FirmwareFault pending_fault_ = FirmwareFault::none;  // raised by this cycle's computation
   FirmwareFault fault_code_ = FirmwareFault::none;     // of the last safe stop
-  char pending_text_[96] = "";
+  char pending_text_[160] = "";
   double pending_time_ = 0;           // s, the cycle the pending fault was raised
   double fault_detected_time_ = -1;   // s, of the last safe stop's fault
-  char fault_text_[96] = "";
+  char fault_text_[160] = "";
   bool finished_ = false;
   double finish_time_ = 0;
   bool stop_requested_ = false;

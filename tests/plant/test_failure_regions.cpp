@@ -162,6 +162,15 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   CHECK_FALSE(warnings[1].active);
   CHECK(warnings[1].utime * 1e-6 == doctest::Approx(last).epsilon(0.05).scale(0));
   CHECK(r.safe_stops == 0);
+
+  // With the valve machine's default limit the lag stops the path, and the fault names the pumps
+  // (their warning raised before the limit is crossed) as the likely cause.
+  Scenario d = move("[0.0, 2.10, 3.00, 2.30]", "[0.0, 2.50, 2.40, 1.90]", 2.0);
+  d.firmware.controller.valves.position_gain = Vec4::Constant(2);
+  const sim::RunRecord stopped = sim::run_lockstep(d.scene, d.firmware, {});
+  MESSAGE("default limit: " << stopped.failure);
+  CHECK(stopped.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+  CHECK(stopped.failure.find("the pumps short of flow since t = ") != std::string::npos);
 }
 
 TEST_CASE("plant/hydraulics: a full-speed boom-down cavitates exactly where it falls faster than the pump and the make-up valves fill its rod side, at v_max + Q_makeup(p_tank) / A_B") {
