@@ -135,9 +135,14 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   holding_ = hold;
   // The machine's safety controller on the firmware's emergency stop (FW_EMERGENCY EmergencyStop):
   // pilot supply cut (every spool springs to centre), engine stopped (the pumps run down), and so
-  // the load-holding valves closed; all back when the stop is released (docs/safety.md).
+  // the load-holding valves closed; all back when the stop is released (docs/safety.md). On a lost
+  // link (commands had come, then none within the timeout, or SYNC fell silent) it drops the enable
+  // as an autonomy kit's receiver does: the pilot supply cut, so the load-holding valves and the
+  // swing's brake hold; the engine runs on. Both come back with the next valid command set. Before
+  // the first command the valves are centred and the supply stays on (no link was lost).
+  const bool link_lost = have_command_ && timed_out;
   if (hydraulic) {
-    plant_.set_pilot_supply(!command_.emergency_stop);
+    plant_.set_pilot_supply(!command_.emergency_stop && !link_lost);
     plant_.set_engine_running(!command_.emergency_stop);
   }
 
@@ -185,7 +190,8 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   apply_sensor_fault();
   const plant::HydraulicReport& h = plant_.state().hydraulics;
   const bool estop = hydraulic && command_.emergency_stop;
-  sensors_.plant_state = static_cast<std::uint8_t>((hold ? hal::kPlantStateHolding : 0) | (estop ? hal::kPlantStatePilotCut : 0) |
+  const bool pilot_cut = hydraulic && (command_.emergency_stop || link_lost);
+  sensors_.plant_state = static_cast<std::uint8_t>((hold ? hal::kPlantStateHolding : 0) | (pilot_cut ? hal::kPlantStatePilotCut : 0) |
                                                    (estop ? hal::kPlantStateEngineStopped : 0) |
                                                    (hydraulic && h.holding_valves_closed ? hal::kPlantStateHoldingValvesClosed : 0));
   sensors_.plant_faults = static_cast<std::uint8_t>((failed() ? 1 : 0) | (machine_fault ? 2 : 0));

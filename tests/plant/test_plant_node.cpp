@@ -186,3 +186,51 @@ TEST_CASE("plant/node: a valve_stuck fault holds a spool at its opening whatever
   CHECK(bench.plant.state().spool[1] == doctest::Approx(3e6 / full).epsilon(1e-3));  // free again
   CHECK_FALSE(bench.node.failed());
 }
+
+TEST_CASE("plant/node: a lost link cuts the pilot supply as an autonomy kit's receiver does: a boom on a spool stuck lowering is held by its load-holding valve, the engine runs on, and the supply returns with the commands") {
+  // The firmware commands, then falls silent (SYNC goes on: a firmware that hangs, a cut command
+  // line). The plant's command watchdog holds after 20 cycles; centred valves alone do not stop a
+  // boom whose spool is stuck lowering (it sinks on), the pilot cut closes its load-holding valve.
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  NodeBench bench(t.scene());
+  hal::SensorState seen;
+  std::uint64_t k = 0;
+  for (; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);  // raise the boom a little
+  app::InjectedFault stuck;
+  stuck.kind = app::InjectedFault::Kind::valve_stuck;
+  stuck.joint = hal::kBoom;
+  stuck.magnitude = -0.5;  // lowering, whatever is commanded
+  bench.node.set_fault(stuck);
+  hal::CommandState centred;
+  centred.mode = hal::CommandMode::valve;
+  for (; k < 400; ++k) bench.cycle(k, centred, seen);
+  REQUIRE(bench.plant.state().qd_a[1] < -0.01);  // sinking on the stuck spool
+  CHECK((seen.plant_state & hal::kPlantStatePilotCut) == 0);
+  // Silent from here: SYNC and the plant's answer only.
+  double q_mark = 0;
+  const std::uint64_t silent_from = k;
+  for (; k < silent_from + 2500; ++k) {
+    bench.firmware.send_sync(k);
+    REQUIRE(bench.node.poll());
+    bench.firmware.read(seen);
+    if (k == silent_from + 1500) q_mark = bench.plant.state().q_a[1];
+    if (k == silent_from + 25) {
+      CHECK((seen.plant_state & hal::kPlantStateHolding) != 0);
+      CHECK((seen.plant_state & hal::kPlantStatePilotCut) != 0);
+    }
+  }
+  const double creep = (bench.plant.state().q_a[1] - q_mark) / (1000 * bench.plant.scene().cycle);
+  const plant::HydraulicReport& h = bench.plant.state().hydraulics;
+  MESSAGE("link lost with the boom's spool stuck at -0.5: pilot supply " << h.pilot_supply << ", engine flow " << h.engine_flow
+                                                                          << ", load-holding valves closed " << h.holding_valves_closed
+                                                                          << ", boom " << creep * 1e3 << " mm/s 1.5-2.5 s after");
+  CHECK(h.pilot_supply < 1e-3);
+  CHECK(h.engine_flow == 1);  // the engine runs on: only the enable dropped
+  CHECK(h.holding_valves_closed);
+  CHECK(std::abs(creep) < 1e-3);  // at rest by the campaign's measure
+  // The commands return: the supply comes back and the bit clears.
+  for (std::uint64_t end = k + 500; k < end; ++k) bench.cycle(k, centred, seen);
+  CHECK(bench.plant.state().hydraulics.pilot_supply > 0.99);
+  CHECK((seen.plant_state & hal::kPlantStatePilotCut) == 0);
+}
