@@ -139,9 +139,10 @@ void FirmwareCanPort::apply(const MessageSpec& message, const CanFrame& frame, S
       state.plant_fault_code = static_cast<std::uint16_t>(v[1]);
       break;
     case can_id::supervisor: {
-      // Kept until the node takes it; a value outside the DBC's range is no command.
+      // Kept until the node takes it; a value outside the DBC's range is no command. Command none is
+      // the station's keep-alive: heard, it tells the firmware a monitored link is there.
       const auto command = static_cast<unsigned>(v[0]);
-      if (command >= 1 && command <= 3) state.supervisor_pending |= static_cast<std::uint8_t>(1u << command);
+      if (command <= 3) state.supervisor_pending |= static_cast<std::uint8_t>(1u << command);
       break;
     }
     default:

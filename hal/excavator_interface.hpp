@@ -37,7 +37,7 @@ struct SensorState {
   bool plant_emergency = false;       // firmware side: the plant latched an emergency stop
   std::uint16_t plant_fault_code = 0;
   // Firmware side: SUPERVISOR commands received and not yet taken, bit 1 << SupervisorCommand
-  // (start, stop, acknowledge); the taker clears them.
+  // (none: a keep-alive, start, stop, acknowledge); the taker clears them.
   std::uint8_t supervisor_pending = 0;
 };
 

@@ -23,6 +23,9 @@ enum class FirmwareFault : std::uint16_t {
   fatal_error = 12,    // the program leaves on an error: the same, with the emergency stop
   operator_stop = 13,  // an operator's stop (SUPERVISOR Command = stop): latched until acknowledged
   pressure_implausible = 14,  // a chamber pressure out of range, jumping or stuck (pressure_plausibility.hpp)
+  // The operator station's link fell silent: it had sent keep-alives (SUPERVISOR Command = none),
+  // then nothing for controller.supervisor_timeout. Stops as an operator's stop does, latched.
+  operator_link_lost = 15,
 };
 
 // The stop a fault takes. controlled: valves centred, EmergencyStop = 0 (the valves still obey).
@@ -42,7 +45,8 @@ constexpr StopKind stop_of(FirmwareFault fault) {
     // standstill monitor watches, are not in doubt (docs/safety.md, H4).
     case FirmwareFault::pressure_implausible:
     case FirmwareFault::exited:
-    case FirmwareFault::operator_stop: return StopKind::controlled;
+    case FirmwareFault::operator_stop:
+    case FirmwareFault::operator_link_lost: return StopKind::controlled;
     case FirmwareFault::sensor_timeout:
     case FirmwareFault::plant_emergency:
     case FirmwareFault::plant_fault:
@@ -55,9 +59,11 @@ constexpr StopKind stop_of(FirmwareFault fault) {
 
 // A controlled stop that first decelerates the machine along its path (control/path_stop.hpp) and
 // latches once the path is at rest: only where the law, its sensors and the path are all sound. An
-// operator's stop is; a tracking error, a refused model state, a late or pressure-blind loop are not,
+// operator's stop (or a lost operator link) is; a tracking error, a refused model state, a late or pressure-blind loop are not,
 // and their stop centres the valves at once.
-constexpr bool stops_along_path(FirmwareFault fault) { return fault == FirmwareFault::operator_stop; }
+constexpr bool stops_along_path(FirmwareFault fault) {
+  return fault == FirmwareFault::operator_stop || fault == FirmwareFault::operator_link_lost;
+}
 
 // The standstill monitor of a controlled stop (IEC 60204-1 category 1: a controlled stop, then the
 // power removed if the machine does not stand still). Two tests escalate the stop to the emergency

@@ -64,6 +64,7 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::exited: return "firmware exited";
     case FirmwareFault::fatal_error: return "firmware fatal error";
     case FirmwareFault::operator_stop: return "operator stop";
+    case FirmwareFault::operator_link_lost: return "operator link lost";
     case FirmwareFault::pressure_implausible: return "pressure implausible";
   }
   return "unknown";
@@ -226,7 +227,22 @@ void FirmwareNode::take_supervisor_commands() {
   const std::uint8_t pending = sensors_.supervisor_pending;
   sensors_.supervisor_pending = 0;
   if ((pending & supervisor_bit(hal::SupervisorCommand::start)) != 0) start_received_ = true;
-  const bool stop_now = (pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0;
+  // The operator link: armed by the station's first keep-alive, lost after supervisor_timeout
+  // without any frame (ISO 15817's remote control: losing the link stops the machine). Taken as the
+  // station's stop; heard again, a later loss is a new one.
+  if ((pending & supervisor_bit(hal::SupervisorCommand::none)) != 0) link_armed_ = true;
+  if (pending != 0) {
+    last_supervisor_time_ = time();
+    link_lost_ = false;
+  }
+  const double timeout = config_.controller.supervisor_timeout;
+  const bool lost_now = link_armed_ && !link_lost_ && timeout > 0 && time() - last_supervisor_time_ > timeout;
+  if (lost_now) {
+    link_lost_ = true;
+    link_stop_ = true;
+  }
+  const bool stop_now = (pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0 || lost_now;
+  if ((pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0) link_stop_ = false;  // the station's own stop
   if (stop_now) {
     operator_stop_pending_ = true;
     start_received_ = false;  // a stop withdraws a start: the next begin needs a new one
@@ -244,11 +260,21 @@ void FirmwareNode::take_supervisor_commands() {
   }
   if (operator_stop_on_rest_ && !path_stop_moving(time()) && !fault_) {
     operator_stop_on_rest_ = false;
-    raise(FirmwareFault::operator_stop);
-    pending_time_ = operator_stop_time_;  // detected when its frame came, whatever the deceleration took
-    std::snprintf(pending_text_, sizeof pending_text_,
-                  "operator stop: SUPERVISOR stop in %s at t = %.3f s, the path at rest %.3f s later",
-                  control::to_string(mode), operator_stop_time_, time() - operator_stop_time_);
+    pending_time_ = operator_stop_time_;  // detected when its frame came (or failed to), whatever the deceleration took
+    if (link_stop_) {
+      link_stop_ = false;
+      raise(FirmwareFault::operator_link_lost);
+      std::snprintf(pending_text_, sizeof pending_text_,
+                    "operator link lost: no SUPERVISOR frame for %.3f s (the last at t = %.3f s), in %s; the path at rest "
+                    "%.3f s later",
+                    config_.controller.supervisor_timeout, last_supervisor_time_, control::to_string(mode),
+                    time() - operator_stop_time_);
+    } else {
+      raise(FirmwareFault::operator_stop);
+      std::snprintf(pending_text_, sizeof pending_text_,
+                    "operator stop: SUPERVISOR stop in %s at t = %.3f s, the path at rest %.3f s later",
+                    control::to_string(mode), operator_stop_time_, time() - operator_stop_time_);
+    }
   }
 }
 

@@ -273,6 +273,10 @@ class FirmwareNode {
   bool acknowledge_requested_ = false;
   bool start_received_ = false;
   bool operator_stop_pending_ = false;  // a SUPERVISOR stop not yet raised (the node did not command yet)
+  bool link_armed_ = false;       // a keep-alive was heard: the operator link is monitored
+  bool link_lost_ = false;        // silent past supervisor_timeout since the last frame
+  bool link_stop_ = false;        // the stop under way is the lost link's, not the station's own
+  double last_supervisor_time_ = 0;  // s, the cycle the last SUPERVISOR frame was taken
   bool emergency_sent_ = false;
   bool safe_command_sent_ = false;
   bool escalated_ = false;  // the controlled stop became an emergency stop (standstill monitor)

@@ -147,6 +147,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
             "without a map: the estimated tip force that tells contact (left below half of it)");
   sc.finish();
   r.number("watchdog_timeout", c.watchdog_timeout, {1e-4, 10}, "s", "without a valid sensor frame -> safe stop");
+  r.number("supervisor_timeout", c.supervisor_timeout, {0, 60}, "s",
+           "without a SUPERVISOR frame once a keep-alive was heard -> the operator's stop (0: not monitored)");
   r.whole("max_missed_deadlines", c.max_missed_deadlines, 1, 100000, "",
           "real time: wake-ups in a row after their deadline that are a fault (controlled stop)");
   c.tracking_error_limit_derived = !r.value_given("tracking_error_limit");

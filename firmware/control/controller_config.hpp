@@ -108,6 +108,10 @@ struct ControllerConfig {
 
   EstimatorConfig filter;           // velocity / acceleration cut-offs
   double watchdog_timeout = 0.02;   // s without a valid sensor frame -> safe_stop
+  // s without a SUPERVISOR frame, once the operator station has sent a keep-alive (Command none),
+  // that stops the machine as the station's stop would (FirmwareFault::operator_link_lost): five
+  // of excavator-operator keep-alive's 0.1 s frames missed. 0: the link is not monitored.
+  double supervisor_timeout = 0.5;
   // Real time: this many wake-ups in a row after their deadline are a fault (docs/safety.md, H7):
   // one late cycle costs a cycle of latency, five in a row is a loop that lost its period.
   int max_missed_deadlines = 5;

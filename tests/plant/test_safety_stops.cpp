@@ -272,6 +272,43 @@ TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machin
                                                       << " s; escalated to the emergency stop: " << std::string(run.estop ? "yes" : "no"));
 }
 
+TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and falls silent stops the machine as its stop would, after supervisor_timeout, latched until acknowledged, and a station that keeps sending does not") {
+  // The station sends SUPERVISOR Command none every 0.1 s (excavator-operator keep-alive) from 0.5 s
+  // and falls silent after its frame at 3 s; it is heard again at 6 s with an acknowledge.
+  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  const double timeout = b.firmware.controller.supervisor_timeout, last = 3.0;
+  REQUIRE(timeout > 0);
+  for (const bool falls_silent : {true, false}) {
+    sim::LockstepOptions o;
+    o.controller = "adaptive";
+    o.duration = 7.0;
+    for (int i = 5; i <= 69; ++i)
+      if (!falls_silent || i <= 30) o.supervisor.push_back({0.1 * i, hal::SupervisorCommand::none});
+    if (falls_silent) o.supervisor.push_back({6.0, hal::SupervisorCommand::acknowledge});
+    const SupervisedRun run = run_supervised(b, o);
+    INFO(run.record.failure << " " << run.fault_text);
+    if (!falls_silent) {
+      CHECK(run.first_stop < 0);
+      CHECK(run.record.ok);
+      continue;
+    }
+    // Taken on the first cycle past the timeout (the last frame is read at 3.001 s), decelerated
+    // along the path, latched once it is at rest.
+    CHECK(run.fault == app::FirmwareFault::operator_link_lost);
+    CHECK(run.fault_text.find("operator link lost: no SUPERVISOR frame for 0.500 s") != std::string::npos);
+    CHECK(run.first_stop > last + timeout);
+    CHECK(run.first_stop < last + timeout + b.firmware.controller.stop_ramp_time * 1.6);
+    CHECK(app::stop_of(run.fault) == app::StopKind::controlled);
+    CHECK(run.left_stop == doctest::Approx(6.0 + 1e-3).epsilon(1e-9));
+    CHECK(run.last_moving_stopped < 5.5);  // the machine at rest by the plant's truth
+    MESSAGE("link silent after " << last << " s: stopped (latched) at " << run.first_stop << " s, machine at rest from "
+                                 << run.last_moving_stopped << " s, released by the acknowledge at " << run.left_stop
+                                 << " s; escalated: " << std::string(run.estop ? "yes" : "no") << "; " << run.fault_text);
+  }
+  // A station that never sent a keep-alive (one-shot commands) is not monitored: the shipped
+  // operator-stop test above runs with single frames and no link stop.
+}
+
 TEST_CASE("firmware/plausibility: a frozen position reading while its function is driven is found by the frozen-reading test and stopped before the machine is far off its path, where the one-sided flow test alone let it go 0.2 m") {
   // The safety campaign's worst case of its kind: the free motion, the bucket's reading frozen at
   // 2.976 s for 0.86 s. The law drives the bucket on after a reading that no longer moves; the oil it
