@@ -9,7 +9,9 @@ four valves centred (no CMD_PILOT, no CMD_EFFORT), and at least --min-cycles SYN
 firmware stayed stopped, not just for a moment). After the acknowledge the firmware releases the
 machine (FW_EMERGENCY EmergencyStop = 0, FaultCode 0) within --release-cycles SYNCs. The stops'
 FaultCodes must be --expect-codes in order (e.g. 10,1: velocity implausible, a stuck spool; then
-sensor timeout).
+sensor timeout). With --controlled the stops are controlled ones (EmergencyStop = 0, FaultCode not 0:
+an operator's stop, a lost operator link): each begins at the first FW_EMERGENCY with a FaultCode
+after the previous acknowledge and holds that code with EmergencyStop = 0.
 
 Exit 0 when every check holds, 1 otherwise, 2 for bad arguments or a missing canmatrix.
 """
@@ -27,6 +29,7 @@ def main():
     parser.add_argument("--expect-codes", required=True, help="the stops' FaultCodes in order, comma-separated")
     parser.add_argument("--min-cycles", type=int, default=50, help="SYNCs each stop must last at least")
     parser.add_argument("--release-cycles", type=int, default=5, help="SYNCs after an acknowledge to the release")
+    parser.add_argument("--controlled", action="store_true", help="the stops are controlled (EmergencyStop = 0)")
     parser.add_argument("capture", help="a candump -L log")
     args = parser.parse_args()
     try:
@@ -60,7 +63,8 @@ def main():
     errors, stops = [], []
     onset = None  # index of the current stop's first EmergencyStop = 1 frame
     for i, (line, name, v) in enumerate(frames):
-        if name == "FW_EMERGENCY" and v["EmergencyStop"] == 1 and onset is None:
+        stop_bit = 0 if args.controlled else 1
+        if name == "FW_EMERGENCY" and v["EmergencyStop"] == stop_bit and (stop_bit == 1 or v["FaultCode"] != 0) and onset is None:
             onset = i
         if name == "SUPERVISOR" and v["Command"] == ACKNOWLEDGE and onset is not None:
             stops.append((onset, i))
@@ -71,7 +75,7 @@ def main():
         syncs = 0
         for line, name, v in frames[start:ack]:
             syncs += name == "SYNC"
-            if name == "FW_EMERGENCY" and (v["EmergencyStop"] != 1 or int(v["FaultCode"]) != code):
+            if name == "FW_EMERGENCY" and (v["EmergencyStop"] != (0 if args.controlled else 1) or int(v["FaultCode"]) != code):
                 errors.append(f"{where}: line {line}: FW_EMERGENCY {v} before the acknowledge")
             elif name in ("CMD_PILOT", "CMD_EFFORT"):
                 errors.append(f"{where}: line {line}: {name} (a motion command) before the acknowledge")
@@ -90,7 +94,7 @@ def main():
         if released is None:
             errors.append(f"{where}: no release (FW_EMERGENCY EmergencyStop=0) within {args.release_cycles} cycles "
                           "of the acknowledge")
-        print(f"{args.capture}: {where}: EmergencyStop=1 held for {syncs} cycles, valves centred and no motion "
+        print(f"{args.capture}: {where}: EmergencyStop={0 if args.controlled else 1} held for {syncs} cycles, valves centred and no motion "
               f"command until the acknowledge, released {released} cycles after it")
     codes = [int(frames[s][2]["FaultCode"]) for s, _ in stops]
     if codes != expected:

@@ -13,6 +13,9 @@
 #                  the firmware's emergency stop holds until excavator-operator's acknowledge frame;
 #                  then the plant is frozen (SIGSTOP: a sensor timeout), the stop holds again until a
 #                  second acknowledge. --ack-check judges the capture on the host.
+#   link           (not in all) the operator link: excavator-operator keep-alive runs beside the
+#                  firmware, then ends (SIGTERM); the firmware's controlled stop (FaultCode 15,
+#                  operator link lost) holds until an acknowledge frame. --ack-check judges it.
 # Nothing waits on wall-clock speed: every wait ends on an event (a receiver registered on vcan0,
 # frames in the capture, a process exit); the time limits only catch hangs.
 #
@@ -35,7 +38,7 @@ usage() {
   cat <<'EOF'
 Usage: two_process.sh --vcan-vm PATH --plant PATH --firmware PATH --sim PATH --capture-check PATH
                       --scene FILE --work DIR [--duration S] [--watchdog-cycles N]
-                      [--scenario all|run|kill-plant|kill-firmware|realtime|no-plant[,...]] [--timeout S]
+                      [--scenario all|run|kill-plant|kill-firmware|realtime|no-plant|ack|link[,...]] [--timeout S]
                       [--decode-check COMMAND] [--bus-load-check COMMAND] [--rt-vm PRIORITY]
                       [--operator PATH] [--ack-check COMMAND]
 Runs the two-process scenarios (see the head of this file) inside vcan-vm, in one VM.
@@ -50,9 +53,9 @@ Runs the two-process scenarios (see the head of this file) inside vcan-vm, in on
   --bus-load-check CMD  after the VM, on the host: run CMD --log run/firmware.lcm run/capture.log
                       (the run scenario's firmware telemetry and capture; tests/vcan/bus_load_check.py:
                       EXC_CAN_STATS.bus_load against the captured frames' exact on-wire time)
-  --operator PATH     excavator-operator (the ack scenario sends its acknowledge frames with it)
-  --ack-check CMD     after the VM, on the host: run CMD with the ack scenario's capture.log as its
-                      last argument (tests/vcan/ack_capture_check.py); a non-zero exit fails the run
+  --operator PATH     excavator-operator (the ack and link scenarios send their frames with it)
+  --ack-check CMD     after the VM, on the host: run CMD with the ack (or link) scenario's capture.log
+                      as its last argument (tests/vcan/ack_capture_check.py); a non-zero exit fails the run
   --rt-vm PRIORITY    once the VM has booted, and before the scenarios run, give QEMU's threads
                       SCHED_FIFO PRIORITY on the host where permitted (root), as the firmware has
                       in the guest: the emulated vCPU is a host thread, and on a busy host each of its
@@ -103,9 +106,9 @@ done
 [[ $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "two_process.sh: --duration '$duration': must be positive seconds" >&2; exit 2; }
 [[ $watchdog_cycles =~ ^[0-9]+$ ]] || { echo "two_process.sh: --watchdog-cycles '$watchdog_cycles': must be a whole number" >&2; exit 2; }
 for one in ${scenario//,/ }; do
-  case $one in all|run|kill-plant|kill-firmware|realtime|no-plant|ack) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware, realtime, no-plant or ack (or a comma-separated list)" >&2; exit 2 ;; esac
-  if [ "$one" = ack ]; then
-    [ -n "$operator" ] && [ -x "$operator" ] || { echo "two_process.sh: --operator '$operator': the ack scenario needs excavator-operator" >&2; exit 2; }
+  case $one in all|run|kill-plant|kill-firmware|realtime|no-plant|ack|link) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware, realtime, no-plant, ack or link (or a comma-separated list)" >&2; exit 2 ;; esac
+  if [ "$one" = ack ] || [ "$one" = link ]; then
+    [ -n "$operator" ] && [ -x "$operator" ] || { echo "two_process.sh: --operator '$operator': the $one scenario needs excavator-operator" >&2; exit 2; }
   fi
 done
 
@@ -153,18 +156,20 @@ if [ "$inside" = 0 ]; then
       echo "FAIL [bus-load]: EXC_CAN_STATS.bus_load does not match the capture:"; cat "$work/run/bus_load_check.out"; rc=1
     fi
   fi
-  case ",$scenario," in
-    *,ack,*)
-      if [ -n "$ack_check" ]; then
-        current=ack-check
-        # shellcheck disable=SC2086  # the command line is split into words on purpose
-        if $ack_check "$work/ack/capture.log" > "$work/ack/ack_check.out" 2>&1; then
-          grep -E 'stop [0-9]|stops held' "$work/ack/ack_check.out" | sed 's/^[^:]*: /[ack-check] /'
-        else
-          echo "FAIL [ack-check]: the capture does not show the stops held until the acknowledge:"; sed -n '1,30p' "$work/ack/ack_check.out"; rc=1
-        fi
-      fi ;;
-  esac
+  for held in ack link; do
+    case ",$scenario," in
+      *,$held,*)
+        if [ -n "$ack_check" ]; then
+          current=ack-check
+          # shellcheck disable=SC2086  # the command line is split into words on purpose
+          if $ack_check "$work/$held/capture.log" > "$work/$held/ack_check.out" 2>&1; then
+            grep -E 'stop [0-9]|stops held' "$work/$held/ack_check.out" | sed 's/^[^:]*: /[ack-check] /'
+          else
+            echo "FAIL [ack-check]: the $held capture does not show the stops held until the acknowledge:"; sed -n '1,30p' "$work/$held/ack_check.out"; rc=1
+          fi
+        fi ;;
+    esac
+  done
   [ -n "$decode_check" ] || exit $rc
   # The second decoder, on the host (fast there, slow in the emulated VM), on every capture this run
   # wrote: it must read every frame as the DBC defines it.
@@ -468,6 +473,38 @@ scenario_ack() {
   grep -q 'arm spool stuck' "$dir/plant.out" || fail "the plant did not stick the arm's spool: $(tail -3 "$dir/plant.out")"
 }
 
+scenario_link() {
+  current=link
+  local dir=$work/link long=600 seen ka_pid
+  rm -rf "$dir"; mkdir -p "$dir"
+  start_capture_and_plant "$dir" "$long" || return
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$FIRMWARE_ARGS" "$long" "$dir/two_process.json" "$dir") > "$dir/firmware.out" 2>&1 &
+  local fw_pid=$!
+  local give_up="stop $fw_pid; stop $plant_pid; stop_capture $dir"
+  wait_until "200 cycles of the firmware" syncs_at_least "$capture" 200 || { eval "$give_up"; return; }
+  # The station's keep-alive every 50 ms (a tenth of the firmware's 0.5 s timeout: a stalled guest
+  # must not look like a lost link), for 1500 cycles; then it ends as a station that hangs up does.
+  "$operator" --can vcan0 keep-alive --period 0.05 > "$dir/keepalive.out" 2>&1 &
+  ka_pid=$!
+  wait_until "the first keep-alive" id_in_capture "$capture" 012 || { stop "$ka_pid"; eval "$give_up"; return; }
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "1500 cycles with the link up" syncs_at_least "$capture" $((seen + 1500)) || { stop "$ka_pid"; eval "$give_up"; return; }
+  id_in_capture "$capture" 010 && fail "FW_EMERGENCY while the keep-alive ran: $(grep -m1 ' 010#' "$capture")"
+  stop "$ka_pid"
+  note "$(tail -1 "$dir/keepalive.out") after $(grep -c ' 080#' "$capture") cycles"
+  wait_until "FW_EMERGENCY after the link's loss" id_in_capture "$capture" 010 || { eval "$give_up"; return; }
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "1000 cycles stopped" syncs_at_least "$capture" $((seen + 1000)) || { eval "$give_up"; return; }
+  "$operator" --can vcan0 --counter 0 ack > "$dir/operator.out" 2>&1 || fail "excavator-operator ack: $(cat "$dir/operator.out")"
+  note "$(cat "$dir/operator.out") after $(grep -c ' 080#' "$capture") cycles"
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "300 cycles after the acknowledge" syncs_at_least "$capture" $((seen + 300))
+  stop "$fw_pid"; stop "$plant_pid"; stop_capture "$dir"
+  grep -q 'operator link lost' "$dir/firmware.out" "$dir/two_process.json" 2>/dev/null ||
+    note "the firmware's output does not name the lost link (the capture's FaultCode is judged on the host)"
+}
+
 current=setup
 # The programs may write defaults (telemetry logs, out/) relative to the working directory: the
 # work directory is the one place the VM can write that the host sees.
@@ -482,6 +519,7 @@ for one in ${scenario//,/ }; do
     realtime) scenario_realtime ;;
     no-plant) scenario_no_plant ;;
     ack) scenario_ack ;;
+    link) scenario_link ;;
   esac
 done
 if [ $failures -eq 0 ]; then echo "two_process.sh: all scenarios passed ($scenario)"; exit 0; fi
