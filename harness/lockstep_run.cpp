@@ -149,12 +149,14 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   hal::FirmwareCanPort firmware_port(firmware_end);
   hal::PlantCanPort plant_port(plant_end);
   // The operator station is outside the burst: its frames are what the fault campaign never damages.
-  // An operator_stop fault is the operator station's stop frame at the fault's start.
+  // An operator_stop fault is the operator station's stop frame at the fault's start; an
+  // operator_link_lost fault its keep-alives every 0.1 s up to the fault's start, then silence.
   std::vector<SupervisorFrameAt> supervisor = options.supervisor;
-  if (options.fault.kind == FaultSchedule::Kind::operator_stop) {
+  if (options.fault.kind == FaultSchedule::Kind::operator_stop)
     supervisor.push_back({options.fault.start, hal::SupervisorCommand::stop});
-    std::stable_sort(supervisor.begin(), supervisor.end(), [](const SupervisorFrameAt& a, const SupervisorFrameAt& b) { return a.time < b.time; });
-  }
+  if (options.fault.kind == FaultSchedule::Kind::operator_link_lost)
+    for (int k = 1; 0.1 * k <= options.fault.start; ++k) supervisor.push_back({0.1 * k, hal::SupervisorCommand::none});
+  std::stable_sort(supervisor.begin(), supervisor.end(), [](const SupervisorFrameAt& a, const SupervisorFrameAt& b) { return a.time < b.time; });
   hal::MemoryBusNode* operator_bus = supervisor.empty() ? nullptr : hub.attach();
   hal::OperatorCanPort operator_port(operator_bus != nullptr ? *operator_bus : *firmware_bus);
   std::size_t next_supervisor = 0;

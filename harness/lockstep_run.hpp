@@ -116,7 +116,7 @@ struct RunRecord {
 struct FaultSchedule {
   enum class Kind : std::uint8_t {
     none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck,
-    pressure_stuck, pressure_jump, pressure_drift, operator_stop, machine_fault
+    pressure_stuck, pressure_jump, pressure_drift, operator_stop, machine_fault, operator_link_lost
   };
   Kind kind = Kind::none;
   double start = 0, duration = 0;  // s
@@ -131,7 +131,7 @@ struct FaultSchedule {
   std::uint64_t seed = 1;
 };
 // The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 13> kFaultKinds{{{
+inline constexpr settings::EnumTable<FaultSchedule::Kind, 14> kFaultKinds{{{
     {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
     {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
     {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
@@ -145,6 +145,8 @@ inline constexpr settings::EnumTable<FaultSchedule::Kind, 13> kFaultKinds{{{
     {FaultSchedule::Kind::pressure_drift, "pressure_drift", "a chamber pressure reading drifts out of range (the hydraulic machine)"},
     {FaultSchedule::Kind::operator_stop, "operator_stop", "the operator station sends a SUPERVISOR stop at the fault's start"},
     {FaultSchedule::Kind::machine_fault, "machine_fault", "the machine's own controller reports a fault (PlantFaults) and holds"},
+    {FaultSchedule::Kind::operator_link_lost, "operator_link_lost",
+     "the operator station's keep-alive (SUPERVISOR none every 0.1 s from 0.1 s) ends at the fault's start"},
 }}};
 inline const char* to_string(FaultSchedule::Kind kind) {
   return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);

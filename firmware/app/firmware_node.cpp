@@ -260,17 +260,16 @@ void FirmwareNode::take_supervisor_commands() {
   }
   if (operator_stop_on_rest_ && !path_stop_moving(time()) && !fault_) {
     operator_stop_on_rest_ = false;
+    raise(link_stop_ ? FirmwareFault::operator_link_lost : FirmwareFault::operator_stop);
     pending_time_ = operator_stop_time_;  // detected when its frame came (or failed to), whatever the deceleration took
     if (link_stop_) {
       link_stop_ = false;
-      raise(FirmwareFault::operator_link_lost);
       std::snprintf(pending_text_, sizeof pending_text_,
                     "operator link lost: no SUPERVISOR frame for %.3f s (the last at t = %.3f s), in %s; the path at rest "
                     "%.3f s later",
                     config_.controller.supervisor_timeout, last_supervisor_time_, control::to_string(mode),
                     time() - operator_stop_time_);
     } else {
-      raise(FirmwareFault::operator_stop);
       std::snprintf(pending_text_, sizeof pending_text_,
                     "operator stop: SUPERVISOR stop in %s at t = %.3f s, the path at rest %.3f s later",
                     control::to_string(mode), operator_stop_time_, time() - operator_stop_time_);

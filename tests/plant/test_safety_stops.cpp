@@ -296,6 +296,8 @@ TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and fa
     // along the path, latched once it is at rest.
     CHECK(run.fault == app::FirmwareFault::operator_link_lost);
     CHECK(run.fault_text.find("operator link lost: no SUPERVISOR frame for 0.500 s") != std::string::npos);
+    // Detected on the first cycle past the timeout (the last frame read at 3.001 s), latched later.
+    CHECK(run.record.first_fault_detected_time == doctest::Approx(last + 1e-3 + timeout + 1e-3).epsilon(1e-9));
     CHECK(run.first_stop > last + timeout);
     CHECK(run.first_stop < last + timeout + b.firmware.controller.stop_ramp_time * 1.6);
     CHECK(app::stop_of(run.fault) == app::StopKind::controlled);

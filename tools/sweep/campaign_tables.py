@@ -25,6 +25,7 @@ FUNCTIONS = (
     ("plant holding", "H6 the machine holding", "5 sensor sets (H6)"),
     ("deadline overrun", "H7 missed deadlines", "the cycle after the last miss (H7)"),
     ("operator stop", "H9 operator stop", "the cycle the frame arrives (H9)"),
+    ("operator link lost", "H10 operator link", "supervisor_timeout, 0.5 s (H10)"),
     ("none", "no stop (tracked, or neither)", "-"),
 )
 
