@@ -432,25 +432,35 @@ scenario_no_plant() {
 # Issue 32's capture: a stuck spool, then a sensor timeout, each stop held until an acknowledge.
 # Every wait counts cycles on the bus (SYNC frames), never wall-clock time.
 sends_at_least() { [ "$(grep -c " $2#" "$1" 2>/dev/null)" -ge "$3" ]; }
+# The firmware on vcan0 for LONG simulated seconds (dir, long): fw_pid, and give_up to end the scenario.
+start_firmware() {
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$FIRMWARE_ARGS" "$2" "$1/two_process.json" "$1") > "$1/firmware.out" 2>&1 &
+  fw_pid=$!
+  give_up="stop $fw_pid; stop $plant_pid; stop_capture $1"
+}
+# After N cycles stopped, excavator-operator's acknowledge (its counter, its output file), then M
+# cycles more: acknowledge_after N COUNTER OUT M.
+acknowledge_after() {
+  local seen
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "$1 cycles stopped" syncs_at_least "$capture" $((seen + $1)) || return 1
+  "$operator" --can vcan0 --counter "$2" ack > "$3" 2>&1 || fail "excavator-operator ack: $(cat "$3")"
+  note "$(cat "$3") after $(grep -c ' 080#' "$capture") cycles"
+  seen=$(grep -c ' 080#' "$capture")
+  wait_until "$4 cycles after the acknowledge" syncs_at_least "$capture" $((seen + $4))
+}
 scenario_ack() {
   current=ack
   local dir=$work/ack long=600 seen stops
   rm -rf "$dir"; mkdir -p "$dir"
   # The arm's spool sticks at 0.4 from 1 s to 1.5 s of the run: the velocity monitor's emergency stop.
   start_capture_and_plant "$dir" "$long" "--stuck-spool arm --stuck-opening 0.4 --stuck-from 1 --stuck-until 1.5" || return
-  # shellcheck disable=SC2046
-  "$firmware" $(expand "$FIRMWARE_ARGS" "$long" "$dir/two_process.json" "$dir") > "$dir/firmware.out" 2>&1 &
-  local fw_pid=$!
-  local give_up="stop $fw_pid; stop $plant_pid; stop_capture $dir"
+  start_firmware "$dir" "$long"
   wait_until "FW_EMERGENCY after the stuck spool" id_in_capture "$capture" 010 || { eval "$give_up"; return; }
   # Stopped for 1000 cycles (1 s of the run), then acknowledged. The counters go 0, 1: in sequence
   # for the capture check, which allows no gap.
-  seen=$(grep -c ' 080#' "$capture")
-  wait_until "1000 cycles stopped" syncs_at_least "$capture" $((seen + 1000)) || { eval "$give_up"; return; }
-  "$operator" --can vcan0 --counter 0 ack > "$dir/operator1.out" 2>&1 || fail "excavator-operator ack: $(cat "$dir/operator1.out")"
-  note "$(cat "$dir/operator1.out") after $(grep -c ' 080#' "$capture") cycles"
-  seen=$(grep -c ' 080#' "$capture")
-  wait_until "500 cycles after the acknowledge" syncs_at_least "$capture" $((seen + 500)) || { eval "$give_up"; return; }
+  acknowledge_after 1000 0 "$dir/operator1.out" 500 || { eval "$give_up"; return; }
   # A sensor timeout: the plant frozen. The firmware's cycles go on (each waits for the sensors).
   stops=$(grep -c ' 010#' "$capture")
   kill -STOP "$plant_pid"
@@ -460,12 +470,7 @@ scenario_ack() {
   wait_until "10 cycles without the plant" syncs_at_least "$capture" $((seen + 10))
   kill -CONT "$plant_pid"
   note "plant resumed (SIGCONT) after $(grep -c ' 080#' "$capture") cycles"
-  seen=$(grep -c ' 080#' "$capture")
-  wait_until "500 cycles with the plant back" syncs_at_least "$capture" $((seen + 500)) || { eval "$give_up"; return; }
-  "$operator" --can vcan0 --counter 1 ack > "$dir/operator2.out" 2>&1 || fail "excavator-operator ack: $(cat "$dir/operator2.out")"
-  note "$(cat "$dir/operator2.out") after $(grep -c ' 080#' "$capture") cycles"
-  seen=$(grep -c ' 080#' "$capture")
-  wait_until "300 cycles after the second acknowledge" syncs_at_least "$capture" $((seen + 300))
+  acknowledge_after 500 1 "$dir/operator2.out" 300 || { eval "$give_up"; return; }
   stop "$fw_pid"; stop "$plant_pid"; stop_capture "$dir"
   # Not vcan-capture-check: a plant thawed from SIGSTOP answers the SYNCs queued while it was frozen,
   # each after a later SYNC, which that strict check counts as out of cycle. canmatrix (--decode-check)
@@ -478,10 +483,7 @@ scenario_link() {
   local dir=$work/link long=600 seen ka_pid
   rm -rf "$dir"; mkdir -p "$dir"
   start_capture_and_plant "$dir" "$long" || return
-  # shellcheck disable=SC2046
-  "$firmware" $(expand "$FIRMWARE_ARGS" "$long" "$dir/two_process.json" "$dir") > "$dir/firmware.out" 2>&1 &
-  local fw_pid=$!
-  local give_up="stop $fw_pid; stop $plant_pid; stop_capture $dir"
+  start_firmware "$dir" "$long"
   wait_until "200 cycles of the firmware" syncs_at_least "$capture" 200 || { eval "$give_up"; return; }
   # The station's keep-alive every 50 ms (a tenth of the firmware's 0.5 s timeout: a stalled guest
   # must not look like a lost link), for 1500 cycles; then it ends as a station that hangs up does.
@@ -494,12 +496,7 @@ scenario_link() {
   stop "$ka_pid"
   note "$(tail -1 "$dir/keepalive.out") after $(grep -c ' 080#' "$capture") cycles"
   wait_until "FW_EMERGENCY after the link's loss" id_in_capture "$capture" 010 || { eval "$give_up"; return; }
-  seen=$(grep -c ' 080#' "$capture")
-  wait_until "1000 cycles stopped" syncs_at_least "$capture" $((seen + 1000)) || { eval "$give_up"; return; }
-  "$operator" --can vcan0 --counter 0 ack > "$dir/operator.out" 2>&1 || fail "excavator-operator ack: $(cat "$dir/operator.out")"
-  note "$(cat "$dir/operator.out") after $(grep -c ' 080#' "$capture") cycles"
-  seen=$(grep -c ' 080#' "$capture")
-  wait_until "300 cycles after the acknowledge" syncs_at_least "$capture" $((seen + 300))
+  acknowledge_after 1000 0 "$dir/operator.out" 300 || { eval "$give_up"; return; }
   stop "$fw_pid"; stop "$plant_pid"; stop_capture "$dir"
   grep -q 'operator link lost' "$dir/firmware.out" "$dir/two_process.json" 2>/dev/null ||
     note "the firmware's output does not name the lost link (the capture's FaultCode is judged on the host)"
