@@ -141,8 +141,9 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   // swing's brake hold; the engine runs on. Both come back with the next valid command set. Before
   // the first command the valves are centred and the supply stays on (no link was lost).
   const bool link_lost = have_command_ && timed_out;
+  const bool pilot_cut = hydraulic && (command_.emergency_stop || link_lost);
   if (hydraulic) {
-    plant_.set_pilot_supply(!command_.emergency_stop && !link_lost);
+    plant_.set_pilot_supply(!pilot_cut);
     plant_.set_engine_running(!command_.emergency_stop);
   }
 
@@ -190,7 +191,6 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   apply_sensor_fault();
   const plant::HydraulicReport& h = plant_.state().hydraulics;
   const bool estop = hydraulic && command_.emergency_stop;
-  const bool pilot_cut = hydraulic && (command_.emergency_stop || link_lost);
   sensors_.plant_state = static_cast<std::uint8_t>((hold ? hal::kPlantStateHolding : 0) | (pilot_cut ? hal::kPlantStatePilotCut : 0) |
                                                    (estop ? hal::kPlantStateEngineStopped : 0) |
                                                    (hydraulic && h.holding_valves_closed ? hal::kPlantStateHoldingValvesClosed : 0));

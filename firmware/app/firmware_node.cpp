@@ -241,8 +241,9 @@ void FirmwareNode::take_supervisor_commands() {
     link_lost_ = true;
     link_stop_ = true;
   }
-  const bool stop_now = (pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0 || lost_now;
-  if ((pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0) link_stop_ = false;  // the station's own stop
+  const bool stop_frame = (pending & supervisor_bit(hal::SupervisorCommand::stop)) != 0;
+  if (stop_frame) link_stop_ = false;  // the station's own stop
+  const bool stop_now = stop_frame || lost_now;
   if (stop_now) {
     operator_stop_pending_ = true;
     start_received_ = false;  // a stop withdraws a start: the next begin needs a new one
@@ -661,9 +662,10 @@ void FirmwareNode::check_plausibility(bool restarted) {
   const FlowMeasurement m = flow_measurement();
   const std::uint8_t found = plausibility_.update(!restarted, v.velocity, m.position, m.compression, m.at_relief);
   const std::uint8_t frozen = frozen_position_.update(!restarted, plausibility_, m.position, m.at_relief);
-  if ((found | frozen) == 0 || fault_ || !plausibility_.settings().enabled) return;
+  const std::uint8_t either = found | frozen;
+  if (either == 0 || fault_ || !plausibility_.settings().enabled) return;
   int j = 0;
-  while ((((found | frozen) >> j) & 1) == 0) ++j;
+  while (((either >> j) & 1) == 0) ++j;
   raise(FirmwareFault::velocity_implausible);
   const char* const unit = j == 0 ? "rad" : "m";
   const double window = plausibility_.settings().window;
