@@ -154,8 +154,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   std::vector<SupervisorFrameAt> supervisor = options.supervisor;
   if (options.fault.kind == FaultSchedule::Kind::operator_stop)
     supervisor.push_back({options.fault.start, hal::SupervisorCommand::stop});
-  if (options.fault.kind == FaultSchedule::Kind::operator_link_lost)
-    for (int k = 1; 0.1 * k <= options.fault.start; ++k) supervisor.push_back({0.1 * k, hal::SupervisorCommand::none});
+  if (options.fault.kind == FaultSchedule::Kind::operator_link_lost) {
+    // Counted, not compared: 0.1 * 30 is above 3.0, and a start on the grid keeps its own frame.
+    const int last = static_cast<int>(std::floor(options.fault.start / 0.1 + 1e-9));
+    for (int k = 1; k <= last; ++k) supervisor.push_back({0.1 * k, hal::SupervisorCommand::none});
+  }
   std::stable_sort(supervisor.begin(), supervisor.end(), [](const SupervisorFrameAt& a, const SupervisorFrameAt& b) { return a.time < b.time; });
   hal::MemoryBusNode* operator_bus = supervisor.empty() ? nullptr : hub.attach();
   hal::OperatorCanPort operator_port(operator_bus != nullptr ? *operator_bus : *firmware_bus);

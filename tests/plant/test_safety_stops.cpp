@@ -273,8 +273,9 @@ TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machin
 }
 
 TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and falls silent stops the machine as its stop would, after supervisor_timeout, latched until acknowledged, and a station that keeps sending does not") {
-  // The station sends SUPERVISOR Command none every 0.1 s (excavator-operator keep-alive) from 0.5 s
-  // and falls silent after its frame at 3 s; it is heard again at 6 s with an acknowledge.
+  // The station sends SUPERVISOR Command none every 0.1 s (excavator-operator keep-alive; the
+  // campaign's fault kind operator_link_lost) and falls silent after its frame at 3 s; it is heard
+  // again at 6 s with an acknowledge. The control keeps sending to the run's end.
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   const double timeout = b.firmware.controller.supervisor_timeout, last = 3.0;
   REQUIRE(timeout > 0);
@@ -282,8 +283,8 @@ TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and fa
     sim::LockstepOptions o;
     o.controller = "adaptive";
     o.duration = 7.0;
-    for (int i = 5; i <= 69; ++i)
-      if (!falls_silent || i <= 30) o.supervisor.push_back({0.1 * i, hal::SupervisorCommand::none});
+    o.fault.kind = sim::FaultSchedule::Kind::operator_link_lost;
+    o.fault.start = falls_silent ? last : o.duration;
     if (falls_silent) o.supervisor.push_back({6.0, hal::SupervisorCommand::acknowledge});
     const SupervisedRun run = run_supervised(b, o);
     INFO(run.record.failure << " " << run.fault_text);
@@ -292,11 +293,10 @@ TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and fa
       CHECK(run.record.ok);
       continue;
     }
-    // Taken on the first cycle past the timeout (the last frame is read at 3.001 s), decelerated
+    // Detected on the first cycle past the timeout (the last frame read at 3.001 s), decelerated
     // along the path, latched once it is at rest.
     CHECK(run.fault == app::FirmwareFault::operator_link_lost);
     CHECK(run.fault_text.find("operator link lost: no SUPERVISOR frame for 0.500 s") != std::string::npos);
-    // Detected on the first cycle past the timeout (the last frame read at 3.001 s), latched later.
     CHECK(run.record.first_fault_detected_time == doctest::Approx(last + 1e-3 + timeout + 1e-3).epsilon(1e-9));
     CHECK(run.first_stop > last + timeout);
     CHECK(run.first_stop < last + timeout + b.firmware.controller.stop_ramp_time * 1.6);
