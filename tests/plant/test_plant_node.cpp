@@ -37,6 +37,13 @@ struct NodeBench {
   }
 };
 
+// plant_scenes.hpp's test scene on the hydraulic machine.
+Scene hydraulic_scene_text() {
+  plant::test::SceneText t;
+  t.actuators = "fidelity: hydraulic";
+  return t.scene();
+}
+
 hal::CommandState boom_pilots(double a, double b) {
   hal::CommandState c;
   c.mode = hal::CommandMode::pilot;
@@ -45,12 +52,17 @@ hal::CommandState boom_pilots(double a, double b) {
   return c;
 }
 
+// Cycles 0..299 with the boom raised on its pilots (3 MPa against 1): the cycle that comes next.
+std::uint64_t raise_boom(NodeBench& bench, hal::SensorState& seen) {
+  std::uint64_t k = 0;
+  for (; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);
+  return k;
+}
+
 }  // namespace
 
 TEST_CASE("plant/node: CMD_PILOT drives the hydraulic plant as pilot commands, step for step as the plant driven directly") {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  const Scene scene = t.scene();
+  const Scene scene = hydraulic_scene_text();
   NodeBench bench(scene);
   // The same commands straight into a second plant: cycle 0 holds (no command yet: valves centred),
   // from cycle 1 on the firmware's pilots of the previous cycle. 3 MPa and 1 MPa are whole steps of
@@ -79,12 +91,9 @@ TEST_CASE("plant/node: CMD_PILOT drives the hydraulic plant as pilot commands, s
 }
 
 TEST_CASE("plant/node: a jammed actuator on the hydraulic machine is a stuck spool: it stays where it was whatever the pilots or the safe state's centred valves ask, and follows them again once freed") {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  NodeBench bench(t.scene());
+  NodeBench bench(hydraulic_scene_text());
   hal::SensorState seen;
-  std::uint64_t k = 0;
-  for (; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);
+  std::uint64_t k = raise_boom(bench, seen);
   const double open = bench.plant.state().spool[1];
   REQUIRE(open > 0.1);
   app::InjectedFault jam;
@@ -104,11 +113,9 @@ TEST_CASE("plant/node: a jammed actuator on the hydraulic machine is a stuck spo
 }
 
 TEST_CASE("plant/node: a cycle whose SYNC was lost coasts: the machine moves on one step with the command it holds and the node sends nothing") {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  NodeBench bench(t.scene());
+  NodeBench bench(hydraulic_scene_text());
   hal::SensorState seen;
-  for (std::uint64_t k = 0; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);
+  raise_boom(bench, seen);
   const double time = bench.plant.state().time, boom = bench.plant.state().q_a[1];
   bench.node.coast();
   CHECK(bench.plant.state().time == doctest::Approx(time + bench.plant.scene().cycle));
@@ -119,9 +126,7 @@ TEST_CASE("plant/node: a cycle whose SYNC was lost coasts: the machine moves on 
 }
 
 TEST_CASE("plant/node: SENS_MACHINE carries every chamber and both pump pressures of the hydraulic plant's sensors, PressureValid 1") {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  NodeBench bench(t.scene());
+  NodeBench bench(hydraulic_scene_text());
   hal::SensorState seen;
   for (std::uint64_t k = 0; k < 300; ++k) {
     REQUIRE(bench.cycle(k, boom_pilots(4e6, 0), seen));
@@ -163,9 +168,7 @@ TEST_CASE("plant/node: a force-commanded plant sends PressureValid 0, and stops 
 }
 
 TEST_CASE("plant/node: a valve_stuck fault holds a spool at its opening whatever CMD_PILOT asks, the others follow their pilots, and its end frees it") {
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  NodeBench bench(t.scene());
+  NodeBench bench(hydraulic_scene_text());
   app::InjectedFault stuck;
   stuck.kind = app::InjectedFault::Kind::valve_stuck;
   stuck.joint = 1;
@@ -174,10 +177,10 @@ TEST_CASE("plant/node: a valve_stuck fault holds a spool at its opening whatever
   hal::CommandState c = boom_pilots(3e6, 0);  // the boom asked to extend ...
   c.pilot_a[hal::kArm] = 2e6;                 // ... and the arm too
   hal::SensorState seen;
-  const double l0 = t.scene().q_a0[1];
+  const double l0 = bench.plant.scene().q_a0[1];
   for (std::uint64_t k = 0; k < 300; ++k) REQUIRE(bench.cycle(k, c, seen));
   const PlantState& s = bench.plant.state();
-  const double full = t.scene().machine.hydraulics.pilot_full_stroke;
+  const double full = bench.plant.scene().machine.hydraulics.pilot_full_stroke;
   CHECK(s.spool[1] == -0.4);                                              // stuck, lowering the boom
   CHECK(s.q_a[1] < l0 - 0.01);
   CHECK(s.spool[2] == doctest::Approx(2e6 / full).epsilon(1e-3));         // the arm's spool follows
@@ -191,12 +194,9 @@ TEST_CASE("plant/node: a lost link cuts the pilot supply as an autonomy kit's re
   // The firmware commands, then falls silent (SYNC goes on: a firmware that hangs, a cut command
   // line). The plant's command watchdog holds after 20 cycles; centred valves alone do not stop a
   // boom whose spool is stuck lowering (it sinks on), the pilot cut closes its load-holding valve.
-  plant::test::SceneText t;
-  t.actuators = "fidelity: hydraulic";
-  NodeBench bench(t.scene());
+  NodeBench bench(hydraulic_scene_text());
   hal::SensorState seen;
-  std::uint64_t k = 0;
-  for (; k < 300; ++k) bench.cycle(k, boom_pilots(3e6, 1e6), seen);  // raise the boom a little
+  std::uint64_t k = raise_boom(bench, seen);  // raise the boom a little
   app::InjectedFault stuck;
   stuck.kind = app::InjectedFault::Kind::valve_stuck;
   stuck.joint = hal::kBoom;
