@@ -95,7 +95,9 @@ class KnobReader {
     return first;
   }
 
-  // A value, read as the scenes' readers read it with the value set.
+  // A value, read as the scenes' readers read it with the value set. One they refuse alone is held
+  // for check_refused: the grid's other values or a variant's may make it valid (a faster path with
+  // the timing fitted), which only the whole spec shows.
   SweepValue value(const SectionReader& r, const std::string& key, long index, const YAML::Node& n, const Declaration& d) {
     const SweepValue v = read_value(r, key, index, n, d);
     if (!checked_.insert(key + "=" + v.text()).second) return v;
@@ -105,10 +107,53 @@ class KnobReader {
         set_knob(spec_.run, key, v, changes);
         (void)changes.read();
       } catch (const std::exception& e) {
-        fail_at(r, key, index, "is " + v.text() + ", refused by the scene: " + e.what());
+        refused_.push_back(Refused{r, key, index, v, e.what()});
+        break;
       }
     }
     return v;
+  }
+
+  // Each value refused alone, read again in every case it runs in: with each grid point and variant
+  // of each scene (the point's or variant's own value of the knob where it sets it; a drawn or
+  // searched value beside their settings, as case_bundle sets them). Refused in any: an error at the
+  // value naming the settings it was read with.
+  void check_refused() const {
+    if (refused_.empty()) return;
+    const int points = spec_.grid_points(), variants = std::max<int>(1, static_cast<int>(spec_.variants.size()));
+    const long combinations = static_cast<long>(spec_.sources.size()) * points * variants;
+    SweepSpec one = spec_;  // a case per combination: its id is the combination's index
+    one.cases = 1;
+    // The grid's and the variants' values first: they are read without the draws, so a value refused
+    // for itself (a name no reader takes) is named, not a draw read beside it.
+    std::vector<const Refused*> order;
+    const std::vector<std::string> set = spec_.set_knobs();
+    for (int pass = 0; pass < 2; ++pass)
+      for (const Refused& x : refused_)
+        if ((std::find(set.begin(), set.end(), x.key) != set.end()) == (pass == 0)) order.push_back(&x);
+    for (const Refused* p : order) {
+      const Refused& x = *p;
+      if (combinations > kMostJointReads)
+        fail_at(x.reader, x.key, x.index, "is " + x.value.text() + ", refused by the scene: " + x.why);
+      const bool searched = x.key == spec_.search.knob;
+      for (long i = 0; i < combinations; ++i) {
+        const SweepCase c = sweep_case(one, static_cast<int>(i));
+        const auto own = std::find_if(c.set.begin(), c.set.end(), [&](const SweepSetting& s) { return s.first == x.key; });
+        if (own != c.set.end() && own->second.text() != x.value.text()) continue;  // a case without this value
+        std::string with;
+        for (const SweepSetting& s : c.set)
+          if (s.first != x.key) with += (with.empty() ? " with " : ", ") + s.first + " = " + s.second.text();
+        try {
+          SceneChanges changes(*spec_.sources[static_cast<std::size_t>(c.scene)]);
+          if (own == c.set.end() && !searched) set_knob(spec_.run, x.key, x.value, changes);
+          for (const SweepSetting& s : c.set) set_knob(spec_.run, s.first, s.second, changes);
+          if (searched) set_knob(spec_.run, x.key, x.value, changes);
+          (void)changes.read();
+        } catch (const std::exception& e) {
+          fail_at(x.reader, x.key, x.index, "is " + x.value.text() + ", refused by the scene" + with + ": " + e.what());
+        }
+      }
+    }
   }
 
   // The knobs given in a mapping (a grid, the search), each a list of values, in the mapping's order.
@@ -143,8 +188,19 @@ class KnobReader {
   }
 
  private:
+  struct Refused {
+    SectionReader reader;  // where the value was given (errors name its line)
+    std::string key;
+    long index;
+    SweepValue value;
+    std::string why;  // the first scene's reason
+  };
+  // Joint reads are a scene read each (about a millisecond): beyond this many a value refused alone
+  // is refused, as it was before the joint check.
+  static constexpr long kMostJointReads = 20000;
   const SweepSpec& spec_;
   std::set<std::string> checked_;  // knob=value pairs already read by the scenes
+  std::vector<Refused> refused_;
 };
 
 }  // namespace
@@ -349,6 +405,7 @@ SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
           if (inside(a, b) || inside(b, a))
             s.fail_here("'" + all[i] + "' and '" + all[j] + "' both write " + (a.size() < b.size() ? a : b) +
                         " (the later one would undo the other): choose one");
+  knobs.check_refused();
   if (spec.total_cases() > 10'000'000) s.fail_here("more than 10 million cases");
   s.finish();
   top.finish();

@@ -207,7 +207,7 @@ Declaration knob_values(SweepRun run, const std::string& knob, const SceneSource
   if (d == nullptr) {
     std::string names;
     for (const Knob& n : named_knobs(run)) names += (names.empty() ? "" : ", ") + std::string(n.name);
-    throw std::invalid_argument("is no knob: neither a named one (" + names + ") nor a number's or a name's path in " +
+    throw std::invalid_argument("is no knob: neither a named one (" + names + ") nor a number's, a name's or a flag's path in " +
                                 scene.scene.file() + " (e.g. sensors.latency_cycles) or its machine file (machine.<path>: the "
                                 "plant's, firmware.machine.<path>: the firmware's model)");
   }

@@ -236,6 +236,8 @@ void SectionReader::flag(const char* key, bool& value, const char* /*what*/) {
     value = v;
   }
   out_[key] = value ? "true" : "false";
+  // A choice of two names, so that a sweep sets it as it sets any named setting.
+  note(key, Declaration::Type::choice, 0, nullptr, nullptr, 0, "", "true, false");
 }
 
 void SectionReader::text(const char* key, std::string& value, const char* what, Need need) {

@@ -303,6 +303,44 @@ TEST_CASE("tools/excavator-sim sweep refuses at load a value the scene's readers
   CHECK(line["pid"].contains("ok"));
 }
 
+TEST_CASE("tools/excavator-sim sweep reads a value the scene refuses alone with the grid's and the variants' values it runs with, and names the one it fails with") {
+  // The free motion's path at 1.3x asks the swing for 84.5 kN m against 59.5: refused alone, taken
+  // with the path's timing fitted (a flag: a choice of true and false for the sweep).
+  const exc::test::Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  const std::string head = "sweep:\n  scene: " + std::string(EXC_SOURCE_DIR) +
+                           "/scenes/free_motion.yaml\n  controllers: [pid]\n  duration: 0.05\n  cases: 2\n"
+                           "  perturbations:\n    path_speed: [0.6, 1.3]\n";
+  const auto sweep = [&](const std::string& rest) {
+    std::ofstream(dir / "spec.yaml") << head + rest;
+    return run_sim("sweep " + (dir / "spec.yaml").string() + " --quiet --out x.jsonl");
+  };
+  for (const std::string& fitted : {std::string("  grid:\n    task.efforts.fit_timing: [true]\n"),
+                                    std::string("  variants:\n    - {name: fitted, task.efforts.fit_timing: true}\n")}) {
+    CAPTURE(fitted);
+    const exc::test::Run ok = sweep(fitted);
+    REQUIRE_MESSAGE(ok.status == 0, ok.err);
+    const std::string lines = read_text_file(ok.dir / "x.jsonl");
+    CHECK(std::count(lines.begin(), lines.end(), '\n') == 2);
+  }
+  // One grid point without the fit: refused at the draw's end, naming the setting it was read with.
+  const exc::test::Run unfitted = sweep("  grid:\n    task.efforts.fit_timing: [false, true]\n");
+  CHECK(unfitted.status == 2);
+  CHECK(unfitted.err.find("sweep.perturbations.path_speed[1]: is 1.3, refused by the scene with task.efforts.fit_timing = false: ") !=
+        std::string::npos);
+  CHECK(unfitted.err.find("the swing needs") != std::string::npos);
+  // Without the grid, as before: refused by the scene alone.
+  const exc::test::Run alone = sweep("");
+  CHECK(alone.status == 2);
+  CHECK(alone.err.find("sweep.perturbations.path_speed[1]: is 1.3, refused by the scene: ") != std::string::npos);
+  // A value refused for itself is named at itself, not at a draw read beside it.
+  const exc::test::Run bad_flag = sweep("  grid:\n    task.efforts.fit_timing: [maybe]\n");
+  CHECK(bad_flag.status == 2);
+  CHECK(bad_flag.err.find("sweep.grid.task.efforts.fit_timing[0]: is maybe, refused by the scene: ") != std::string::npos);
+  CHECK(bad_flag.err.find("allowed values: true, false") != std::string::npos);
+  CHECK_FALSE(fs::exists(bad_flag.dir / "x.jsonl"));
+}
+
 TEST_CASE("tools/excavator-sim sweep refuses two knobs that write one setting whole (the later would undo the earlier), and takes knobs that compose") {
   const exc::test::Run setup = run_sim("--help");
   const fs::path dir = setup.dir;
