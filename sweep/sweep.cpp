@@ -195,9 +195,9 @@ class KnobReader {
     SweepValue value;
     std::string why;  // the first scene's reason
   };
-  // Joint reads are a scene read each (about a millisecond): beyond this many a value refused alone
-  // is refused, as it was before the joint check.
-  static constexpr long kMostJointReads = 20000;
+  // A joint read is a scene read (its path's effort check included: some 10 ms): beyond this many
+  // combinations a value refused alone is refused, as it was before the joint check.
+  static constexpr long kMostJointReads = 1000;
   const SweepSpec& spec_;
   std::set<std::string> checked_;  // knob=value pairs already read by the scenes
   std::vector<Refused> refused_;
