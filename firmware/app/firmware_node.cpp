@@ -95,6 +95,7 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       lag_compensator_(config.controller.actuator_lag, config.controller.actuator_lag_target,
                        config.controller.period, control::effort_limits_of(model.machine)),
       valves_(control::valve_loop_model(model.machine), config.controller.valves, config.controller.period),
+      pacing_(model.machine, config.controller.pump_pacing_share, config.controller.period),
       plausibility_(config.controller.plausibility, config.controller.period),
       frozen_position_(config.controller.plausibility),
       pressure_monitor_(model.machine, config.controller.pressure_plausibility, config.controller.period),
@@ -283,18 +284,21 @@ bool FirmwareNode::path_stop_moving(double t) const {
 }
 
 void FirmwareNode::begin_path_stop(double t) {
-  const double tau0 = unslowed_task_time(t);
+  const bool paced = config_.controller.pump_pacing;
+  const double tau0 = paced ? pacing_.tau() : unslowed_task_time(t);
   Vec4 q, yd, ydd;
   task_.trajectory.evaluate(tau0, q, yd, ydd);
-  path_stop_.begin(tau0, yd, model_.machine.speed_max(), config_.controller.stop_ramp_time);
+  path_stop_.begin(tau0, yd, model_.machine.speed_max(), config_.controller.stop_ramp_time, paced ? pacing_.rate() : 1.0);
   path_stop_start_ = t;
 }
 
 double FirmwareNode::path_time_at(double t, double& rate, double& rate_dot) const {
   if (!path_stop_.active()) {
-    rate = 1;
-    rate_dot = 0;
-    return unslowed_task_time(t);
+    // Paced, the clock is a state stepped once a cycle (compute_command), read here at this cycle's t.
+    const bool paced = config_.controller.pump_pacing;
+    rate = paced ? pacing_.rate() : 1;
+    rate_dot = paced ? pacing_.rate_dot() : 0;
+    return paced ? pacing_.tau() : unslowed_task_time(t);
   }
   double tau = 0;
   path_stop_.path_time(t - path_stop_start_, tau, rate, rate_dot);
@@ -370,7 +374,10 @@ void FirmwareNode::end_cycle() {
       if (transition.from == control::Mode::safe_stop) port_.send_fault(false, 0);
       escalated_ = false;
     }
-    if (transition.to == control::Mode::track) track_start_ = t;
+    if (transition.to == control::Mode::track) {
+      track_start_ = t;
+      pacing_.start(task_.start_time());
+    }
     if (transition.to == control::Mode::safe_stop) {
       operator_stop_on_rest_ = false;  // whatever stopped the machine, an operator's stop under way is in it
       ++safe_stops_;
@@ -549,6 +556,11 @@ void FirmwareNode::compute_command(const control::Transition& transition) {
     if (path_stop_.active()) {
       const Vec4 yd = qd_d_, ydd = qdd_d_;  // in path time
       control::PathStop::scale(rate, rate_dot, yd, ydd, qd_d_, qdd_d_);
+    } else if (config_.controller.pump_pacing) {
+      const Vec4 yd = qd_d_, ydd = qdd_d_;
+      pacing_.update(yd);
+      control::PathStop::scale(pacing_.rate(), pacing_.rate_dot(), yd, ydd, qd_d_, qdd_d_);
+      pacing_.advance();
     }
   } else {
     q_d_ = held_q_;

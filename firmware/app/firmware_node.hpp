@@ -14,6 +14,7 @@
 #include "model/actuator_friction.hpp"
 #include "control/actuator_lag_compensator.hpp"
 #include "control/path_stop.hpp"
+#include "control/pump_pacing.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
 #include "control/frozen_position.hpp"
@@ -229,6 +230,7 @@ class FirmwareNode {
   control::CommandBlender blender_;
   control::ActuatorLagCompensator lag_compensator_;
   control::ValveInnerLoop valves_;
+  control::PumpPacing pacing_;    // the path's clock when paced to the pumps (controller.pump_pacing)
   control::VelocityPlausibility plausibility_;
   control::FrozenPosition frozen_position_;  // the reading that stops while its function is driven
   control::PressurePlausibility pressure_monitor_;

@@ -1,10 +1,13 @@
 #include "app/firmware_settings.hpp"
 
+#include "control/pump_pacing.hpp"
+
 #include <algorithm>
 #include <cmath>
 
 #include "app/firmware_node.hpp"
 #include "control/effort_feasibility.hpp"
+#include "control/pump_pacing.hpp"
 #include "model/actuator_friction.hpp"
 #include "model/model.hpp"
 #include "model/scene_common.hpp"
@@ -51,6 +54,19 @@ void check_task_efforts(FirmwareSettings& s) {
   for (control::DigWaypoint& w : task.path) w.t = t0 + (w.t - t0) * task.timing_scale;
 }
 
+// A paced path (controller.pump_pacing) takes longer than its times say: a run that covered the
+// path covers the paced one, estimated without the clock's lag, plus a tenth and the lag's settling
+// (4 T) for what the lag adds.
+void extend_for_pump_pacing(FirmwareSettings& s) {
+  if (!s.controller.pump_pacing) return;
+  const control::JointTrajectory& path = s.task.trajectory;
+  const control::PumpPacing pacing(s.machine, s.controller.pump_pacing_share, s.controller.period);
+  const double path_time = path.end_time() - path.start_time();
+  const double paced = control::paced_duration(pacing, path, s.controller.period);
+  if (s.duration >= path_time && paced > path_time)
+    s.duration += 1.1 * (paced - path_time) + 4 * control::PumpPacing::kTimeConstant;
+}
+
 }  // namespace
 
 FirmwareSettings read_firmware_settings(const settings::Document& scene, const SceneMachine& machine) {
@@ -72,6 +88,7 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene, const S
   top.finish();
   try {
     check_task_efforts(s);
+    extend_for_pump_pacing(s);
   } catch (const SettingsError& e) {
     top.rethrow_placed(e);
   }

@@ -158,6 +158,13 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
   r.number("stop_ramp_time", c.stop_ramp_time, {0, 10}, "s",
            "a stop along the path decelerates each function by at most its top speed per this time (0: at once)");
+  r.flag("pump_pacing", c.pump_pacing,
+         "valve interface: slow the path's clock while the path asks the pumps for more than pump_pacing_share of their flow");
+  r.number("pump_pacing_share", c.pump_pacing_share, {0.1, 1}, "",
+           "the share of the pumps' flow a paced path may ask (the rest is left to the feedback)");
+  if (c.pump_pacing && c.command_interface != CommandInterface::valve)
+    r.fail("pump_pacing", "is true; it paces the path to the pumps, which only the valve interface drives "
+                          "(controller.command_interface: valve)");
   r.flag("integral_action", c.integral_action, "integral action in the adaptive law (beyond the paper)");
   r.numbers("lyapunov_q_integral", c.lyapunov_q_integral, kWeight, "", "Q of the integral states");
   r.number("actuator_lag", c.actuator_lag, {0, 1}, "s", "the effort lag the firmware compensates (0: none)");

@@ -133,6 +133,12 @@ struct ControllerConfig {
   // decelerates at most its top speed per this time (path_stop.hpp): a function at top speed stops
   // in 0.63 s over its path, a slower one sooner. About the ramp an operator's joystick release gives.
   double stop_ramp_time = 0.4;
+  // Valve interface: the path's clock slowed while the path asks the pumps for more than
+  // pump_pacing_share of their flow (pump_pacing.hpp), the run lengthened by what that costs. Off by
+  // default: the path's times are then the task's, and a path the pumps cannot follow lags until the
+  // tracking limit stops it.
+  bool pump_pacing = false;
+  double pump_pacing_share = 0.9;
 
   static PidGains default_gains() {
     PidGains g;

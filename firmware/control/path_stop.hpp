@@ -21,12 +21,15 @@ namespace exc::control {
 
 class PathStop {
  public:
-  // Begins at path time tau0 where the path moves at path_velocity (joint units per second).
-  void begin(double tau0, const Vec4& path_velocity, const Vec4& speed_max, double ramp_time) {
+  // Begins at path time tau0 where the path moves at path_velocity (joint units per second of path
+  // time) and its clock at `rate` (below 1 where it was paced, pump_pacing.hpp): the rate falls from
+  // there, rate (1 + cos(pi s / T)) / 2, T from the machine's speed rate x path_velocity.
+  void begin(double tau0, const Vec4& path_velocity, const Vec4& speed_max, double ramp_time, double rate = 1) {
     double worst = 0;
     for (int j = 0; j < 4; ++j)
-      if (speed_max[j] > 0) worst = std::max(worst, std::abs(path_velocity[j]) / speed_max[j]);
+      if (speed_max[j] > 0) worst = std::max(worst, rate * std::abs(path_velocity[j]) / speed_max[j]);
     tau0_ = tau0;
+    rate0_ = rate;
     duration_ = 0.5 * kPi * ramp_time * worst;
     active_ = true;
   }
@@ -35,7 +38,7 @@ class PathStop {
   double duration() const { return duration_; }            // T, s
   // The longest T: the path's fastest function at its top speed (a task faster is refused at load).
   static double longest(double ramp_time) { return 0.5 * kPi * ramp_time; }
-  double path_time_at_rest() const { return tau0_ + 0.5 * duration_; }
+  double path_time_at_rest() const { return tau0_ + 0.5 * rate0_ * duration_; }
   bool done(double s) const { return s >= duration_; }
 
   // Path time s after the stop began, and its rate and the rate's derivative.
@@ -46,9 +49,9 @@ class PathStop {
       return;
     }
     const double w = kPi / duration_;
-    tau = tau0_ + 0.5 * s + std::sin(w * s) / (2 * w);
-    rate = 0.5 * (1 + std::cos(w * s));
-    rate_dot = -0.5 * w * std::sin(w * s);
+    tau = tau0_ + rate0_ * (0.5 * s + std::sin(w * s) / (2 * w));
+    rate = 0.5 * rate0_ * (1 + std::cos(w * s));
+    rate_dot = -0.5 * rate0_ * w * std::sin(w * s);
   }
 
   // The path's point and derivatives (in path time) made the desired motion of the slowed clock.
@@ -59,7 +62,7 @@ class PathStop {
 
  private:
   static constexpr double kPi = 3.14159265358979323846;
-  double tau0_ = 0, duration_ = 0;
+  double tau0_ = 0, rate0_ = 1, duration_ = 0;
   bool active_ = false;
 };
 

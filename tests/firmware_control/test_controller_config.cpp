@@ -120,4 +120,9 @@ TEST_CASE("firmware/controller config errors name the field, its line and column
   check_error("controller: {regressor_acceleration: measured}", "controller.regressor_acceleration", "measured",
               "is 'measured'; allowed values: filtered, desired");
   check_error("controller: [1, 2]", "controller", "[1, 2]", "must be a mapping");
+  // Pacing the path to the pumps needs the pumps' commands: the valve interface.
+  check_error("controller: {pump_pacing: true}", "controller.pump_pacing", "true",
+              "is true; it paces the path to the pumps, which only the valve interface drives");
+  check_error("controller: {command_interface: valve, pump_pacing: true, pump_pacing_share: 1.5}", "controller.pump_pacing_share",
+              "1.5", "is 1.5; allowed range [0.1, 1]");
 }

@@ -43,15 +43,18 @@ struct Scenario {
 // Both sides of a hydraulic scene read from its text by the real readers.
 Scenario scenario(const std::string& yaml) {
   const settings::Document doc = settings::Document::parse(yaml, "<test>", EXC_SOURCE_DIR "/scenes");
-  return {read_scene(doc), app::read_firmware_settings(doc)};
+  Scenario s{read_scene(doc), app::read_firmware_settings(doc)};
+  s.scene.duration = s.firmware.duration;  // as scene_source.cpp: the firmware may lengthen the run (a paced path)
+  return s;
 }
 
-// A move from q0 to q1 in `seconds` (then held for a second), the machine in the air.
-Scenario move(const std::string& q0, const std::string& q1, double seconds) {
+// A move from q0 to q1 in `seconds` (then held for a second), the machine in the air; `controller`:
+// more keys of the controller section.
+Scenario move(const std::string& q0, const std::string& q1, double seconds, const std::string& controller = "") {
   const std::string t = std::to_string(seconds), end = std::to_string(seconds + 1);
   return scenario("name: move\nterrain: {height: -3.0}\nsoil: {preset: none}\ninitial_state: {q_a: " + q0 +
                   "}\nactuators: {fidelity: hydraulic}\nduration: " + end +
-                  "\ncontroller: {command_interface: valve}\n"
+                  "\ncontroller: {command_interface: valve" + (controller.empty() ? "" : ", " + controller) + "}\n"
                   "task:\n  type: joint_waypoints\n  waypoints:\n    - {t: 0, q: " + q0 + "}\n    - {t: " + t +
                   ", q: " + q1 + "}\n    - {t: " + end + ", q: " + q1 + "}\n");
 }
@@ -171,6 +174,41 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   MESSAGE("default limit: " << stopped.failure);
   CHECK(stopped.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
   CHECK(stopped.failure.find("the pumps short of flow since t = ") != std::string::npos);
+}
+
+TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its end under every law on the default tracking limit, the pumps never short, later by less than the run's added time") {
+  // The path above asks the pumps for 1.8x their flow at its peak; controller.pump_pacing slows its
+  // clock so that its own oil stays within 0.9 of theirs (control/pump_pacing.hpp). The reader
+  // lengthens the run by the load's estimate of what that costs.
+  const std::string q0 = "[0.0, 2.10, 3.00, 2.30]", q1 = "[0.0, 2.50, 2.40, 1.90]";
+  const Scenario plain = move(q0, q1, 2.0);
+  const double track_delay = app::FirmwareNodeConfig{}.track_delay, path_end = 3.0;
+  for (const std::string law : {"pid", "adaptive", "flow"}) {
+    CAPTURE(law);
+    const Scenario s = move(q0, q1, 2.0, "pump_pacing: true");
+    const double added = s.firmware.duration - plain.firmware.duration;
+    sim::LockstepOptions o;
+    o.controller = law;
+    const sim::RunRecord r = sim::run_lockstep(s.scene, s.firmware, o);
+    REQUIRE_MESSAGE(r.ok, r.failure);
+    const double late = r.task_finish_time - (track_delay + path_end);
+    MESSAGE(law << ": finished " << late << " s after the path's own end (the run given " << added
+                << " s more); worst error boom, arm, bucket " << r.max_error[1] << ", " << r.max_error[2] << ", "
+                << r.max_error[3] << " m; pumps short " << r.flow_saturated_seconds << " s, firmware asked more in "
+                << r.pump_limited_cycles << " cycles");
+    CHECK(r.safe_stops == 0);
+    CHECK(r.task_finished);
+    CHECK(late > 0.3);  // paced: about 1.8 / 0.9 - 1 of the peak's path time later
+    CHECK(late < added);
+    const Vec4 limit = s.firmware.controller.tracking_error_limit;
+    for (int j = 1; j < 4; ++j) CHECK(r.max_error[j] < 0.25 * limit[j]);
+    CHECK(r.flow_saturated_seconds <= 0.02);  // unpaced: over 1 s
+    CHECK(r.pump_limited_cycles <= 20);
+  }
+  // Unpaced, the same path on the same limit stops on its lag (the test above).
+  const sim::RunRecord unpaced = sim::run_lockstep(plain.scene, plain.firmware, {});
+  CHECK(unpaced.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+  CHECK(unpaced.flow_saturated_seconds > 0.3);
 }
 
 TEST_CASE("plant/hydraulics: a full-speed boom-down cavitates exactly where it falls faster than the pump and the make-up valves fill its rod side, at v_max + Q_makeup(p_tank) / A_B") {
