@@ -63,8 +63,10 @@ void extend_for_pump_pacing(FirmwareSettings& s) {
   const control::PumpPacing pacing(s.machine, s.controller.pump_pacing_share, s.controller.period);
   const double path_time = path.end_time() - path.start_time();
   const double paced = control::paced_duration(pacing, path, s.controller.period);
-  if (s.duration >= path_time && paced > path_time)
-    s.duration += 1.1 * (paced - path_time) + 4 * control::PumpPacing::kTimeConstant;
+  // Stepped in whole periods, an unpaced path comes out up to a period longer: no time added for it.
+  const double period = s.controller.period;
+  if (s.duration >= path_time && paced > path_time + 2 * period)  // whole cycles added
+    s.duration += period * std::ceil((1.1 * (paced - path_time) + 4 * control::PumpPacing::kTimeConstant) / period);
 }
 
 }  // namespace

@@ -205,6 +205,8 @@ TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its en
     CHECK(r.flow_saturated_seconds <= 0.02);  // unpaced: over 1 s
     CHECK(r.pump_limited_cycles <= 20);
   }
+  // A path within the pumps is not paced, and its run keeps its length.
+  CHECK(move(q0, q1, 10.0, "pump_pacing: true").firmware.duration == move(q0, q1, 10.0).firmware.duration);
   // Unpaced, the same path on the same limit stops on its lag (the test above).
   const sim::RunRecord unpaced = sim::run_lockstep(plain.scene, plain.firmware, {});
   CHECK(unpaced.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
