@@ -321,12 +321,14 @@ TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over
   }
 }
 
-TEST_CASE("firmware/node: zero heap allocations through a stop along the path (request, deceleration, hold) in the dig task") {
+TEST_CASE("firmware/node: zero heap allocations through a stop along the path (request, deceleration, hold) in the dig task, its clock paced to the pumps or not") {
   REQUIRE(exc::app::allocation_counting_works());
   const Model model = build_model(reference_machine());
+  for (const bool paced : {false, true})
   for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
     app::FirmwareNodeConfig cfg;
     cfg.controller.law = kind;
+    cfg.controller.pump_pacing = paced;  // control/pump_pacing.hpp: the clock a state stepped each cycle
     Loop loop(model, sim::kDigTask, cfg);
     loop.cycle();  // start-up cycle outside the count (first touch)
     std::size_t allocations = 0;
@@ -341,7 +343,7 @@ TEST_CASE("firmware/node: zero heap allocations through a stop along the path (r
       }
       allocations = counter.count();
     }
-    INFO(kind);
+    INFO(kind << (paced ? ", paced" : ""));
     CHECK(allocations == 0);
     CHECK(slowing > 0);  // the path was slowed, not cut
     CHECK(loop.node.mode() == Mode::hold);

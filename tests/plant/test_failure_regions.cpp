@@ -204,6 +204,7 @@ TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its en
     for (int j = 1; j < 4; ++j) CHECK(r.max_error[j] < 0.25 * limit[j]);
     CHECK(r.flow_saturated_seconds <= 0.02);  // unpaced: over 1 s
     CHECK(r.pump_limited_cycles <= 20);
+    CHECK(r.heap_allocations_in_loop == 0);
   }
   // A path within the pumps is not paced, and its run keeps its length.
   CHECK(move(q0, q1, 10.0, "pump_pacing: true").firmware.duration == move(q0, q1, 10.0).firmware.duration);
