@@ -16,6 +16,10 @@
 #   link           (not in all) the operator link: excavator-operator keep-alive runs beside the
 #                  firmware, then ends (SIGTERM); the firmware's controlled stop (FaultCode 15,
 #                  operator link lost) holds until an acknowledge frame. --ack-check judges it.
+#   paced          (not in all) both programs on their default durations (no --duration) with a scene
+#                  whose firmware stretches its task past the scene's duration (--scene
+#                  scenes/fast_reach.yaml: controller.pump_pacing): the plant answers every SYNC on
+#                  past its scene's end, both exit 0, the firmware's task finished with no safe stop.
 # Nothing waits on wall-clock speed: every wait ends on an event (a receiver registered on vcan0,
 # frames in the capture, a process exit); the time limits only catch hangs.
 #
@@ -38,7 +42,7 @@ usage() {
   cat <<'EOF'
 Usage: two_process.sh --vcan-vm PATH --plant PATH --firmware PATH --sim PATH --capture-check PATH
                       --scene FILE --work DIR [--duration S] [--watchdog-cycles N]
-                      [--scenario all|run|kill-plant|kill-firmware|realtime|no-plant|ack|link[,...]] [--timeout S]
+                      [--scenario all|run|kill-plant|kill-firmware|realtime|no-plant|ack|link|paced[,...]] [--timeout S]
                       [--decode-check COMMAND] [--bus-load-check COMMAND] [--rt-vm PRIORITY]
                       [--operator PATH] [--ack-check COMMAND]
 Runs the two-process scenarios (see the head of this file) inside vcan-vm, in one VM.
@@ -66,6 +70,8 @@ Runs the two-process scenarios (see the head of this file) inside vcan-vm, in on
                       the missed deadlines named); the real programs only
   no-plant            (not in all) the firmware with no plant: exit 1, ok false, "never tracked",
                       tracking figures null; the real programs only
+  paced               (not in all) both on their default durations, the firmware's paced task longer
+                      than the scene's duration: the plant follows it (--scene a paced scene)
 Exit status: 0 when every scenario passed; 1 when one failed (the reasons are printed); 2 for bad
 arguments; otherwise vcan-vm's (124 timeout, 125 VM failure).
 EOF
@@ -106,7 +112,7 @@ done
 [[ $duration =~ ^[0-9]+([.][0-9]+)?$ ]] || { echo "two_process.sh: --duration '$duration': must be positive seconds" >&2; exit 2; }
 [[ $watchdog_cycles =~ ^[0-9]+$ ]] || { echo "two_process.sh: --watchdog-cycles '$watchdog_cycles': must be a whole number" >&2; exit 2; }
 for one in ${scenario//,/ }; do
-  case $one in all|run|kill-plant|kill-firmware|realtime|no-plant|ack|link) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware, realtime, no-plant, ack or link (or a comma-separated list)" >&2; exit 2 ;; esac
+  case $one in all|run|kill-plant|kill-firmware|realtime|no-plant|ack|link|paced) ;; *) echo "two_process.sh: --scenario '$scenario': must be all, run, kill-plant, kill-firmware, realtime, no-plant, ack, link or paced (or a comma-separated list)" >&2; exit 2 ;; esac
   if [ "$one" = ack ] || [ "$one" = link ]; then
     [ -n "$operator" ] && [ -x "$operator" ] || { echo "two_process.sh: --operator '$operator': the $one scenario needs excavator-operator" >&2; exit 2; }
   fi
@@ -502,6 +508,34 @@ scenario_link() {
     note "the firmware's output does not name the lost link (the capture's FaultCode is judged on the host)"
 }
 
+scenario_paced() {
+  current=paced
+  local dir=$work/paced scene_cycles ran steps fw_rc plant_rc
+  rm -rf "$dir"; mkdir -p "$dir"
+  # The argument templates without their --duration: each program takes its own default.
+  local plant_template=${PLANT_ARGS/--duration @DURATION@/} firmware_template=${FIRMWARE_ARGS/--duration @DURATION@/}
+  PLANT_ARGS=$plant_template start_capture_and_plant "$dir" 0 || return
+  # shellcheck disable=SC2046
+  "$firmware" $(expand "$firmware_template" 0 "$dir/two_process.json" "$dir") > "$dir/firmware.out" 2>&1
+  fw_rc=$?
+  wait "$plant_pid"; plant_rc=$?
+  stop_capture "$dir"
+  [ $fw_rc -eq 0 ] || fail "the firmware exited with $fw_rc: $(tail -3 "$dir/firmware.out")"
+  [ $plant_rc -eq 0 ] || fail "the plant exited with $plant_rc: $(tail -3 "$dir/plant.out")"
+  scene_cycles=$(sed -n 's/.* on vcan0, \([0-9]*\) cycles or as many as the firmware runs.*/\1/p' "$dir/plant.out")
+  ran=$(json_field "$dir/two_process.json" 'j["cycles"]')
+  steps=$(sed -n 's/^excavator-plant: \([0-9]*\) steps.*/\1/p' "$dir/plant.out")
+  [ -n "$scene_cycles" ] || fail "the plant does not say it follows the firmware: $(head -1 "$dir/plant.out")"
+  if [ -n "$ran" ] && [ -n "$scene_cycles" ] && [ "$ran" -gt "$scene_cycles" ]; then
+    note "the firmware ran $ran cycles, past the scene's $scene_cycles"
+  else fail "the firmware ran ${ran:-?} cycles, not past the scene's ${scene_cycles:-?}: is the scene paced?"; fi
+  if [ "${steps:-x}" = "${ran:-y}" ]; then note "the plant answered all $steps"
+  else fail "the plant stepped ${steps:-?} times for ${ran:-?} firmware cycles"; fi
+  [ "$(json_field "$dir/two_process.json" 'j["ok"]')" = True ] || fail "the firmware's run is not ok: $(tail -2 "$dir/firmware.out")"
+  [ "$(json_field "$dir/two_process.json" 'j["task_finished"]')" = True ] || fail "the firmware's task did not finish"
+  grep -q 'no SYNC for .*: hold' "$dir/plant.out" && fail "the plant held: $(grep -m1 'no SYNC for' "$dir/plant.out")"
+}
+
 current=setup
 # The programs may write defaults (telemetry logs, out/) relative to the working directory: the
 # work directory is the one place the VM can write that the host sees.
@@ -517,6 +551,7 @@ for one in ${scenario//,/ }; do
     no-plant) scenario_no_plant ;;
     ack) scenario_ack ;;
     link) scenario_link ;;
+    paced) scenario_paced ;;
   esac
 done
 if [ $failures -eq 0 ]; then echo "two_process.sh: all scenarios passed ($scenario)"; exit 0; fi

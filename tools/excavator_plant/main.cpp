@@ -41,7 +41,9 @@ int main(int argc, char** argv) {
   double stuck_opening = 0, stuck_from = 0, stuck_until = 1e9;
   app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
   app.add_option("--scene", scene_path, "scene file")->required();
-  app.add_option("--duration", duration, "exit after this many simulated seconds (default: the scene's)")
+  app.add_option("--duration", duration,
+                 "exit after this many simulated seconds (default: the scene's, or while SYNC comes on after it: "
+                 "a firmware whose task is stretched, by task.efforts.fit_timing or controller.pump_pacing, runs longer)")
       ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   app.add_option("--lcm", lcm_url, "publish the machine state (EXC_STATE) to this LCM URL");
   app.add_option("--silence-ms", silence_ms, "hold after this long without SYNC (wall clock)")
@@ -89,15 +91,19 @@ int main(int argc, char** argv) {
 
     const double total = duration > 0 ? duration : plant.scene().duration;
     const auto cycles = static_cast<std::uint64_t>(std::llround(total / plant.scene().cycle));
+    // Without --duration the firmware decides the run's length: it may have stretched the task past
+    // the scene's duration (fit_timing, pump_pacing), which this side does not read. Past the scene's
+    // cycles the plant answers every SYNC that still comes and ends once none came for --silence-ms.
+    const bool follow_firmware = duration <= 0;
     // Wake every 10 ms to watch for silence: while holding, PLANT_EMERGENCY repeats at that period
     // (IfActive in the DBC).
     const std::int64_t slice_ns = exc::hal::kEmergencyRepeatCycles * exc::hal::kCyclePeriodNs;
     double silent_ms = 0;
     bool announced = false;
-    std::printf("excavator-plant: %s on %s, %llu cycles, waiting for SYNC\n", plant.scene().name.c_str(),
-                iface.c_str(), static_cast<unsigned long long>(cycles));
+    std::printf("excavator-plant: %s on %s, %llu cycles%s, waiting for SYNC\n", plant.scene().name.c_str(),
+                iface.c_str(), static_cast<unsigned long long>(cycles), follow_firmware ? " or as many as the firmware runs" : "");
     std::fflush(stdout);
-    while (!g_stop && node.steps() < cycles) {
+    while (!g_stop && (node.steps() < cycles || follow_firmware)) {
       const double t = static_cast<double>(node.steps()) * plant.scene().cycle;
       if (stuck.kind != exc::app::InjectedFault::Kind::none && (t >= stuck_from && t < stuck_until) != stuck_now) {
         stuck_now = !stuck_now;
@@ -119,6 +125,8 @@ int main(int argc, char** argv) {
         continue;
       }
       silent_ms += slice_ns * 1e-6;
+      // Following the firmware past the scene's end: silent as long as would make it hold, its run is over.
+      if (node.steps() >= cycles && silent_ms >= silence_ms) break;
       if (node.steps() == 0 && silent_ms > startup_s * 1e3) {
         std::fprintf(stderr, "excavator-plant: no SYNC on %s within %.0f s; is excavator-firmware running?\n",
                      iface.c_str(), startup_s);
