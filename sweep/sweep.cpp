@@ -336,6 +336,8 @@ SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
   s.choices("controllers", spec.controllers, control::controller_registry(), 1, "the controllers each case runs");
   s.whole("cases", spec.cases, 1, 1e6, "", "seeded random draws per grid point and variant, case i from (seed, i)");
   s.whole("seed", spec.seed, 0, 4e9, "", "the draws' seed");
+  s.flag("paired_draws", spec.paired_draws,
+         "every grid point and variant of a scene runs the same draws (and faults), to compare them pair by pair");
   if (s.given("duration")) s.number("duration", spec.duration, {1e-3, 3600}, "s", "per run (absent: the scene's)");
   s.flag("stop_at_safe_state", spec.stop_at_safe_state, "end each run at the firmware's first safe stop");
   SectionReader w = s.section("window", "open loop: the task's window the effort profile covers");
@@ -414,14 +416,17 @@ SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
 }
 
 SweepCase sweep_case(const SweepSpec& spec, int id) {
-  // One generator per case, seeded from (seed, id): independent of which shard runs the case.
-  std::seed_seq seq{spec.seed, static_cast<unsigned>(id), 0x5eedu};
-  std::mt19937_64 rng(seq);
-  SweepCase c;
-  c.id = id;
   // id = ((scene * variants + variant) * points + point) * cases + draw.
   int rest = id / spec.cases;
   const int points = spec.grid_points(), variants = std::max<int>(1, static_cast<int>(spec.variants.size()));
+  // One generator per case, seeded from (seed, id): independent of which shard runs the case. Paired,
+  // from (seed, scene, draw): the same for every grid point and variant of the scene.
+  const int draw = id % spec.cases, scene = rest / points / variants;
+  std::seed_seq unpaired{spec.seed, static_cast<unsigned>(id), 0x5eedu};
+  std::seed_seq paired{spec.seed, static_cast<unsigned>(scene), static_cast<unsigned>(draw), 0xda12u};
+  std::mt19937_64 rng(spec.paired_draws ? paired : unpaired);
+  SweepCase c;
+  c.id = id;
   int point = rest % points;
   rest /= points;
   c.variant = spec.variants.empty() ? -1 : rest % variants;

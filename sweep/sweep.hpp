@@ -79,6 +79,9 @@ struct SweepSpec {
   std::vector<std::string> controllers{"pid", "adaptive"};
   int cases = 1;  // random draws per grid point and variant
   unsigned seed = 1;
+  // true: every grid point and variant of a scene runs the same draws (case i's from (seed, scene,
+  // i mod cases)), so they compare pair by pair; false: each case its own (from (seed, i)).
+  bool paired_draws = false;
   double duration = 0;
   bool stop_at_safe_state = false;  // end a run at the firmware's first safe stop (maps)
   double window_start = 0, window_horizon = 1;  // open loop: s of the task, s simulated

@@ -3,6 +3,10 @@
 // refused when the spec loads, and each file is loaded once per process.
 #include <doctest/doctest.h>
 
+#include <sstream>
+
+#include <map>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -339,6 +343,43 @@ TEST_CASE("tools/excavator-sim sweep reads a value the scene refuses alone with 
   CHECK(bad_flag.err.find("sweep.grid.task.efforts.fit_timing[0]: is maybe, refused by the scene: ") != std::string::npos);
   CHECK(bad_flag.err.find("allowed values: true, false") != std::string::npos);
   CHECK_FALSE(fs::exists(bad_flag.dir / "x.jsonl"));
+}
+
+TEST_CASE("tools/excavator-sim sweep with paired_draws runs every grid point of a scene on the same draws and faults, and without it each case draws its own") {
+  const exc::test::Run setup = run_sim("--help");
+  const fs::path dir = setup.dir;
+  const auto lines_of = [&](bool paired) {
+    std::ofstream(dir / "spec.yaml") << "sweep:\n  scene: " + kDig + "\n  controllers: [pid]\n  duration: 0.05\n  cases: 3\n"
+                                        "  paired_draws: " + std::string(paired ? "true" : "false") + "\n"
+                                        "  perturbations: {position_noise: [0, 1.0e-4], model_mass: [-0.2, 0.2]}\n"
+                                        "  faults: [sensor_jump, rock]\n"
+                                        "  grid: {sensors.latency_cycles: [0, 1]}\n";
+    const exc::test::Run r = run_sim("sweep " + (dir / "spec.yaml").string() + " --quiet --out x.jsonl");
+    REQUIRE_MESSAGE(r.status == 0, r.err);
+    std::map<int, nlohmann::json> by_case;
+    std::istringstream in(read_text_file(r.dir / "x.jsonl"));
+    for (std::string line; std::getline(in, line);) {
+      const nlohmann::json j = nlohmann::json::parse(line);
+      by_case[j["case"].get<int>()] = j;
+    }
+    REQUIRE(by_case.size() == 6);  // 2 grid points x 3 draws
+    return by_case;
+  };
+  const auto paired = lines_of(true), unpaired = lines_of(false);
+  for (int d = 0; d < 3; ++d) {
+    CAPTURE(d);
+    // Case d runs latency 0, case 3 + d latency 1.
+    CHECK(paired.at(d)["set"]["sensors.latency_cycles"] == 0);
+    CHECK(paired.at(3 + d)["set"]["sensors.latency_cycles"] == 1);
+    for (const char* knob : {"position_noise", "model_mass"}) {
+      CHECK(paired.at(d)[knob] == paired.at(3 + d)[knob]);
+      CHECK(unpaired.at(d)[knob] != unpaired.at(3 + d)[knob]);
+    }
+    CHECK(paired.at(d)["fault"] == paired.at(3 + d)["fault"]);
+    CHECK(unpaired.at(d)["fault"] != unpaired.at(3 + d)["fault"]);
+  }
+  // Different draws of one grid point still differ.
+  CHECK(paired.at(0)["model_mass"] != paired.at(1)["model_mass"]);
 }
 
 TEST_CASE("tools/excavator-sim sweep refuses two knobs that write one setting whole (the later would undo the earlier), and takes knobs that compose") {
