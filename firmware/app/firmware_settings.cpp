@@ -46,7 +46,8 @@ void check_task_efforts(FirmwareSettings& s) {
   // track delay); a run asked to cover only part of the path keeps its duration.
   const double path_time = task.end_time() - task.start_time();
   const double after = std::max(s.duration - path_time, FirmwareNodeConfig{}.track_delay + s.controller.period);
-  if (s.duration >= path_time) s.duration = path_time * task.timing_scale + after;
+  if (s.duration >= path_time)  // in whole cycles, as the run steps
+    s.duration = s.controller.period * std::ceil((path_time * task.timing_scale + after) / s.controller.period - 1e-9);
   task.trajectory = control::scale_timing(task.trajectory, task.timing_scale);
   const double t0 = task.waypoint_times.front();
   for (double& t : task.waypoint_times) t = t0 + (t - t0) * task.timing_scale;

@@ -1,5 +1,7 @@
 // The firmware's own loader of a scene file: its sections read, the plant's left alone, typos refused.
 #include <doctest/doctest.h>
+
+#include <cmath>
 #include <yaml-cpp/yaml.h>
 
 #include <string>
@@ -182,10 +184,14 @@ TEST_CASE("firmware/settings fit a task's timing when asked, say by how much and
   CHECK(control::check_effort_feasibility(model, fit.task.trajectory).ok);
   // The 3 s run covered the 2.5 s path: it covers the stretched path and the 0.5 s after it.
   CHECK(fit.scene_duration == 3);
-  CHECK(fit.duration == doctest::Approx(2.5 * fit.task.timing_scale + 0.5));
+  // In whole cycles, rounded up: the run steps by them.
+  const auto whole_cycles = [](double seconds) { return 1e-3 * std::ceil(seconds / 1e-3 - 1e-9); };
+  CHECK(fit.duration == doctest::Approx(whole_cycles(2.5 * fit.task.timing_scale + 0.5)).epsilon(1e-12));
+  CHECK(std::abs(fit.duration / 1e-3 - std::round(fit.duration / 1e-3)) < 1e-9);
   // Covered to its last cycle, it still runs until the task has finished (tracking from 50 ms on).
   const app::FirmwareSettings exact = read(fast_swing_scene("  efforts: {fit_timing: true}\n", "2.5"));
-  CHECK(exact.duration == doctest::Approx(2.5 * exact.task.timing_scale + app::FirmwareNodeConfig{}.track_delay + 1e-3));
+  CHECK(exact.duration ==
+        doctest::Approx(whole_cycles(2.5 * exact.task.timing_scale + app::FirmwareNodeConfig{}.track_delay + 1e-3)).epsilon(1e-12));
   // A run asked for part of the path keeps its duration.
   CHECK(read(fast_swing_scene("  efforts: {fit_timing: true}\n", "2")).duration == 2);
 
