@@ -140,9 +140,6 @@ class KnobReader {
         const SweepCase c = sweep_case(one, static_cast<int>(i));
         const auto own = std::find_if(c.set.begin(), c.set.end(), [&](const SweepSetting& s) { return s.first == x.key; });
         if (own != c.set.end() && own->second.text() != x.value.text()) continue;  // a case without this value
-        std::string with;
-        for (const SweepSetting& s : c.set)
-          if (s.first != x.key) with += (with.empty() ? " with " : ", ") + s.first + " = " + s.second.text();
         try {
           SceneChanges changes(*spec_.sources[static_cast<std::size_t>(c.scene)]);
           if (own == c.set.end() && !searched) set_knob(spec_.run, x.key, x.value, changes);
@@ -150,6 +147,9 @@ class KnobReader {
           if (searched) set_knob(spec_.run, x.key, x.value, changes);
           (void)changes.read();
         } catch (const std::exception& e) {
+          std::string with;
+          for (const SweepSetting& s : c.set)
+            if (s.first != x.key) with += (with.empty() ? " with " : ", ") + s.first + " = " + s.second.text();
           fail_at(x.reader, x.key, x.index, "is " + x.value.text() + ", refused by the scene" + with + ": " + e.what());
         }
       }
@@ -417,20 +417,19 @@ SweepSpec load_sweep_spec(const std::string& path, const SceneChoice& scenes) {
 
 SweepCase sweep_case(const SweepSpec& spec, int id) {
   // id = ((scene * variants + variant) * points + point) * cases + draw.
-  int rest = id / spec.cases;
-  const int points = spec.grid_points(), variants = std::max<int>(1, static_cast<int>(spec.variants.size()));
-  // One generator per case, seeded from (seed, id): independent of which shard runs the case. Paired,
-  // from (seed, scene, draw): the same for every grid point and variant of the scene.
-  const int draw = id % spec.cases, scene = rest / points / variants;
-  std::seed_seq unpaired{spec.seed, static_cast<unsigned>(id), 0x5eedu};
-  std::seed_seq paired{spec.seed, static_cast<unsigned>(scene), static_cast<unsigned>(draw), 0xda12u};
-  std::mt19937_64 rng(spec.paired_draws ? paired : unpaired);
   SweepCase c;
   c.id = id;
+  int rest = id / spec.cases;
+  const int points = spec.grid_points(), variants = std::max<int>(1, static_cast<int>(spec.variants.size()));
   int point = rest % points;
   rest /= points;
   c.variant = spec.variants.empty() ? -1 : rest % variants;
   c.scene = rest / variants;
+  // One generator per case, seeded from (seed, id): independent of which shard runs the case. Paired,
+  // from (seed, scene, draw): the same for every grid point and variant of the scene.
+  std::seed_seq unpaired{spec.seed, static_cast<unsigned>(id), 0x5eedu};
+  std::seed_seq paired{spec.seed, static_cast<unsigned>(c.scene), static_cast<unsigned>(id % spec.cases), 0xda12u};
+  std::mt19937_64 rng(spec.paired_draws ? paired : unpaired);
   for (std::size_t g = 0; g < spec.grids.size(); ++g) {
     const int size = grid_size(spec.grids[g]);
     if (point >= size) {

@@ -1,7 +1,5 @@
 #include "app/firmware_settings.hpp"
 
-#include "control/pump_pacing.hpp"
-
 #include <algorithm>
 #include <cmath>
 
@@ -14,6 +12,10 @@
 
 namespace exc::app {
 namespace {
+
+// Seconds rounded up to whole control cycles (the run steps by them; a rounding error below 1e-9 of
+// a cycle adds none).
+double whole_cycles_up(double seconds, double period) { return period * std::ceil(seconds / period - 1e-9); }
 
 // The task against the actuators' limits before the run: refused with the place, the joint and the
 // effort, or (task.efforts.fit_timing) slowed down until it fits, 2 % beyond the exact fit, and the
@@ -46,8 +48,7 @@ void check_task_efforts(FirmwareSettings& s) {
   // track delay); a run asked to cover only part of the path keeps its duration.
   const double path_time = task.end_time() - task.start_time();
   const double after = std::max(s.duration - path_time, FirmwareNodeConfig{}.track_delay + s.controller.period);
-  if (s.duration >= path_time)  // in whole cycles, as the run steps
-    s.duration = s.controller.period * std::ceil((path_time * task.timing_scale + after) / s.controller.period - 1e-9);
+  if (s.duration >= path_time) s.duration = whole_cycles_up(path_time * task.timing_scale + after, s.controller.period);
   task.trajectory = control::scale_timing(task.trajectory, task.timing_scale);
   const double t0 = task.waypoint_times.front();
   for (double& t : task.waypoint_times) t = t0 + (t - t0) * task.timing_scale;
@@ -60,14 +61,14 @@ void check_task_efforts(FirmwareSettings& s) {
 // (4 T) for what the lag adds.
 void extend_for_pump_pacing(FirmwareSettings& s) {
   if (!s.controller.pump_pacing) return;
-  const control::JointTrajectory& path = s.task.trajectory;
-  const control::PumpPacing pacing(s.machine, s.controller.pump_pacing_share, s.controller.period);
-  const double path_time = path.end_time() - path.start_time();
-  const double paced = control::paced_duration(pacing, path, s.controller.period);
-  // Stepped in whole periods, an unpaced path comes out up to a period longer: no time added for it.
   const double period = s.controller.period;
-  if (s.duration >= path_time && paced > path_time + 2 * period)  // whole cycles added
-    s.duration += period * std::ceil((1.1 * (paced - path_time) + 4 * control::PumpPacing::kTimeConstant) / period);
+  const control::JointTrajectory& path = s.task.trajectory;
+  const control::PumpPacing pacing(s.machine, s.controller.pump_pacing_share, period);
+  const double path_time = path.end_time() - path.start_time();
+  const double paced = control::paced_duration(pacing, path, period);
+  // Stepped in whole periods, an unpaced path comes out up to a period longer: no time added for it.
+  if (s.duration >= path_time && paced > path_time + 2 * period)
+    s.duration += whole_cycles_up(1.1 * (paced - path_time) + 4 * control::PumpPacing::kTimeConstant, period);
 }
 
 }  // namespace
