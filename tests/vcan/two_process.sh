@@ -514,7 +514,9 @@ scenario_paced() {
   rm -rf "$dir"; mkdir -p "$dir"
   # The argument templates without their --duration: each program takes its own default.
   local plant_template=${PLANT_ARGS/--duration @DURATION@/} firmware_template=${FIRMWARE_ARGS/--duration @DURATION@/}
-  PLANT_ARGS=$plant_template start_capture_and_plant "$dir" 0 || return
+  # --silence-ms 5000: past the scene's end the plant ends on silence; a guest that stalls for the
+  # default 0.5 s must not end it early (it only holds before the end).
+  PLANT_ARGS=$plant_template start_capture_and_plant "$dir" 0 "--silence-ms 5000" || return
   # shellcheck disable=SC2046
   "$firmware" $(expand "$firmware_template" 0 "$dir/two_process.json" "$dir") > "$dir/firmware.out" 2>&1
   fw_rc=$?
