@@ -31,8 +31,9 @@ using exc::telemetry::TelemetryPublisher;
 
 namespace {
 
-// A made-up run: sinusoidal references, an error that is larger for "pid", a saw-tooth soil force.
-void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale) {
+// A made-up run: sinusoidal references, an error that is larger for "pid", a saw-tooth soil force
+// (with_soil) and estimates converging on the truth (with_soil; the PID baseline publishes zeros).
+void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale, bool with_soil = true) {
   const double pi = std::acos(-1.0);
   for (std::int64_t k = 0; k < 2000; ++k) {
     const double t = k * 1e-3;
@@ -44,11 +45,13 @@ void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale) {
       ctrl.error[j] = error_scale * 0.01 * std::sin(2 * pi * 2 * t + j);
       state.q_active[j] = ctrl.q_desired[j] + ctrl.error[j];
     }
-    state.soil_force[0] = 4e4 * std::fmod(t, 0.25) / 0.25;
-    state.soil_force[1] = -2e4 * std::fmod(t, 0.25) / 0.25;
+    if (with_soil) {
+      state.soil_force[0] = 4e4 * std::fmod(t, 0.25) / 0.25;
+      state.soil_force[1] = -2e4 * std::fmod(t, 0.25) / 0.25;
+    }
     for (int i = 0; i < 6; ++i) {
-      ctrl.theta_true[i] = 1000.0 * (i + 1);
-      ctrl.theta_hat[i] = ctrl.theta_true[i] * (1 - std::exp(-t));
+      ctrl.theta_true[i] = with_soil ? 1000.0 * (i + 1) : std::nan("");
+      ctrl.theta_hat[i] = with_soil ? ctrl.theta_true[i] * (1 - std::exp(-t)) : 0.0;
     }
     publisher.publish(Channel::state, state);
     publisher.publish(Channel::controller, ctrl);
@@ -147,6 +150,40 @@ TEST_CASE("tools/plot-run draws every figure and the report from a small recorde
     CHECK(width == 1200);
     CHECK(height == 700);
     CHECK(report.str().find(std::string("(") + name + ")") != std::string::npos);
+  }
+  if (std::getenv("EXC_KEEP_PLOTS") == nullptr) fs::remove_all(dir);
+}
+
+TEST_CASE("tools/plot-run draws a run with empty panels (PID alone, no soil) without a plotting library's warning") {
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
+  const fs::path dir = fs::temp_directory_path() / ("exc-plot-run-empty-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path log_path = dir / "run.lcm";
+  {
+    std::string error;
+    TelemetryConfig config;
+    config.lcm_url = "file://" + log_path.string() + "?mode=w";
+    config.channel_suffix = "/pid";
+    TelemetryPublisher publisher(config);
+    REQUIRE_MESSAGE(publisher.start(&error), error);
+    publish_synthetic_run(publisher, 1.0, false);
+    publisher.stop();
+  }
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = std::string(EXC_EXCAVATOR_LOG) + " report " + log_path.string() + " --out " +
+                              (dir / "report").string() + " >/dev/null 2>" + err.string();
+  REQUIRE(std::system(command.c_str()) == 0);
+  std::ifstream in(err);
+  std::stringstream text;
+  text << in.rdbuf();
+  INFO("stderr: " << text.str());
+  // matplotlib warns "No artists with labels found to put in legend" for a legend over an empty panel.
+  CHECK(text.str().find("No artists") == std::string::npos);
+  CHECK(text.str().find("Warning") == std::string::npos);
+  for (const char* name : {"soil_force.png", "soil_estimates.png", "tracking_error.png"}) {
+    CAPTURE(std::string(name));
+    CHECK(fs::exists(dir / "report" / name));
   }
   if (std::getenv("EXC_KEEP_PLOTS") == nullptr) fs::remove_all(dir);
 }

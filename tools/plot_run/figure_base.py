@@ -39,7 +39,12 @@ def decorate(ax, xlabel, ylabel=None, title=None, legend=True, **legend_options)
     if ylabel is not None:
         ax.set_ylabel(ylabel)
     ax.grid(True, alpha=0.3)
-    if legend:
+    if not ax.has_data():
+        # An empty panel (no soil in the scene, no estimator in the law) says so rather than looking
+        # like a plotting failure.
+        ax.text(0.5, 0.5, "nothing logged for this panel", transform=ax.transAxes, ha="center", va="center",
+                color="0.5")
+    elif legend and ax.get_legend_handles_labels()[1]:
         ax.legend(loc="best", **legend_options)
 
 
