@@ -68,13 +68,19 @@ void publish_synthetic_run(TelemetryPublisher& publisher, double error_scale, bo
   publisher.publish(Channel::timing, timing);
 }
 
+// An empty scratch directory of this test process's own.
+fs::path fresh_dir(const std::string& prefix) {
+  const fs::path dir = fs::temp_directory_path() / (prefix + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
 }  // namespace
 
 TEST_CASE("tools/plot-run draws every figure and the report from a small recorded log") {
   REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
-  const fs::path dir = fs::temp_directory_path() / ("exc-plot-run-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("exc-plot-run-");
   const fs::path log_path = dir / "run.lcm";
   {
     std::string error;
@@ -156,9 +162,7 @@ TEST_CASE("tools/plot-run draws every figure and the report from a small recorde
 
 TEST_CASE("tools/plot-run draws a run with empty panels (PID alone, no soil) without a plotting library's warning") {
   REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
-  const fs::path dir = fs::temp_directory_path() / ("exc-plot-run-empty-" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("exc-plot-run-empty-");
   const fs::path log_path = dir / "run.lcm";
   {
     std::string error;
