@@ -31,12 +31,19 @@ void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, 
     r.position[i] = quantise(q_a[i] + pn, params_.position_quantum[i]);
     r.velocity[i] = qd_a[i] + vn;
   }
+  // Pressures likewise: noise (drawn only when set, so a run without it draws what it drew), then the
+  // quantum.
+  auto pressure = [this](double p) {
+    const double n = params_.pressure_noise > 0 ? params_.pressure_noise * normal_(rng_) : 0.0;
+    return quantise(p + n, params_.pressure_quantum);
+  };
   for (int i = 0; i < 3; ++i) {
-    r.pressure_a[i] = quantise(p_a[i + 1], params_.pressure_quantum);
-    r.pressure_b[i] = quantise(p_b[i + 1], params_.pressure_quantum);
+    r.pressure_a[i] = pressure(p_a[i + 1]);
+    r.pressure_b[i] = pressure(p_b[i + 1]);
   }
-  r.swing_pressure = Vec2(quantise(p_a[0], params_.pressure_quantum), quantise(p_b[0], params_.pressure_quantum));
-  for (int i = 0; i < 2; ++i) r.pump_pressure[i] = quantise(pump[i], params_.pressure_quantum);
+  r.swing_pressure.x() = pressure(p_a[0]);
+  r.swing_pressure.y() = pressure(p_b[0]);
+  for (int i = 0; i < 2; ++i) r.pump_pressure[i] = pressure(pump[i]);
   r.cycle = cycle;
   const int n = static_cast<int>(ring_.size());
   const int latency = params_.latency_cycles;

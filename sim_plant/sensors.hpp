@@ -15,6 +15,9 @@ struct SensorParameters {
   Vec4 position_noise = Vec4::Zero();    // standard deviation, rad, m
   Vec4 velocity_noise = Vec4::Zero();    // standard deviation, rad/s, m/s
   double pressure_quantum = 0;           // Pa (0: none)
+  // Pa, standard deviation on every chamber and pump pressure reading: a transmitter's noise and the
+  // pumps' ripple as 1 kHz samples see them (0: none, the readings are the circuit's own).
+  double pressure_noise = 0;
   std::uint64_t seed = 1;
   int latency_cycles = 0;                // 0 .. kMaxLatency
   static constexpr int kMaxLatency = 63;
