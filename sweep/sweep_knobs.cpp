@@ -173,6 +173,7 @@ const std::vector<Knob>& named_knobs(SweepRun run) {
       {"path_speed", nullptr, {0.1, 10}, "", "the task's times and the run's duration / value", scale_path_speed},
       {"position_noise", "sensors.position_noise"},
       {"velocity_noise", "sensors.velocity_noise"},
+      {"pressure_noise", "sensors.pressure_noise"},
       {"delay_cycles", "sensors.latency_cycles"},
       {"gain_scale", nullptr, {0.01, 100}, "",
        "the outer law's omega_n x value (kp x s^2, kv x s, ki x s^3, Slotine-Li's lambda and kd x s)", scale_gains, false,
