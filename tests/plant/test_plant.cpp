@@ -50,7 +50,7 @@ TEST_CASE("plant/step allocates nothing over 10000 steps (every integrator, form
     t.terrain = "height: 1.9";  // the tip starts in the soil: the soil path runs too
     t.soil = "preset: loam";
     t.sensors = "position_noise: [1e-4, 1e-4, 1e-4, 1e-4], velocity_noise: [1e-3, 1e-3, 1e-3, 1e-3], seed: 7, "
-                "latency_cycles: 2, position_quantum: [1e-4, 1e-4, 1e-4, 1e-4]";
+                "latency_cycles: 2, position_quantum: [1e-4, 1e-4, 1e-4, 1e-4], pressure_noise: 5e3, pressure_quantum: 1e3";
     Plant p(t.scene());
     ActuatorCommand cmd;
     const bool valves = p.fidelity().takes_valves();
