@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "hal/excavator_interface.hpp"
+
 namespace exc::hal {
 
 // operator_station: an operator station or remote e-stop kit; it only sends (SUPERVISOR).
@@ -68,8 +70,7 @@ inline constexpr std::uint32_t fw_heartbeat = 0x701;
 inline constexpr std::uint32_t plant_heartbeat = 0x702;
 }  // namespace can_id
 
-// SUPERVISOR's Command signal.
-enum class SupervisorCommand : std::uint8_t { none = 0, start = 1, stop = 2, acknowledge = 3 };
+// SUPERVISOR's Command signal (SupervisorCommand, hal/excavator_interface.hpp).
 const char* to_string(SupervisorCommand command);
 
 inline constexpr std::size_t kMessageCount = 10;

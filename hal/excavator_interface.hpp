@@ -19,6 +19,9 @@ inline constexpr std::uint8_t kPlantStatePilotCut = 2;
 inline constexpr std::uint8_t kPlantStateEngineStopped = 4;
 inline constexpr std::uint8_t kPlantStateHoldingValvesClosed = 8;
 
+// An operator station's command (SUPERVISOR's Command signal): a keep-alive, start, stop, acknowledge.
+enum class SupervisorCommand : std::uint8_t { none = 0, start = 1, stop = 2, acknowledge = 3 };
+
 struct SensorState {
   std::array<double, kAxisCount> position{};  // swing angle (rad); cylinder pin-to-pin lengths (m)
   std::array<double, kAxisCount> velocity{};  // swing rate (rad/s); cylinder stroke rates (m/s)

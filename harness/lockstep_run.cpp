@@ -287,16 +287,16 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         rec.peak_soil_force = std::max(rec.peak_soil_force, s.soil_force.norm());
         for (int i = 0; i < 6; ++i) rec.theta_hat[i] = node.last_output().theta_hat[i];
       }
-      if (result.first_safe_stop_time < 0 && node.safe_stops() > 0) {
+      if (result.first_safe_stop_time < 0 && node.supervisor().safe_stops() > 0) {
         // The firmware's clock (the schedule's): the plant's lags it by every SYNC a burst dropped.
         result.first_safe_stop_time = node.time();
-        result.first_fault_detected_time = node.fault_detected_time();
-        result.first_fault_code = static_cast<int>(node.last_fault());
+        result.first_fault_detected_time = node.supervisor().fault_detected_time();
+        result.first_fault_code = static_cast<int>(node.supervisor().last_fault());
       }
       if (options.observer) options.observer(k, plant, node);
       if (options.node_observer) options.node_observer(k, plant_node, node);
       if (plant_node.failed()) break;
-      if (options.stop_at_safe_state && node.safe_stops() > 0) break;
+      if (options.stop_at_safe_state && node.supervisor().safe_stops() > 0) break;
       if (options.progress && (k + 1) % progress_every == 0) {
         // On a terminal the line is redrawn in place; in a log, one line per tenth of the run.
         std::fprintf(stderr, interactive ? "\r  %-10s %5.1f / %.1f s simulated" : "  %-10s %5.1f / %.1f s simulated\n",
@@ -308,7 +308,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     // At rest from the first sample after the last that moved; never, if the last one moved.
     if (!moving_now) result.machine_at_rest_time = last_moving < 0 ? 0.0 : last_moving + scene.cycle;
   }
-  result.estop = node.emergency_sent();
+  result.estop = node.supervisor().emergency_sent();
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   if (options.progress && interactive) std::fprintf(stderr, "\n");
   node.publish_counters();
@@ -352,7 +352,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
                                       timing_between(plant_last_begin, plant_node.step_timing())};
   result.firmware_cycle = timing_of(node.cycle_timing());
   result.heap_allocations_in_loop = allocations;
-  result.safe_stops = node.safe_stops();
+  result.safe_stops = node.supervisor().safe_stops();
   result.rx_rejected = firmware_port.rx_stats().rejected() + plant_port.rx_stats().rejected();
   for (std::size_t c = 0; c < cycles_acc.size(); ++c) {
     CycleRecord& rec = cycles_acc[c];
@@ -366,20 +366,20 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     result.flow_saturated_seconds = static_cast<double>(h.saturated_substeps) * step;
     result.relief_seconds = static_cast<double>(h.relief_substeps) * step;
     result.cavitation_seconds = static_cast<double>(h.cavitation_substeps) * step;
-    result.pump_limited_cycles = node.pump_limited_cycles();
+    result.pump_limited_cycles = node.supervisor().pump_limited_cycles();
   }
   result.task_finished = node.trajectory_finished();
   result.task_finish_time = node.finish_time();
   if (plant_node.failed()) {
     result.ok = false;
     result.failure = std::string("plant stopped: ") + plant.status().text();
-  } else if (node.safe_stops() > 0) {
+  } else if (node.supervisor().safe_stops() > 0) {
     result.ok = false;
-    result.failure = "the firmware went to its safe state " + std::to_string(node.safe_stops()) + " time(s), the last for " +
-                     node.last_fault_text() + " (mode " + control::to_string(node.mode()) + " at the end)";
+    result.failure = "the firmware went to its safe state " + std::to_string(node.supervisor().safe_stops()) + " time(s), the last for " +
+                     node.supervisor().last_fault_text() + " (mode " + safety::to_string(node.mode()) + " at the end)";
   } else if (metrics.samples() == 0) {
     result.ok = false;
-    result.failure = std::string("the firmware never tracked (mode ") + control::to_string(node.mode()) + ")";
+    result.failure = std::string("the firmware never tracked (mode ") + safety::to_string(node.mode()) + ")";
   }
   return result;
 }

@@ -104,7 +104,7 @@ struct ChannelWriter {
   std::vector<std::pair<std::int64_t, std::int64_t>> windows;
 };
 
-// The firmware's modes in which q_desired is commanded: hold and track (control::Mode 2 and 3).
+// The firmware's modes in which q_desired is commanded: hold and track (safety::Mode 2 and 3).
 bool commanded_mode(std::int8_t mode) { return mode == 2 || mode == 3; }
 
 // Each controller's largest tracking error per joint and its utime, by channel suffix.

@@ -2,7 +2,7 @@
 
 #include <stdexcept>
 
-#include "app/firmware_faults.hpp"
+#include "safety/firmware_faults.hpp"
 #include "control/path_stop.hpp"
 
 namespace exc::sim {
@@ -92,7 +92,7 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
   } else if (r.first_safe_stop_time >= 0) {
     // A stop along the path latches once the path is at rest: it may take the deceleration's time too.
     const double allowed =
-        watchdog + (app::stops_along_path(static_cast<app::FirmwareFault>(r.first_fault_code))
+        watchdog + (safety::stops_along_path(static_cast<safety::FirmwareFault>(r.first_fault_code))
                         ? control::PathStop::longest(firmware.controller.stop_ramp_time)
                         : 0.0);
     const double late = r.first_safe_stop_time - r.first_fault_detected_time - allowed;
@@ -146,7 +146,7 @@ void count_safety_function(nlohmann::json& table, const nlohmann::json& line, co
   const nlohmann::json& r = line[controller];
   const nlohmann::json& fault = line["fault"];
   const bool stopped = r.contains("fault_code") && !r["fault_code"].is_null();
-  const std::string name = stopped ? app::to_string(static_cast<app::FirmwareFault>(r["fault_code"].get<int>())) : "none";
+  const std::string name = stopped ? safety::to_string(static_cast<safety::FirmwareFault>(r["fault_code"].get<int>())) : "none";
   nlohmann::json& k = table[controller][name];
   if (k.is_null())
     k = {{"runs", 0}, {"never_at_rest", 0}, {"estop", 0}, {"kinds", nlohmann::json::object()},

@@ -15,12 +15,12 @@ std::string number(const char* format, double value) {
 }
 
 void print_transition(const FirmwareNode& node, std::FILE* progress) {
-  const control::Transition& t = node.last_transition();
+  const safety::Transition& t = node.last_transition();
   if (!t.changed || !progress) return;
-  const bool stopped = t.to == control::Mode::safe_stop;
+  const bool stopped = t.to == safety::Mode::safe_stop;
   std::fprintf(progress, "excavator-firmware: cycle %llu (%.3f s): %s -> %s: %s%s%s\n",
-               static_cast<unsigned long long>(node.cycle()), node.time(), control::to_string(t.from),
-               control::to_string(t.to), t.reason, stopped ? ": " : "", stopped ? node.last_fault_text() : "");
+               static_cast<unsigned long long>(node.cycle()), node.time(), safety::to_string(t.from),
+               safety::to_string(t.to), t.reason, stopped ? ": " : "", stopped ? node.supervisor().last_fault_text() : "");
   std::fflush(progress);
 }
 
@@ -80,11 +80,11 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
     print_transition(node, progress);
   }
   // The run is over (its end, or a stop): the machine is left with its valves centred.
-  node.send_safe_command(FirmwareFault::exited);
+  node.send_safe_command(safety::FirmwareFault::exited);
   if (progress)
     std::fprintf(progress, "excavator-firmware: last command sent: valves centred, FW_EMERGENCY %s stop (%s)\n",
-                 to_string(node.emergency_sent() ? StopKind::emergency : StopKind::controlled),
-                 node.mode() == control::Mode::safe_stop ? node.last_fault_text() : "firmware exited");
+                 to_string(node.supervisor().emergency_sent() ? safety::StopKind::emergency : safety::StopKind::controlled),
+                 node.mode() == safety::Mode::safe_stop ? node.supervisor().last_fault_text() : "firmware exited");
   node.publish_counters(true);
 
   outcome.cycles = node.cycle();
@@ -102,9 +102,9 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
         " periods were skipped (allowed together: " + number("%g %%", options.max_overrun_fraction * 100) +
         " of the cycles): the loop cannot hold its " + number("%g ms", period_s * 1e3) + " period");
   if (node.measured_tracking().samples() == 0)
-    add(std::string("the firmware never tracked (mode ") + control::to_string(node.mode()) + ")");
-  else if (node.safe_stops() > 0)
-    add(std::string("safe state: ") + node.last_fault_text());
+    add(std::string("the firmware never tracked (mode ") + safety::to_string(node.mode()) + ")");
+  else if (node.supervisor().safe_stops() > 0)
+    add(std::string("safe state: ") + node.supervisor().last_fault_text());
   outcome.ok = outcome.failure.empty();
   return outcome;
 }

@@ -15,7 +15,7 @@ class LastSafeCommand {
   LastSafeCommand& operator=(const LastSafeCommand&) = delete;
   ~LastSafeCommand() {
     if (!node_.safe_command_sent())
-      node_.send_safe_command(std::uncaught_exceptions() > 0 ? FirmwareFault::fatal_error : FirmwareFault::exited);
+      node_.send_safe_command(std::uncaught_exceptions() > 0 ? safety::FirmwareFault::fatal_error : safety::FirmwareFault::exited);
   }
 
  private:

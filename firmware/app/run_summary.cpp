@@ -35,7 +35,7 @@ void print_run_summary(const RunContext& run, std::FILE* out) {
                static_cast<unsigned long long>(run.outcome.cycles), run.period_s * 1e3, c.median_us(), c.p99_us(),
                c.max_us(), static_cast<unsigned long long>(run.outcome.overruns),
                static_cast<unsigned long long>(run.outcome.skipped_periods),
-               static_cast<unsigned long long>(run.node.safe_stops()),
+               static_cast<unsigned long long>(run.node.supervisor().safe_stops()),
                static_cast<unsigned long long>(run.can_frames_rejected),
                static_cast<unsigned long long>(telemetry_dropped(run)));
   std::fprintf(out, "excavator-firmware: %s%s\n", run.outcome.ok ? "ok" : "FAILED: ", run.outcome.failure.c_str());
@@ -58,9 +58,9 @@ nlohmann::json run_summary_json(const RunContext& run) {
   j["cycle_us"] = timing_json(node.cycle_timing());
   j["deadlines"] = {{"overruns", run.outcome.overruns}, {"skipped_periods", run.outcome.skipped_periods},
                     {"interval_us", timing_json(node.interval_timing())}};
-  j["safe_stops"] = node.safe_stops();
-  j["estop"] = node.emergency_sent();  // any FW_EMERGENCY with EmergencyStop = 1, the last command included
-  if (node.safe_stops() > 0) j["last_fault"] = node.last_fault_text();
+  j["safe_stops"] = node.supervisor().safe_stops();
+  j["estop"] = node.supervisor().emergency_sent();  // any FW_EMERGENCY with EmergencyStop = 1, the last command included
+  if (node.supervisor().safe_stops() > 0) j["last_fault"] = node.supervisor().last_fault_text();
   j["task_finished"] = node.trajectory_finished();
   j["can_frames_rejected"] = run.can_frames_rejected;
   if (run.publisher) {

@@ -10,11 +10,11 @@
 
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
-#include "control/pressure_plausibility.hpp"
+#include "safety/pressure_plausibility.hpp"
 #include "control/soil_contact.hpp"
 #include "control/state_estimator.hpp"
 #include "control/valve_inner_loop.hpp"
-#include "control/velocity_plausibility.hpp"
+#include "safety/velocity_plausibility.hpp"
 #include "model/machine.hpp"
 #include "settings/section_reader.hpp"
 
@@ -117,10 +117,10 @@ struct ControllerConfig {
   int max_missed_deadlines = 5;
   // Commanded against measured velocity per function on the valve interface (docs/safety.md, H1).
   // Its floors default to shares of each function's top speed and effort (controller_defaults).
-  PlausibilitySettings plausibility;
+  safety::PlausibilitySettings plausibility;
   // The chamber pressures' range, steps and stuck-at readings on the valve interface (docs/safety.md,
   // H4); its limits come from the machine file's hydraulics section (pressure_plausibility.hpp).
-  PressurePlausibilitySettings pressure_plausibility;
+  safety::PressurePlausibilitySettings pressure_plausibility;
   // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
   // machine far from where it was told to go must stop; rad (swing), m (cylinders). On the valve
   // interface the default is kTrackingLimitMultiple x what the valve machine reaches

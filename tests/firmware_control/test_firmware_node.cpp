@@ -24,6 +24,7 @@
 
 using namespace exc;
 using namespace exc::control;
+using namespace exc::safety;
 
 namespace {
 
@@ -292,11 +293,11 @@ TEST_CASE("firmware/node: losing the sensor frames raises the sensor-timeout fau
   CHECK(cycles_to_stop == static_cast<int>(std::lround(cfg.controller.watchdog_timeout / 1e-3)) + 1);
   // Detected on the gap's first cycle: the safe state follows the watchdog's time later.
   const double silent_from = loop.node.time() - (cycles_to_stop - 1) * 1e-3;
-  CHECK(loop.node.fault_detected_time() == doctest::Approx(silent_from));
-  CHECK(loop.node.time() - loop.node.fault_detected_time() == doctest::Approx(cfg.controller.watchdog_timeout));
+  CHECK(loop.node.supervisor().fault_detected_time() == doctest::Approx(silent_from));
+  CHECK(loop.node.time() - loop.node.supervisor().fault_detected_time() == doctest::Approx(cfg.controller.watchdog_timeout));
   // The plant's end reads the fault frame with its code (on its next SYNC).
   loop.cycle();
-  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::sensor_timeout));
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::sensor_timeout));
 }
 
 TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over 20000 cycles of the dig task") {
@@ -421,18 +422,18 @@ TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated
     last_qd = loop.node.q_desired();
   }
   REQUIRE(loop.node.mode() == Mode::safe_stop);
-  CHECK(loop.node.last_fault() == app::FirmwareFault::tracking_error);
-  const std::string text = loop.node.last_fault_text();
+  CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::tracking_error);
+  const std::string text = loop.node.supervisor().last_fault_text();
   MESSAGE(text << "; error at the last tracking cycle " << error_before << " rad");
   CHECK(text.rfind("tracking error: swing ", 0) == 0);
   // Stopped before the error passed the limit by more than one cycle of the path's motion.
   CHECK(error_before <= limit + desired_step + 1e-9);
   CHECK(loop.node.time() < 2.5 + cfg.track_delay);  // long before the path's end
   // Detected on the last tracking cycle, the safe state on the next.
-  CHECK(loop.node.time() - loop.node.fault_detected_time() == doctest::Approx(1e-3));
+  CHECK(loop.node.time() - loop.node.supervisor().fault_detected_time() == doctest::Approx(1e-3));
   // The plant hears it: FW_EMERGENCY carries the code.
   loop.cycle();
-  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::tracking_error));
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::tracking_error));
 }
 
 TEST_CASE("firmware/node: the reference dig and free-motion tasks on the force-actuated model never trip the tracking-error fault with any effort law") {
@@ -443,8 +444,8 @@ TEST_CASE("firmware/node: the reference dig and free-motion tasks on the force-a
       cfg.controller.law = kind;
       Loop loop(model, task, cfg);
       for (int k = 0; k < 11000; ++k) loop.cycle();
-      INFO(kind << ": " << loop.node.last_fault_text());
-      CHECK(loop.node.safe_stops() == 0);
+      INFO(kind << ": " << loop.node.supervisor().last_fault_text());
+      CHECK(loop.node.supervisor().safe_stops() == 0);
       CHECK(loop.node.trajectory_finished());
     }
   }
@@ -490,13 +491,13 @@ TEST_CASE("firmware/node: a sensor timeout takes the emergency stop (EmergencySt
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 1.0) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::track);
-  CHECK_FALSE(loop.node.emergency_sent());
+  CHECK_FALSE(loop.node.supervisor().emergency_sent());
   loop.answer = false;
   for (int k = 0; k < 50; ++k) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::safe_stop);
-  CHECK(loop.node.last_fault() == app::FirmwareFault::sensor_timeout);
-  CHECK(loop.node.last_stop() == app::StopKind::emergency);
-  CHECK(loop.node.emergency_sent());
+  CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::sensor_timeout);
+  CHECK(loop.node.supervisor().last_stop() == safety::StopKind::emergency);
+  CHECK(loop.node.supervisor().emergency_sent());
   // The frames come back; for 2 s nobody acknowledges: the firmware stays stopped, the machine's
   // end keeps reading the emergency stop with its code.
   loop.answer = true;
@@ -505,9 +506,9 @@ TEST_CASE("firmware/node: a sensor timeout takes the emergency stop (EmergencySt
     REQUIRE(loop.node.mode() == Mode::safe_stop);
   }
   CHECK(loop.command.emergency_stop);
-  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::sensor_timeout));
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::sensor_timeout));
   CHECK(loop.command.mode == hal::CommandMode::valve);
-  CHECK(loop.node.safe_stops() == 1);
+  CHECK(loop.node.supervisor().safe_stops() == 1);
   // Acknowledged: hold where the machine is, the machine's latch released, the task not restarted.
   loop.node.acknowledge();
   loop.cycle();
@@ -550,9 +551,9 @@ TEST_CASE("firmware/node: the machine's own signals are heard and named: PLANT_E
     loop.plant_port.send_fault(true, 3);
     loop.cycle();  // read in this cycle, before the state machine steps: the safe state at once
     CHECK(loop.node.mode() == Mode::safe_stop);
-    CHECK(loop.node.last_fault() == app::FirmwareFault::plant_emergency);
-    CHECK(std::string(loop.node.last_fault_text()).find("PLANT_EMERGENCY code 3") != std::string::npos);
-    CHECK(loop.node.last_stop() == app::StopKind::emergency);
+    CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::plant_emergency);
+    CHECK(std::string(loop.node.supervisor().last_fault_text()).find("PLANT_EMERGENCY code 3") != std::string::npos);
+    CHECK(loop.node.supervisor().last_stop() == safety::StopKind::emergency);
     loop.cycle();
     CHECK(loop.command.emergency_stop);
   }
@@ -563,8 +564,8 @@ TEST_CASE("firmware/node: the machine's own signals are heard and named: PLANT_E
     loop.cycle();
     loop.cycle();
     CHECK(loop.node.mode() == Mode::safe_stop);
-    CHECK(loop.node.last_fault() == app::FirmwareFault::plant_fault);
-    CHECK(std::string(loop.node.last_fault_text()).find("PlantFaults 0x02") != std::string::npos);
+    CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::plant_fault);
+    CHECK(std::string(loop.node.supervisor().last_fault_text()).find("PlantFaults 0x02") != std::string::npos);
     // Latched: the plant's fault bits clear, the firmware stays stopped until acknowledged; an
     // acknowledge while the bits stand is refused.
     loop.plant_faults = 0x02;
@@ -594,8 +595,8 @@ TEST_CASE("firmware/node: the machine's own signals are heard and named: PLANT_E
       ++cycles;
     }
     CHECK(cycles == 5);  // the fifth set; the plant's signals are read before the state machine steps
-    CHECK(loop.node.last_fault() == app::FirmwareFault::plant_holding);
-    CHECK(loop.node.last_stop() == app::StopKind::emergency);
+    CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::plant_holding);
+    CHECK(loop.node.supervisor().last_stop() == safety::StopKind::emergency);
   }
 }
 
@@ -624,16 +625,16 @@ TEST_CASE("firmware/node: consecutive missed deadlines in real time are a fault 
   }
   loop.cycle();
   CHECK(loop.node.mode() == Mode::safe_stop);
-  CHECK(loop.node.last_fault() == app::FirmwareFault::deadline_overrun);
-  CHECK(loop.node.last_stop() == app::StopKind::controlled);
+  CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::deadline_overrun);
+  CHECK(loop.node.supervisor().last_stop() == safety::StopKind::controlled);
   loop.cycle();
   CHECK_FALSE(loop.command.emergency_stop);
-  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::deadline_overrun));
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::deadline_overrun));
 }
 
 TEST_CASE("firmware/node: the last command of a program that leaves centres the valves and says why, an error takes the emergency stop") {
   const Model model = build_model(reference_machine());
-  for (const app::FirmwareFault why : {app::FirmwareFault::exited, app::FirmwareFault::fatal_error}) {
+  for (const safety::FirmwareFault why : {safety::FirmwareFault::exited, safety::FirmwareFault::fatal_error}) {
     app::FirmwareNodeConfig cfg;
     cfg.controller.law = "pid";
     Loop loop(model, sim::kFreeMotionTask, cfg);
@@ -644,11 +645,11 @@ TEST_CASE("firmware/node: the last command of a program that leaves centres the 
     std::uint64_t k = 0;
     loop.plant_port.poll_sync(k);  // no SYNC follows: the frames are latched as they come
     loop.plant_port.read(loop.command);
-    INFO(app::to_string(why));
+    INFO(safety::to_string(why));
     CHECK(loop.command.mode == hal::CommandMode::valve);
     for (int j = 0; j < 4; ++j) CHECK(loop.command.value[j] == 0.0);
     CHECK(loop.command.fault_code == static_cast<std::uint16_t>(why));
-    CHECK(loop.command.emergency_stop == (why == app::FirmwareFault::fatal_error));
+    CHECK(loop.command.emergency_stop == (why == safety::FirmwareFault::fatal_error));
     CHECK(loop.node.safe_command_sent());
   }
 }
@@ -672,14 +673,14 @@ TEST_CASE("firmware/node: a node set to wait for the operator holds until a SUPE
     CHECK(loop.node.mode() == Mode::hold);
     REQUIRE(station.send(hal::SupervisorCommand::start));
     loop.cycle();
-    CHECK(loop.node.start_received());
+    CHECK(loop.node.supervisor().start_received());
     CHECK(loop.node.mode() == Mode::track);
   }
   SUBCASE("starts by itself") {
     Loop loop(model, sim::kFreeMotionTask, cfg);
     while (loop.node.time() < 0.2) loop.cycle();
     CHECK(loop.node.mode() == Mode::track);
-    CHECK_FALSE(loop.node.start_received());
+    CHECK_FALSE(loop.node.supervisor().start_received());
   }
 }
 
@@ -696,11 +697,11 @@ TEST_CASE("firmware/node: SUPERVISOR stop and acknowledge in one cycle: the stop
   // The machine decelerates along its path (at most (pi / 2) stop_ramp_time), then the stop latches.
   for (int k = 0; k < 700 && loop.node.mode() == Mode::track; ++k) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::safe_stop);
-  CHECK(loop.node.last_fault() == app::FirmwareFault::operator_stop);
-  CHECK(loop.node.last_stop() == app::StopKind::controlled);
+  CHECK(loop.node.supervisor().last_fault() == safety::FirmwareFault::operator_stop);
+  CHECK(loop.node.supervisor().last_stop() == safety::StopKind::controlled);
   loop.cycle();
   CHECK_FALSE(loop.command.emergency_stop);
-  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::operator_stop));
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::operator_stop));
   REQUIRE(station.send(hal::SupervisorCommand::acknowledge));
   REQUIRE(station.send(hal::SupervisorCommand::stop));
   for (int k = 0; k < 20; ++k) loop.cycle();
@@ -711,19 +712,19 @@ TEST_CASE("firmware/node: SUPERVISOR stop and acknowledge in one cycle: the stop
 }
 
 TEST_CASE("firmware/faults: every fault kind names its stop, those the valves or sensors cannot be trusted in take the emergency stop") {
-  using app::FirmwareFault;
-  using app::StopKind;
-  CHECK(app::stop_of(FirmwareFault::none) == StopKind::none);
-  CHECK(app::stop_of(FirmwareFault::pump_limited) == StopKind::none);
-  for (FirmwareFault f : {FirmwareFault::sensor_timeout, FirmwareFault::plant_emergency, FirmwareFault::plant_fault,
-                          FirmwareFault::plant_holding, FirmwareFault::velocity_implausible, FirmwareFault::fatal_error})
-    CHECK(app::stop_of(f) == StopKind::emergency);
+  using safety::FirmwareFault;
+  using safety::StopKind;
+  CHECK(safety::stop_of(safety::FirmwareFault::none) == safety::StopKind::none);
+  CHECK(safety::stop_of(safety::FirmwareFault::pump_limited) == safety::StopKind::none);
+  for (safety::FirmwareFault f : {safety::FirmwareFault::sensor_timeout, safety::FirmwareFault::plant_emergency, safety::FirmwareFault::plant_fault,
+                          safety::FirmwareFault::plant_holding, safety::FirmwareFault::velocity_implausible, safety::FirmwareFault::fatal_error})
+    CHECK(safety::stop_of(f) == safety::StopKind::emergency);
   // A wrong pressure reading: the valves obey and the position sensors watch the stop (docs/safety.md, H4).
-  for (FirmwareFault f : {FirmwareFault::model, FirmwareFault::tracking_error, FirmwareFault::no_pressures,
-                          FirmwareFault::deadline_overrun, FirmwareFault::exited, FirmwareFault::operator_stop,
-                          FirmwareFault::pressure_implausible})
-    CHECK(app::stop_of(f) == StopKind::controlled);
-  for (int code = 0; code <= 14; ++code) CHECK(std::string(app::to_string(static_cast<FirmwareFault>(code))) != "unknown");
+  for (safety::FirmwareFault f : {safety::FirmwareFault::model, safety::FirmwareFault::tracking_error, safety::FirmwareFault::no_pressures,
+                          safety::FirmwareFault::deadline_overrun, safety::FirmwareFault::exited, safety::FirmwareFault::operator_stop,
+                          safety::FirmwareFault::pressure_implausible})
+    CHECK(safety::stop_of(f) == safety::StopKind::controlled);
+  for (int code = 0; code <= 14; ++code) CHECK(std::string(safety::to_string(static_cast<safety::FirmwareFault>(code))) != "unknown");
 }
 
 // excavator-firmware's cycle (app/firmware_runner), run here over the memory bus with the model plant
@@ -749,7 +750,7 @@ TEST_CASE("firmware/runner: a lockstep run does its cycles, tracks, and leaves t
   loop.plant_port.read(loop.command);
   CHECK(loop.command.mode == hal::CommandMode::valve);
   for (int j = 0; j < 4; ++j) CHECK(loop.command.value[j] == 0.0);
-  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(app::FirmwareFault::exited));
+  CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::exited));
   CHECK_FALSE(loop.command.emergency_stop);
 }
 

@@ -5,12 +5,12 @@
 
 #include <limits>
 
-#include "control/pressure_plausibility.hpp"
+#include "safety/pressure_plausibility.hpp"
 #include "model/machine.hpp"
 
 using namespace exc;
-using control::PressurePlausibility;
-using control::PressureTest;
+using safety::PressurePlausibility;
+using safety::PressureTest;
 
 namespace {
 
@@ -19,7 +19,7 @@ constexpr double kPeriod = 1e-3;
 struct Feed {
   PressurePlausibility monitor;
   Vec4 q, v = Vec4::Zero();
-  explicit Feed(const Machine& m, const control::PressurePlausibilitySettings& s = {})
+  explicit Feed(const Machine& m, const safety::PressurePlausibilitySettings& s = {})
       : monitor(m, s, kPeriod), q(0.5 * (m.q_min() + m.q_max())) {
     q[0] = 0;
   }
@@ -40,8 +40,8 @@ constexpr std::uint8_t kBoomA = 1u << 2;
 
 TEST_CASE("firmware/pressure plausibility: the range is the floor and the highest relief plus override, each widened by the margin, from the machine file") {
   const Machine m = reference_machine();
-  const control::PressurePlausibilitySettings s;
-  const control::PressureLimits l = control::pressure_limits(m, s);
+  const safety::PressurePlausibilitySettings s;
+  const safety::PressureLimits l = safety::pressure_limits(m, s);
   // The reference machine's numbers (machines/reference-20t.yaml): port relief 36.8 MPa, override
   // 1.5 MPa; vapour 0 and tank 0.3 MPa less the make-up's 0.2 MPa.
   CHECK(l.top[1] == doctest::Approx(36.8e6 + 1.5e6 + s.range_margin));
@@ -69,7 +69,7 @@ TEST_CASE("firmware/pressure plausibility: the range is the floor and the highes
 
 TEST_CASE("firmware/pressure plausibility: a jump beyond what the oil can make for the debounce is found, a one-set spike that returns and a ramp at the oil's rate are not") {
   const Machine m = reference_machine();
-  const control::PressurePlausibilitySettings s;
+  const safety::PressurePlausibilitySettings s;
   Feed f(m);
   f.set(10e6);
   f.set(10e6);
@@ -96,7 +96,7 @@ TEST_CASE("firmware/pressure plausibility: a jump beyond what the oil can make f
 
 TEST_CASE("firmware/pressure plausibility: a bit-identical reading is frozen after frozen_sets sets of motion, not at rest nor at the tank's level") {
   const Machine m = reference_machine();
-  control::PressurePlausibilitySettings s;
+  safety::PressurePlausibilitySettings s;
   s.frozen_sets = 50;
   Feed f(m, s);
   // At rest for 3x the window: no fault.

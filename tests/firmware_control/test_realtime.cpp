@@ -16,12 +16,14 @@
 #include "control/actuator_lag_compensator.hpp"
 #include "control/adaptive_computed_torque.hpp"
 #include "control/perf_counter.hpp"
-#include "control/state_machine.hpp"
+#include "control/command_blender.hpp"
+#include "safety/state_machine.hpp"
 #include "scenes.hpp"
 #include "tracking_run.hpp"
 
 using namespace exc;
 using namespace exc::control;
+using namespace exc::safety;
 
 namespace {
 

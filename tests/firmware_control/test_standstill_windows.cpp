@@ -6,7 +6,7 @@
 #include <cmath>
 #include <functional>
 
-#include "app/creep_window.hpp"
+#include "safety/creep_window.hpp"
 
 using namespace exc;
 
@@ -16,7 +16,7 @@ constexpr double kPeriod = 1e-3, kLength = 2.5, kLimit = 0.002, kSlowing = 0.2, 
 
 // Feeds x(t) on the function 0 for `seconds`; returns the time the first creep was found (-1: none).
 double first_creep(const std::function<double(double)>& x, double seconds) {
-  app::CreepWindow w;
+  safety::CreepWindow w;
   const Vec4 limit(kLimit, INFINITY, INFINITY, INFINITY);
   for (std::uint64_t k = 0; k * kPeriod <= seconds; ++k) {
     const double t = static_cast<double>(k) * kPeriod;

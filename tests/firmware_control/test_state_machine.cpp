@@ -2,10 +2,12 @@
 
 #include <cstring>
 
-#include "control/state_machine.hpp"
+#include "control/command_blender.hpp"
+#include "safety/state_machine.hpp"
 
 using namespace exc;
-using namespace exc::control;
+using namespace exc::safety;
+using exc::control::CommandBlender;
 
 TEST_CASE("firmware/state machine: init, wait for sensors, hold, track, finish") {
   ControlStateMachine sm(0.02);

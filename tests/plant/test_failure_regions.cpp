@@ -153,7 +153,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   fs::remove(log_path);
   std::vector<exlcm::fault_t> warnings;
   for (const exlcm::fault_t& f : faults)
-    if (f.code == static_cast<int>(app::FirmwareFault::pump_limited)) warnings.push_back(f);
+    if (f.code == static_cast<int>(safety::FirmwareFault::pump_limited)) warnings.push_back(f);
   REQUIRE(warnings.size() == 2);
   const std::string raised(reinterpret_cast<const char*>(warnings[0].text));
   MESSAGE(raised << " / " << std::string(reinterpret_cast<const char*>(warnings[1].text)));
@@ -172,7 +172,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   d.firmware.controller.valves.position_gain = Vec4::Constant(2);
   const sim::RunRecord stopped = sim::run_lockstep(d.scene, d.firmware, {});
   MESSAGE("default limit: " << stopped.failure);
-  CHECK(stopped.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+  CHECK(stopped.first_fault_code == static_cast<int>(safety::FirmwareFault::tracking_error));
   CHECK(stopped.failure.find("the pumps short of flow since t = ") != std::string::npos);
 }
 
@@ -210,7 +210,7 @@ TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its en
   CHECK(move(q0, q1, 10.0, "pump_pacing: true").firmware.duration == move(q0, q1, 10.0).firmware.duration);
   // Unpaced, the same path on the same limit stops on its lag (the test above).
   const sim::RunRecord unpaced = sim::run_lockstep(plain.scene, plain.firmware, {});
-  CHECK(unpaced.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+  CHECK(unpaced.first_fault_code == static_cast<int>(safety::FirmwareFault::tracking_error));
   CHECK(unpaced.flow_saturated_seconds > 0.3);
 }
 
@@ -320,7 +320,7 @@ TEST_CASE("firmware/relief in hard digging: on a rock the arm's bore side peaks 
       peak = st.pressure_a[2];
       v_at_peak = st.qd_a[2];
     }
-    if (relief_at_stop < 0 && node.safe_stops() > 0) relief_at_stop = st.hydraulics.relief_substeps;
+    if (relief_at_stop < 0 && node.supervisor().safe_stops() > 0) relief_at_stop = st.hydraulics.relief_substeps;
   };
   const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
   const double expected = h.port_relief_pressure + h.relief_override * area_a(m, 2) * std::abs(v_at_peak) / h.pump_flow;
@@ -394,7 +394,7 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity monitor off: the 
     // The error the closed forms predict: the stuck opening's speed against the path's.
     if (now >= t_stick && t_stop < 0) predicted_error += (v_stuck - (node.q_desired()[1] - q_d_prev[1]) / b.scene.cycle) * b.scene.cycle;
     q_d_prev = node.q_desired();
-    if (t_stop < 0 && node.safe_stops() > 0) {
+    if (t_stop < 0 && node.supervisor().safe_stops() > 0) {
       t_stop = st.time;
       q_stop = st.q_a[1];
     }
@@ -406,14 +406,14 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity monitor off: the 
   const double v_before = (q_stop - q_stuck0) / (t_stop - t_stick - 0.5);
   const double predicted_end = t_stop + (m.boom.max_length - q_stop) / v_stuck;
   MESSAGE("stuck at " << t_stick << " s: boom at " << v_before << " m/s (closed form " << v_stuck << "); "
-                      << std::string(node.last_fault_text()) << "; stopped " << t_stop - t_stick << " s after the stick at "
+                      << std::string(node.supervisor().last_fault_text()) << "; stopped " << t_stop - t_stick << " s after the stick at "
                       << q_stop << " m; end stop at " << t_end_stop << " s (closed form " << predicted_end
                       << "); bore side " << end.pressure_a[1] * 1e-6 << " MPa at the end; the closed forms' error at the stop "
                       << e_stick + predicted_error << " m");
   CHECK(v_before == doctest::Approx(v_stuck).epsilon(0.05).scale(0));
-  REQUIRE(node.safe_stops() == 1);
-  CHECK(node.last_fault() == app::FirmwareFault::tracking_error);
-  CHECK(std::string(node.last_fault_text()).find("boom") != std::string::npos);
+  REQUIRE(node.supervisor().safe_stops() == 1);
+  CHECK(node.supervisor().last_fault() == safety::FirmwareFault::tracking_error);
+  CHECK(std::string(node.supervisor().last_fault_text()).find("boom") != std::string::npos);
   const double limit = b.firmware.controller.tracking_error_limit[1];
   CHECK(e_stick + predicted_error == doctest::Approx(limit).epsilon(0.05).scale(0));  // stopped where the error met it
   CHECK(others_max < 1e-3);  // the safe state centred the other spools (within 0.2 s: 30 ms lag) ...
@@ -421,10 +421,10 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity monitor off: the 
   // Oil arriving through a centred valve in the controlled stop (the standstill monitor's flow test,
   // which runs with the tracking fault off): escalated to the emergency stop, the engine stopped;
   // the boom stops short of the end stop it would have reached at predicted_end.
-  MESSAGE("standstill monitor: escalated " << node.stop_escalated() << "; boom at " << end.q_a[1] << " m at the end (end stop "
+  MESSAGE("standstill monitor: escalated " << node.supervisor().stop_escalated() << "; boom at " << end.q_a[1] << " m at the end (end stop "
                                            << m.boom.max_length << " m, reached before at " << predicted_end << " s)");
-  CHECK(node.stop_escalated());
-  CHECK(node.emergency_sent());
+  CHECK(node.supervisor().stop_escalated());
+  CHECK(node.supervisor().emergency_sent());
   CHECK(t_end_stop < 0);
   CHECK(end.q_a[1] < m.boom.max_length - 0.05);
   CHECK(std::abs(end.qd_a[1]) < 1e-3);

@@ -1,4 +1,4 @@
-// The chamber pressures' plausibility monitor (firmware/control/pressure_plausibility.hpp,
+// The chamber pressures' plausibility monitor (firmware/safety/pressure_plausibility.hpp,
 // docs/safety.md H4) against the plant's pressure sensor faults, firmware and plant in lockstep: a
 // stuck, a jumping and a drifting (out of range) transmitter are each found, by their own test, within
 // a bound in sensor sets stated from the monitor's settings; and without a fault the monitor never
@@ -32,7 +32,7 @@ int sets_to_detection(const sim::RunRecord& r, double start, double cycle) {
 
 TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting chamber pressure are found by their test within their bound in sensor sets, the controlled stop taken") {
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  const control::PressurePlausibilitySettings& s = b.firmware.controller.pressure_plausibility;
+  const safety::PressurePlausibilitySettings& s = b.firmware.controller.pressure_plausibility;
   const double dt = b.scene.cycle;
   const double start = 2.0;  // s: the dig's bucket and arm are in the soil and moving
   int worst_stuck = 0, worst_jump = 0, worst_drift = 0, escalations = 0, found_cases = 0, skipped_cases = 0, found_by_motion = 0;
@@ -60,11 +60,11 @@ TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting cha
           const double top = s.range_margin + b.scene.machine.hydraulics.relief_override +
                              std::max(b.scene.machine.hydraulics.port_relief_pressure, b.scene.machine.hydraulics.pump_pressure_limit());
           o.node_observer = [&](std::int64_t, const app::PlantNode& plant, const app::FirmwareNode& node) {
-            escalated = escalated || node.stop_escalated();
+            escalated = escalated || node.supervisor().stop_escalated();
             if (!sampled && node.time() >= start - 1e-9) {
               sampled = true;
               p0 = (chamber == 0 ? node.sensors().pressure_a : node.sensors().pressure_b)[static_cast<std::size_t>(joint)];
-              allowed = node.pressure_plausibility().step_allowed(2 * joint + chamber);
+              allowed = node.supervisor().pressure_plausibility().step_allowed(2 * joint + chamber);
             }
             const long n = std::lround((node.time() - start) / dt);
             const double truth = (chamber == 0 ? plant.plant().state().pressure_a : plant.plant().state().pressure_b)[joint];
@@ -102,7 +102,7 @@ TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting cha
           // path before the reading leaves the range: then the flow monitor finds the motion first
           // and takes its emergency stop. Allowed only if it came before the range test's bound.
           if (kind == sim::FaultSchedule::Kind::pressure_drift &&
-              r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible)) {
+              r.first_fault_code == static_cast<int>(safety::FirmwareFault::velocity_implausible)) {
             REQUIRE(crossed > 0);
             const int sets = sets_to_detection(r, start, dt);
             MESSAGE(name << ": the motion it caused found by the flow monitor after " << sets << " sensor sets, before the range test's "
@@ -113,10 +113,10 @@ TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting cha
             ++found_cases;
             continue;
           }
-          CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::pressure_implausible));
+          CHECK(r.first_fault_code == static_cast<int>(safety::FirmwareFault::pressure_implausible));
           // The controlled stop: the valves obey and the position sensors watch the stop; the standstill
           // monitor escalates it when the machine does not stand still (printed, counted).
-          CHECK(app::stop_of(static_cast<app::FirmwareFault>(r.first_fault_code)) == app::StopKind::controlled);
+          CHECK(safety::stop_of(static_cast<safety::FirmwareFault>(r.first_fault_code)) == safety::StopKind::controlled);
           CHECK(r.estop == escalated);
           escalations += escalated ? 1 : 0;
           ++found_cases;
@@ -171,9 +171,9 @@ TEST_CASE("firmware/pressure plausibility: without a fault the pressure monitor 
       sim::LockstepOptions o;
       o.controller = law;
       o.node_observer = [&](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
-        for (int c = 0; c < control::PressurePlausibility::kChambers; ++c) {
-          worst_step = std::max(worst_step, node.pressure_plausibility().worst_step_ratio(c));
-          longest_frozen = std::max(longest_frozen, node.pressure_plausibility().longest_frozen(c));
+        for (int c = 0; c < safety::PressurePlausibility::kChambers; ++c) {
+          worst_step = std::max(worst_step, node.supervisor().pressure_plausibility().worst_step_ratio(c));
+          longest_frozen = std::max(longest_frozen, node.supervisor().pressure_plausibility().longest_frozen(c));
         }
       };
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
@@ -183,7 +183,7 @@ TEST_CASE("firmware/pressure plausibility: without a fault the pressure monitor 
       MESSAGE(what << ": largest step / allowance " << worst_step << ", longest frozen run while moving " << longest_frozen
                    << " sets (of " << limits.frozen_sets << "), chamber pressures " << r.min_pressure * 1e-6 << " .. "
                    << r.peak_pressure * 1e-6 << " MPa" << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
-      CHECK(r.first_fault_code != static_cast<int>(app::FirmwareFault::pressure_implausible));
+      CHECK(r.first_fault_code != static_cast<int>(safety::FirmwareFault::pressure_implausible));
       CHECK(worst_step < 1);
       CHECK(longest_frozen < limits.frozen_sets);
     }
@@ -196,15 +196,15 @@ TEST_CASE("firmware/pressure plausibility: with 5 kPa of noise on the readings a
   // region: slow paths).
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   b.scene.sensors.pressure_noise = 5e3;
-  const control::PressurePlausibilitySettings& s = b.firmware.controller.pressure_plausibility;
+  const safety::PressurePlausibilitySettings& s = b.firmware.controller.pressure_plausibility;
   const double dt = b.scene.cycle, start = 2.0;
   {
     sim::LockstepOptions o;
     o.controller = "pid";
     int longest = 0;
     o.node_observer = [&](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
-      for (int c = 0; c < control::PressurePlausibility::kChambers; ++c)
-        longest = std::max(longest, node.pressure_plausibility().longest_frozen(c));
+      for (int c = 0; c < safety::PressurePlausibility::kChambers; ++c)
+        longest = std::max(longest, node.supervisor().pressure_plausibility().longest_frozen(c));
     };
     const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
     INFO(r.failure);

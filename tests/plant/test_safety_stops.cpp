@@ -68,7 +68,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, either way, under eve
         ++cases;
         REQUIRE(r.first_safe_stop_time >= 0);
         const bool flow_swing = law == "flow" && joint == 0;
-        CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible));
+        CHECK(r.first_fault_code == static_cast<int>(safety::FirmwareFault::velocity_implausible));
         const double detection = r.first_fault_detected_time - t_stick;
         CHECK(detection > 0);
         CHECK(detection <= (flow_swing ? 0.15 : 0.1));
@@ -109,8 +109,8 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       sim::LockstepOptions o;
       o.controller = law;
       o.node_observer = [&worst, &longest_frozen](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
-        worst = node.plausibility().worst_ratio();
-        for (int i = 0; i < 4; ++i) longest_frozen = std::max(longest_frozen, node.frozen_position().run(i));
+        worst = node.supervisor().plausibility().worst_ratio();
+        for (int i = 0; i < 4; ++i) longest_frozen = std::max(longest_frozen, node.supervisor().frozen_position().run(i));
       };
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
       const std::string what = std::string(sc.scene) + ", " + law;
@@ -124,7 +124,7 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
                    << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
       // The monitor's own criterion: outside its floor for its debounce time in a row. A single
       // cycle beyond the floor is no fault (the printed figure is the largest single cycle's).
-      CHECK(r.first_fault_code != static_cast<int>(app::FirmwareFault::velocity_implausible));
+      CHECK(r.first_fault_code != static_cast<int>(safety::FirmwareFault::velocity_implausible));
       CHECK(r.safe_stops == 0);
       CHECK(longest_frozen < b.firmware.controller.plausibility.frozen_sets);
       // The default limit is 5x the worst of 1300 unseen runs: a shipped scene within half of it.
@@ -155,7 +155,7 @@ TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x w
     const sim::RunRecord r = sim::run_lockstep(c.scene, c.firmware, o);
     INFO(r.failure);
     REQUIRE(r.first_safe_stop_time >= 0);
-    CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+    CHECK(r.first_fault_code == static_cast<int>(safety::FirmwareFault::tracking_error));
     CHECK(r.failure.find("tracking error: boom") != std::string::npos);
     found[loose] = r.first_safe_stop_time - 3.0;
     MESSAGE(std::string(loose ? "effort interface's 0.2 m" : "valve default 37 mm") << ": stopped " << found[loose]
@@ -177,21 +177,21 @@ struct SupervisedRun {
   double last_moving_stopped = -1;  // s, the last cycle the machine moved while the firmware was stopped
   int stopped_cycles = 0;
   bool estop = false;               // FW_EMERGENCY with EmergencyStop = 1 sent
-  app::FirmwareFault fault = app::FirmwareFault::none;
+  safety::FirmwareFault fault = safety::FirmwareFault::none;
   std::string fault_text, leave_reason;
 };
 
 SupervisedRun run_supervised(const sim::SceneBundle& b, sim::LockstepOptions o) {
   SupervisedRun run;
   o.observer = [&run](std::int64_t, const plant::Plant& plant, const app::FirmwareNode& node) {
-    const bool stopped = node.mode() == control::Mode::safe_stop;
+    const bool stopped = node.mode() == safety::Mode::safe_stop;
     const double t = node.time();
     if (stopped) {
       ++run.stopped_cycles;
       if (run.first_stop < 0) {
         run.first_stop = t;
-        run.fault = node.last_fault();
-        run.fault_text = node.last_fault_text();
+        run.fault = node.supervisor().last_fault();
+        run.fault_text = node.supervisor().last_fault_text();
       }
       const auto& qd = plant.state().qd_a;
       bool moving = std::abs(qd[0]) >= sim::kRestSwingRate;
@@ -201,7 +201,7 @@ SupervisedRun run_supervised(const sim::SceneBundle& b, sim::LockstepOptions o) 
       run.left_stop = t;
       run.leave_reason = node.last_transition().reason;
     }
-    run.estop = run.estop || node.emergency_sent();
+    run.estop = run.estop || node.supervisor().emergency_sent();
   };
   run.record = sim::run_lockstep(b.scene, b.firmware, o);
   return run;
@@ -224,7 +224,7 @@ TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the 
     const SupervisedRun run = run_supervised(b, o);
     INFO(run.record.failure << " " << run.fault_text);
     REQUIRE(run.first_stop > 3.0);
-    CHECK(run.fault == app::FirmwareFault::velocity_implausible);
+    CHECK(run.fault == safety::FirmwareFault::velocity_implausible);
     CHECK(run.estop);
     // Stopped from the fault to the acknowledge's cycle, and not a cycle less (a frame sent before
     // the harness's cycle at t is read in the firmware's cycle t + 1 ms).
@@ -261,9 +261,9 @@ TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machin
   const double ramp = b.firmware.controller.stop_ramp_time;
   CHECK(run.first_stop >= 3.0 + 1e-3);
   CHECK(run.first_stop <= 3.0 + 1e-3 + 0.5 * M_PI * ramp + 1e-3);
-  CHECK(run.fault == app::FirmwareFault::operator_stop);
+  CHECK(run.fault == safety::FirmwareFault::operator_stop);
   CHECK(run.fault_text.find("operator stop: SUPERVISOR stop in track at t = 3.001 s") != std::string::npos);
-  CHECK(app::stop_of(run.fault) == app::StopKind::controlled);
+  CHECK(safety::stop_of(run.fault) == safety::StopKind::controlled);
   // Controlled; the standstill monitor may escalate it (printed).
   CHECK(run.last_moving_stopped < 4.5);
   CHECK(run.left_stop == doctest::Approx(6.0 + 1e-3).epsilon(1e-9));
@@ -295,12 +295,12 @@ TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and fa
     }
     // Detected on the first cycle past the timeout (the last frame read at 3.001 s), decelerated
     // along the path, latched once it is at rest.
-    CHECK(run.fault == app::FirmwareFault::operator_link_lost);
+    CHECK(run.fault == safety::FirmwareFault::operator_link_lost);
     CHECK(run.fault_text.find("operator link lost: no SUPERVISOR frame for 0.500 s") != std::string::npos);
     CHECK(run.record.first_fault_detected_time == doctest::Approx(last + 1e-3 + timeout + 1e-3).epsilon(1e-9));
     CHECK(run.first_stop > last + timeout);
     CHECK(run.first_stop < last + timeout + b.firmware.controller.stop_ramp_time * 1.6);
-    CHECK(app::stop_of(run.fault) == app::StopKind::controlled);
+    CHECK(safety::stop_of(run.fault) == safety::StopKind::controlled);
     CHECK(run.left_stop == doctest::Approx(6.0 + 1e-3).epsilon(1e-9));
     CHECK(run.last_moving_stopped < 5.5);  // the machine at rest by the plant's truth
     MESSAGE("link silent after " << last << " s: stopped (latched) at " << run.first_stop << " s, machine at rest from "
@@ -335,7 +335,7 @@ TEST_CASE("firmware/plausibility: a frozen position reading while its function i
       o.fault.joint = 3;
       double worst_at_stop = -1;
       o.observer = [&](std::int64_t, const plant::Plant&, const app::FirmwareNode& node) {
-        if (worst_at_stop < 0 && node.mode() == control::Mode::safe_stop) worst_at_stop = std::abs(node.q_desired()[3] - node.sensors().position[3]);
+        if (worst_at_stop < 0 && node.mode() == safety::Mode::safe_stop) worst_at_stop = std::abs(node.q_desired()[3] - node.sensors().position[3]);
       };
       const sim::RunRecord r = sim::run_lockstep(c.scene, c.firmware, o);
       const std::string name = law + (frozen_test ? ", frozen-reading test on" : ", frozen-reading test off");
@@ -344,7 +344,7 @@ TEST_CASE("firmware/plausibility: a frozen position reading while its function i
                    << ", the bucket's true worst error " << r.max_error[3] * 1e3 << " mm");
       if (frozen_test) {
         REQUIRE(r.first_safe_stop_time >= 0);
-        CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::velocity_implausible));
+        CHECK(r.first_fault_code == static_cast<int>(safety::FirmwareFault::velocity_implausible));
         CHECK(r.failure.find("no motion") != std::string::npos);
         // frozen_sets (0.2 s) after the asked displacement first doubles what arrived (the flow
         // monitor's 0.1 s window and the commands' 20 ms lag).
@@ -372,19 +372,19 @@ TEST_CASE("firmware/standstill: a swing spool stuck just past its dead zone, fou
     o.fault = stuck_spool(0, 0.19340007372785273, 5.814950679714288, 1e9);
     bool escalated = false;
     o.node_observer = [&escalated](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
-      escalated = escalated || node.stop_escalated();
+      escalated = escalated || node.supervisor().stop_escalated();
     };
     const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
     INFO(law << ": " << r.failure);
     MESSAGE(law << ": stopped at " << r.first_safe_stop_time << " s (" << r.failure << "), escalated " << escalated
                 << ", at rest from " << r.machine_at_rest_time << " s");
     REQUIRE(r.first_safe_stop_time >= 0);
-    CHECK(r.first_fault_code == static_cast<int>(app::FirmwareFault::tracking_error));
+    CHECK(r.first_fault_code == static_cast<int>(safety::FirmwareFault::tracking_error));
     CHECK(escalated);
     CHECK(r.estop);
     REQUIRE(r.machine_at_rest_time >= 0);
-    // The first swing window closes kStandstillDelay + kStandstillSwingWindow after the stop; the
+    // The first swing window closes safety::kStandstillDelay + safety::kStandstillSwingWindow after the stop; the
     // brake then holds the swing within a second.
-    CHECK(r.machine_at_rest_time - r.first_safe_stop_time < app::kStandstillDelay + app::kStandstillSwingWindow + 1.0);
+    CHECK(r.machine_at_rest_time - r.first_safe_stop_time < safety::kStandstillDelay + safety::kStandstillSwingWindow + 1.0);
   }
 }

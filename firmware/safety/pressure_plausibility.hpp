@@ -28,7 +28,7 @@
 #include "model/machine.hpp"
 #include "model/types.hpp"
 
-namespace exc::control {
+namespace exc::safety {
 
 struct PressurePlausibilitySettings {
   bool enabled = true;
@@ -164,4 +164,4 @@ class PressurePlausibility {
   std::array<PressureTest, kChambers> test_{};
 };
 
-}  // namespace exc::control
+}  // namespace exc::safety

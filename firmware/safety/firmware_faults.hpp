@@ -3,7 +3,7 @@
 // codes travel in FW_EMERGENCY's FaultCode and in fault_t.code.
 #include <cstdint>
 
-namespace exc::app {
+namespace exc::safety {
 
 enum class FirmwareFault : std::uint16_t {
   none = 0,
@@ -93,4 +93,4 @@ inline constexpr double kStandstillFastFactor = 10;
 const char* to_string(FirmwareFault fault);
 const char* to_string(StopKind stop);
 
-}  // namespace exc::app
+}  // namespace exc::safety

@@ -1,5 +1,5 @@
 #pragma once
-// The firmware's operating modes and their transitions (issue 5):
+// The firmware's operating modes and their transitions:
 //   init -> wait_sensors          once the loop runs (start-up done)
 //   wait_sensors -> hold          the first valid sensor frame arrived
 //   hold -> track                 tracking requested (and sensors fresh)
@@ -14,7 +14,7 @@
 
 #include "model/types.hpp"
 
-namespace exc::control {
+namespace exc::safety {
 
 enum class Mode : std::uint8_t { init = 0, wait_sensors = 1, hold = 2, track = 3, safe_stop = 4 };
 const char* to_string(Mode m);
@@ -81,34 +81,4 @@ class ControlStateMachine {
   const char* reason_ = "";
 };
 
-// Bumpless switching of modes or controllers: at the switch the new law's command is offset to
-// equal the last command sent, and the offset fades linearly to zero over blend_time. The command
-// is continuous at the switch and equals the new law's after blend_time.
-class CommandBlender {
- public:
-  explicit CommandBlender(double blend_time = 0.2) : blend_time_(blend_time) {}
-  // last_sent: the command sent on the previous cycle; first_new: the new law's command now.
-  void on_switch(double t, const Vec4& last_sent, const Vec4& first_new) {
-    t_switch_ = t;
-    offset_ = last_sent - first_new;
-    active_ = true;
-  }
-  Vec4 apply(double t, const Vec4& command) {
-    if (!active_) return command;
-    const double s = blend_time_ > 0 ? (t - t_switch_) / blend_time_ : 1.0;
-    if (s >= 1) {
-      active_ = false;
-      return command;
-    }
-    return command + offset_ * (1 - (s < 0 ? 0 : s));
-  }
-  bool active() const { return active_; }
-
- private:
-  double blend_time_;
-  double t_switch_ = 0;
-  bool active_ = false;
-  Vec4 offset_ = Vec4::Zero();
-};
-
-}  // namespace exc::control
+}  // namespace exc::safety

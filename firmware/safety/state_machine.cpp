@@ -1,6 +1,6 @@
-#include "control/state_machine.hpp"
+#include "safety/state_machine.hpp"
 
-namespace exc::control {
+namespace exc::safety {
 
 const char* to_string(Mode m) {
   switch (m) {
@@ -13,4 +13,4 @@ const char* to_string(Mode m) {
   return "unknown";
 }
 
-}  // namespace exc::control
+}  // namespace exc::safety

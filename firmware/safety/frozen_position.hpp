@@ -19,10 +19,10 @@
 #include <cmath>
 #include <cstdint>
 
-#include "control/velocity_plausibility.hpp"
+#include "safety/velocity_plausibility.hpp"
 #include "model/types.hpp"
 
-namespace exc::control {
+namespace exc::safety {
 
 class FrozenPosition {
  public:
@@ -56,4 +56,4 @@ class FrozenPosition {
   Eigen::Vector4i run_ = Eigen::Vector4i::Zero();
 };
 
-}  // namespace exc::control
+}  // namespace exc::safety

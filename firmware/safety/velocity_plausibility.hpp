@@ -27,7 +27,7 @@
 
 #include "model/types.hpp"
 
-namespace exc::control {
+namespace exc::safety {
 
 struct PlausibilitySettings {
   bool enabled = true;  // the tracking fault (the sums run regardless: the standstill monitor uses them)
@@ -126,4 +126,4 @@ class VelocityPlausibility {
   Eigen::Vector4i run_ = Eigen::Vector4i::Zero();
 };
 
-}  // namespace exc::control
+}  // namespace exc::safety

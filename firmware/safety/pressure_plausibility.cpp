@@ -1,7 +1,7 @@
 // The pressure monitor's limits from the nominal machine's hydraulics section (start-up).
-#include "control/pressure_plausibility.hpp"
+#include "safety/pressure_plausibility.hpp"
 
-namespace exc::control {
+namespace exc::safety {
 
 const char* to_string(PressureTest test) {
   switch (test) {
@@ -43,4 +43,4 @@ PressureLimits pressure_limits(const Machine& nominal, const PressurePlausibilit
   return l;
 }
 
-}  // namespace exc::control
+}  // namespace exc::safety

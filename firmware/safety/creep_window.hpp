@@ -14,7 +14,7 @@
 
 #include "model/types.hpp"
 
-namespace exc::app {
+namespace exc::safety {
 
 class CreepWindow {
  public:
@@ -60,4 +60,4 @@ class CreepWindow {
   bool started_ = false;
 };
 
-}  // namespace exc::app
+}  // namespace exc::safety
