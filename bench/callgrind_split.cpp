@@ -32,7 +32,7 @@ const std::vector<Stage>& loop_stages() {
        {"exc::control::ValveInnerLoop::from_force(", "exc::control::ValveInnerLoop::from_velocity("}},
       {"CAN write: CMD_PILOT (FirmwareCanPort::write)", 2, {"exc::hal::FirmwareCanPort::write("}},
       {"telemetry encode (publish_cycle, publish_counters)", 2,
-       {"exc::app::FirmwareNode::publish_cycle()", "exc::app::FirmwareNode::publish_counters()"}},
+       {"exc::app::FirmwareNode::publish_cycle(", "exc::app::FirmwareNode::publish_counters("}},
       {"across the nodes: exact on-wire frame time (frame_time_ns)", 0, {"exc::hal::frame_time_ns("}},
       {"across the nodes: frame encode (encode_message)", 0, {"exc::hal::encode_message("}},
       {"across the nodes: frame validate and decode (accept, decode_message)", 0,

@@ -1,32 +1,29 @@
 #pragma once
-// The firmware's 1 kHz cycle, wired (PX4 module style: the control law is a library, this only
-// wires bus, state machine, estimator, trajectory, controller and telemetry):
+// The firmware's 1 kHz cycle, wired (PX4 module style: the control law, the supervision and the
+// stages after the law are libraries; this wires bus, state machine and telemetry to them):
 //   begin_cycle(): send SYNC(k) (+ heartbeat)              -> the plant steps once and answers
-//   end_cycle():   read + validate sensors -> watchdog/state machine -> estimate -> trajectory
-//                  -> control law -> saturate/blend -> actuator-lag lead -> write commands
-//                  -> telemetry
+//   end_cycle():   read + validate sensors -> supervisor (operator, machine signals) -> state
+//                  machine -> estimate -> path -> control law -> supervisor's checks -> actuation
+//                  stage (blend and lag lead, or the valve stage) -> write commands -> telemetry
 // Time is the cycle count times the period, so a run is deterministic and the plant's time is the
 // firmware's. Nothing here allocates, locks or blocks after construction.
 #include <cmath>
 #include <cstdint>
 #include <memory>
 
-#include "model/actuator_friction.hpp"
-#include "control/actuator_lag_compensator.hpp"
-#include "control/command_blender.hpp"
-#include "control/path_clock.hpp"
+#include "app/loop_counters.hpp"
+#include "app/subnormal_scan.hpp"
+#include "app/tracking_metrics.hpp"
+#include "control/actuation_stage.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
+#include "control/path_clock.hpp"
 #include "control/perf_counter.hpp"
 #include "control/state_estimator.hpp"
 #include "control/task.hpp"
-#include "control/valve_inner_loop.hpp"
 #include "hal/can_ports.hpp"
-#include "app/can_stats_message.hpp"
-#include "app/subnormal_scan.hpp"
-#include "safety/supervisor.hpp"
-#include "app/tracking_metrics.hpp"
 #include "model/model.hpp"
+#include "safety/supervisor.hpp"
 
 namespace exc::telemetry {
 class TelemetryPublisher;
@@ -46,11 +43,6 @@ struct FirmwareNodeConfig {
   Vec6 theta_true = Vec6::Zero();
 };
 
-// Cycles between the node's counter messages (EXC_TIMING per stage, EXC_CAN_STATS).
-inline constexpr int kCounterPeriod = 100;
-// The stages the node publishes on EXC_TIMING each time (publish_counters): whole cycle, read, update,
-// write, telemetry encode; a real-time loop adds its wake-up interval.
-inline constexpr int kTimingStages = 5;
 class FirmwareNode {
  public:
   FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
@@ -117,35 +109,29 @@ class FirmwareNode {
   bool has_sensors() const { return have_valid_; }  // a complete, valid sensor set arrived at least once
   const control::ControlOutput& last_output() const { return out_; }
   // The valve stage's last command (valve interface; zeros otherwise).
-  const control::ValveCommand& last_valve_command() const { return valves_.last(); }
+  const control::ValveCommand& last_valve_command() const { return stage_.last_valve_command(); }
   bool valve_interface() const { return config_.controller.command_interface == control::CommandInterface::valve; }
   const hal::CommandState& last_command() const { return command_; }
-  // The control computation (estimate, path, law, the stages after it and the monitors), the whole
-  // end_cycle (read, compute, write, telemetry encoding with the counter messages every 100 cycles),
-  // and a real-time loop's wake-up interval.
-  const control::PerfCounter& control_timing() const { return control_timing_; }
-  const control::PerfCounter& cycle_timing() const { return cycle_timing_; }
-  const control::PerfCounter& interval_timing() const { return interval_timing_; }
+  // The loop's timing counters by stage (loop_counters.hpp); the control computation (estimate, path,
+  // law, the stages after it and the monitors), the whole end_cycle and a real-time loop's interval.
+  const LoopCounters& counters() const { return counters_; }
+  const control::PerfCounter& control_timing() const { return counters_.update; }
+  const control::PerfCounter& cycle_timing() const { return counters_.cycle; }
+  const control::PerfCounter& interval_timing() const { return counters_.interval; }
 
  private:
+  // The state machine's step for this cycle's inputs, what the transition changes (the path, the
+  // hold, the latched stop) and the standstill monitor of a standing stop.
+  safety::Transition step_mode(const safety::CycleInputs& in);
+  // The command of the mode: centred valves, or estimate, path, law and the stages after it, with
+  // the supervisor's checks of each.
   void compute_command(const safety::Transition& transition);
-  void centre_valves();
-  // The efforts the machine applied over the last cycle as far as the firmware knows them: measured
-  // (valve interface, from the pressures) or the delivered-effort model of the last command.
-  control::AppliedEffort applied_effort() const;
-  // The nominal machine's seal friction at velocity v and these chamber pressures (actuator_friction.hpp).
-  Vec4 seal_friction(const Vec4& v, const Vec4& p_a, const Vec4& p_b) const;
-  // The valve interface: the law's effort through the force loop (or a flow law's velocity) to the
-  // spools' pilot pressures.
-  void command_valves(const Vec4& q);
-  safety::FlowMeasurement flow_measurement() const;
   void send_stop_frame();
-  void publish_cycle();
-  void publish_events();
+  // The cycle's telemetry: the supervisor's fault events, EXC_COMMAND, EXC_CONTROLLER, a transition's
+  // EXC_FAULT and every kCounterPeriod cycles the counters.
+  void publish_cycle(const safety::Transition& transition);
   void publish_fault(safety::FirmwareFault code, std::int8_t severity, bool active, const char* text);
 
-  const Model& model_;
-  ActuatorFriction friction_;  // the nominal machine's (start-up)
   const control::Task& task_;
   FirmwareNodeConfig config_;
   hal::FirmwareCanPort& port_;
@@ -156,13 +142,8 @@ class FirmwareNode {
   safety::ControlStateMachine machine_;
   safety::Supervisor supervisor_;
   control::PathClock path_;
-  control::CommandBlender blender_;
-  control::ActuatorLagCompensator lag_compensator_;
-  control::ValveInnerLoop valves_;
-  control::PerfCounter control_timing_, cycle_timing_;
-  control::PerfCounter read_timing_, write_timing_, telemetry_timing_, interval_timing_;
-  std::uint64_t deadline_overruns_ = 0, skipped_deadlines_ = 0;
-  BusLoadWindow bus_load_;
+  control::ActuationStage stage_;
+  LoopCounters counters_;
 
   double period_;
   std::uint64_t cycle_ = 0;
@@ -178,7 +159,6 @@ class FirmwareNode {
   bool safe_command_sent_ = false;
   Vec4 held_q_ = Vec4::Zero();
   Vec4 q_d_ = Vec4::Zero(), qd_d_ = Vec4::Zero(), qdd_d_ = Vec4::Zero();
-  Vec4 last_sent_ = Vec4::Zero();
   hal::SensorState sensors_;
   hal::CommandState command_;
   control::ControlOutput out_;

@@ -86,10 +86,27 @@ class StateVisitor {
   void visit(const char* name, const Eigen::PlainObjectBase<Derived>& values) {
     visit(name, values.data(), static_cast<std::size_t>(values.size()));
   }
+  void visit(const char* name, const double& value) { visit(name, &value, 1); }
 
  protected:
   ~StateVisitor() = default;
 };
+
+// A law's output, which the node keeps from one cycle to the next.
+inline void visit_state(const ControlOutput& out, StateVisitor& v) {
+  v.visit("law tau", out.tau);
+  v.visit("law tau_unsaturated", out.tau_unsaturated);
+  v.visit("law e", out.e);
+  v.visit("law ed", out.ed);
+  v.visit("law theta_hat", out.theta_hat);
+  v.visit("law lyapunov", out.lyapunov);
+  v.visit("law lyapunov_tracking", out.lyapunov_tracking);
+  v.visit("law rho", out.rho);
+  v.visit("law rho_env", out.rho_env);
+  v.visit("law velocity (flow law)", out.velocity);
+  v.visit("law disturbance (observer)", out.disturbance);
+  v.visit("law tip_force", out.tip_force);
+}
 
 class Controller {
  public:

@@ -10,6 +10,7 @@
 // Fixed-size state, no allocation.
 #include <cmath>
 
+#include "control/control_types.hpp"
 #include "model/types.hpp"
 
 namespace exc::control {
@@ -144,6 +145,12 @@ class StateEstimator {
   const Vec4& position() const { return q_; }
   const Vec4& velocity() const { return v_; }
   const Vec4& acceleration() const { return a_; }
+  // The filters' memory is these outputs and the inputs, one cycle back.
+  void visit_state(StateVisitor& v) const {
+    v.visit("estimator position", q_);
+    v.visit("estimator velocity (Butterworth)", v_);
+    v.visit("estimator acceleration (filtered derivative)", a_);
+  }
   const EstimatorConfig& config() const { return config_; }
 
  private:

@@ -1,0 +1,56 @@
+#pragma once
+// The firmware loop's timing counters, PX4 perf_counter style: one per stage of end_cycle, the
+// whole cycle and a real-time loop's wake-up interval, each published on EXC_TIMING under its stage
+// number (lcmtypes/timing_t.lcm), with the bus's counts and load on EXC_CAN_STATS. Read from
+// hal::monotonic_now_ns: nanoseconds on a host, instructions on the emulated Cortex-M7 (whose clock
+// counts one nanosecond per instruction: docs/target.md).
+#include <cstdint>
+
+#include "app/can_stats_message.hpp"
+#include "control/perf_counter.hpp"
+#include "hal/can_ports.hpp"
+
+namespace exc::telemetry {
+class TelemetryPublisher;
+}
+
+namespace exc::app {
+
+// Cycles between the counter messages (EXC_TIMING per stage, EXC_CAN_STATS).
+inline constexpr int kCounterPeriod = 100;
+
+// timing_t.stage of each counter.
+enum class LoopStage : std::int8_t {
+  cycle = 0,      // the whole end_cycle: read to telemetry encoded
+  read = 1,       // the bus read and the supervisor's take of the operator's and the machine's signals
+  update = 2,     // estimate, path, law, the stages after it and the monitors (7 to 10 together)
+  write = 3,      // the command frames encoded and sent
+  interval = 5,   // a real-time loop's wake-up to wake-up
+  telemetry = 6,  // the cycle's messages encoded
+  estimate = 7,   // the state estimator and the path's desired motion
+  law = 8,        // the control law
+  actuation = 9,  // the stages after the law: blend and lag lead, or the valve stage
+  monitors = 10,  // the supervisor's checks of the law's output, the pressures and the flow
+};
+
+// The stages published each time, the interval aside (it is published once a real-time loop has one).
+inline constexpr int kTimingStages = 9;
+
+struct LoopCounters {
+  explicit LoopCounters(double period);
+  control::PerfCounter& operator[](LoopStage s) { return counter(s); }
+  const control::PerfCounter& operator[](LoopStage s) const { return const_cast<LoopCounters*>(this)->counter(s); }
+
+  // Publishes every stage that has samples (the interval with the sleeper's deadline counters) and
+  // the bus's counts: window_end is the end of the bus-load window (s), utime the messages' stamp.
+  void publish(telemetry::TelemetryPublisher& telemetry, const hal::FirmwareCanPort& port, double window_end, std::int64_t utime);
+
+  control::PerfCounter cycle, read, update, write, interval, telemetry, estimate, law, actuation, monitors;
+  std::uint64_t deadline_overruns = 0, skipped_deadlines = 0;  // the real-time sleeper's, as last reported
+
+ private:
+  control::PerfCounter& counter(LoopStage s);
+  BusLoadWindow bus_load_;
+};
+
+}  // namespace exc::app
