@@ -10,7 +10,7 @@
 #include "exlcm/fault_t.hpp"
 #include "hal/can_protocol.hpp"
 #include "hal/clock.hpp"
-#include "telemetry/telemetry_publisher.hpp"
+#include "telemetry/telemetry_sink.hpp"
 
 namespace exc::app {
 namespace {
@@ -47,7 +47,7 @@ safety::SupervisorSettings supervisor_settings(const control::ControllerConfig& 
 }  // namespace
 
 FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
-                           hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry)
+                           hal::FirmwareCanPort& port, telemetry::TelemetrySink* telemetry)
     : task_(task),
       config_(config),
       port_(port),

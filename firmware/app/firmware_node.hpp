@@ -26,7 +26,7 @@
 #include "safety/supervisor.hpp"
 
 namespace exc::telemetry {
-class TelemetryPublisher;
+class TelemetrySink;
 }
 
 namespace exc::app {
@@ -46,7 +46,7 @@ struct FirmwareNodeConfig {
 class FirmwareNode {
  public:
   FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
-               hal::FirmwareCanPort& port, telemetry::TelemetryPublisher* telemetry);
+               hal::FirmwareCanPort& port, telemetry::TelemetrySink* telemetry);
   ~FirmwareNode();
   FirmwareNode(const FirmwareNode&) = delete;
   FirmwareNode& operator=(const FirmwareNode&) = delete;
@@ -135,7 +135,7 @@ class FirmwareNode {
   const control::Task& task_;
   FirmwareNodeConfig config_;
   hal::FirmwareCanPort& port_;
-  telemetry::TelemetryPublisher* telemetry_;
+  telemetry::TelemetrySink* telemetry_;
   std::unique_ptr<control::Controller> controller_;
   std::int8_t controller_id_;  // the law's number in telemetry (ControllerRegistry::id_of)
   control::StateEstimator estimator_;

@@ -2,7 +2,7 @@
 
 #include "app/timing_message.hpp"
 #include "exlcm/timing_t.hpp"
-#include "telemetry/telemetry_publisher.hpp"
+#include "telemetry/telemetry_sink.hpp"
 
 namespace exc::app {
 
@@ -34,7 +34,7 @@ control::PerfCounter& LoopCounters::counter(LoopStage s) {
   return cycle;
 }
 
-void LoopCounters::publish(telemetry::TelemetryPublisher& out, const hal::FirmwareCanPort& port, double window_end, std::int64_t utime) {
+void LoopCounters::publish(telemetry::TelemetrySink& out, const hal::FirmwareCanPort& port, double window_end, std::int64_t utime) {
   exlcm::timing_t m{};
   for (const LoopStage s : {LoopStage::cycle, LoopStage::read, LoopStage::update, LoopStage::write, LoopStage::telemetry,
                             LoopStage::estimate, LoopStage::law, LoopStage::actuation, LoopStage::monitors}) {

@@ -11,7 +11,7 @@
 #include "hal/can_ports.hpp"
 
 namespace exc::telemetry {
-class TelemetryPublisher;
+class TelemetrySink;
 }
 
 namespace exc::app {
@@ -43,7 +43,7 @@ struct LoopCounters {
 
   // Publishes every stage that has samples (the interval with the sleeper's deadline counters) and
   // the bus's counts: window_end is the end of the bus-load window (s), utime the messages' stamp.
-  void publish(telemetry::TelemetryPublisher& telemetry, const hal::FirmwareCanPort& port, double window_end, std::int64_t utime);
+  void publish(telemetry::TelemetrySink& telemetry, const hal::FirmwareCanPort& port, double window_end, std::int64_t utime);
 
   control::PerfCounter cycle, read, update, write, interval, telemetry, estimate, law, actuation, monitors;
   std::uint64_t deadline_overruns = 0, skipped_deadlines = 0;  // the real-time sleeper's, as last reported

@@ -30,14 +30,14 @@ const char* to_string(OverflowPolicy policy) {
 }
 
 TelemetryPublisher::TelemetryPublisher(TelemetryConfig config)
-    : config_(std::move(config)),
+    : TelemetrySink(config.per_cycle_every),
+      config_(std::move(config)),
       ring_storage_(std::make_unique<Ring>()),
       ring_(*ring_storage_),
       message_(std::make_unique<Ring::Message>()) {
   for (std::size_t i = 0; i < channel_count; ++i) {
     channel_names_[i] =
         std::string(channel_base_name(static_cast<Channel>(i))) + config_.channel_suffix;
-    every_[i] = per_cycle(static_cast<Channel>(i)) ? std::max<std::uint32_t>(1, config_.per_cycle_every) : 1;
   }
 }
 

@@ -16,6 +16,7 @@
 #include "telemetry/lcm_output.hpp"
 #include "telemetry/spsc_ring.hpp"
 #include "telemetry/telemetry_channels.hpp"
+#include "telemetry/telemetry_sink.hpp"
 
 namespace exc::telemetry {
 
@@ -67,11 +68,11 @@ struct TelemetryCounters {
   std::uint64_t publish_errors = 0;     // lcm_publish calls that failed
 };
 
-class TelemetryPublisher {
+class TelemetryPublisher final : public TelemetrySink {
  public:
   // 1 KiB slots hold every exlcm type (timing_t, the largest, is 593 bytes); 1024 slots buffer
   // about a quarter of a second of the loop's ~4 messages per cycle.
-  using Ring = SpscRing<1024, 1024>;
+  using Ring = SpscRing<1024, TelemetrySink::kMaxMessageBytes>;
 
   explicit TelemetryPublisher(TelemetryConfig config);
   ~TelemetryPublisher();  // stop()
@@ -85,28 +86,6 @@ class TelemetryPublisher {
   // the provider (a log file not shared with another publisher is closed).
   void stop();
 
-  // Allocation-free. Sets msg.seq to this channel's next sequence number (0, 1, 2, ...) and enqueues
-  // its encoding. A full ring waits (block: not for real-time loops) or refuses the message and
-  // counts it (drop_newest). Returns false if it was refused.
-  template <class Msg>
-  bool publish(Channel channel, Msg msg) {
-    const auto index = static_cast<std::size_t>(channel);
-    if (index >= channel_count) return false;
-    if (every_[index] > 1 && offered_[index]++ % every_[index] != 0) return true;  // left out on purpose
-    msg.seq = static_cast<std::int64_t>(next_sequence_[index]++);
-    const int size = msg.encode(encode_buffer_.data(), 0, static_cast<int>(Ring::slot_bytes));
-    if (size < 0) {
-      ring_.note_too_large();
-      return false;
-    }
-    if (ring_.full() && !make_room()) {
-      dropped_full_[index].fetch_add(1, std::memory_order_relaxed);
-      return false;
-    }
-    return ring_.push(static_cast<std::uint16_t>(index), encode_buffer_.data(),
-                      static_cast<std::size_t>(size));
-  }
-
   TelemetryCounters counters() const;
   // The full LCM channel name, suffix included.
   const std::string& channel_name(Channel channel) const {
@@ -114,6 +93,16 @@ class TelemetryPublisher {
   }
 
  private:
+  // The loop's encoded message into the ring: a full ring waits (block: not for real-time loops) or
+  // refuses the message and counts it (drop_newest).
+  bool put(std::size_t channel, const std::uint8_t* bytes, std::size_t size) override {
+    if (ring_.full() && !make_room()) {
+      dropped_full_[channel].fetch_add(1, std::memory_order_relaxed);
+      return false;
+    }
+    return ring_.push(static_cast<std::uint16_t>(channel), bytes, size);
+  }
+  void note_too_large() override { ring_.note_too_large(); }
   void run();
   // Ring full: with `block` and a running thread, waits until there is room (true); else false.
   bool make_room();
@@ -125,11 +114,6 @@ class TelemetryPublisher {
   std::array<std::string, channel_count> channel_names_;
   std::unique_ptr<Ring> ring_storage_;  // ~1 MiB: on the heap, allocated once at construction
   Ring& ring_;
-  // Loop-side state (producer thread only).
-  std::array<std::uint64_t, channel_count> next_sequence_{};
-  std::array<std::uint64_t, channel_count> offered_{};  // messages offered per channel (per_cycle_every)
-  std::array<std::uint32_t, channel_count> every_{};    // record every Nth (1: all)
-  alignas(8) std::array<std::uint8_t, Ring::slot_bytes> encode_buffer_{};
   // Telemetry-thread state.
   std::shared_ptr<LcmOutput> output_;
   std::unique_ptr<Ring::Message> message_;

@@ -1,0 +1,59 @@
+#pragma once
+// The loop's side of telemetry: publish(channel, msg) stamps the channel's sequence number, leaves
+// out what a per-cycle decimation says to (per_cycle_every), encodes the message with the lcm-gen
+// encoder into a fixed buffer and hands the bytes to put(), which a sink implements: the host's
+// TelemetryPublisher (a lock-free ring drained into LCM by a thread), or the Cortex-M7 image's link
+// to the host (docs/target.md). No LCM library, no thread, no allocation: the encoders are lcm-gen's
+// header-only C++.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "telemetry/telemetry_channels.hpp"
+
+namespace exc::telemetry {
+
+class TelemetrySink {
+ public:
+  // The largest encoding a sink takes (timing_t, the largest exlcm type, is 593 bytes).
+  static constexpr std::size_t kMaxMessageBytes = 1024;
+
+  // Allocation-free. Sets msg.seq to this channel's next sequence number (0, 1, 2, ...) and hands its
+  // encoding to the sink; false if it was refused (too large, or the sink was full).
+  template <class Msg>
+  bool publish(Channel channel, Msg msg) {
+    const auto index = static_cast<std::size_t>(channel);
+    if (index >= channel_count) return false;
+    if (every_[index] > 1 && offered_[index]++ % every_[index] != 0) return true;  // left out on purpose
+    msg.seq = static_cast<std::int64_t>(next_sequence_[index]++);
+    const int size = msg.encode(encode_buffer_.data(), 0, static_cast<int>(kMaxMessageBytes));
+    if (size < 0) {
+      note_too_large();
+      return false;
+    }
+    return put(index, encode_buffer_.data(), static_cast<std::size_t>(size));
+  }
+
+ protected:
+  // Record the per-cycle channels (per_cycle(): EXC_STATE, EXC_COMMAND, EXC_CONTROLLER) every Nth
+  // message only, from the first; the others whole. seq counts the recorded ones.
+  explicit TelemetrySink(std::uint32_t per_cycle_every) {
+    for (std::size_t i = 0; i < channel_count; ++i)
+      every_[i] = per_cycle(static_cast<Channel>(i)) && per_cycle_every > 1 ? per_cycle_every : 1;
+  }
+  ~TelemetrySink() = default;
+  TelemetrySink(const TelemetrySink&) = delete;
+  TelemetrySink& operator=(const TelemetrySink&) = delete;
+
+  // One encoded message of channel `channel` (its index): false when the sink refused it.
+  virtual bool put(std::size_t channel, const std::uint8_t* bytes, std::size_t size) = 0;
+  virtual void note_too_large() {}
+
+ private:
+  std::array<std::uint64_t, channel_count> next_sequence_{};
+  std::array<std::uint64_t, channel_count> offered_{};  // messages offered per channel (per_cycle_every)
+  std::array<std::uint32_t, channel_count> every_{};    // record every Nth (1: all)
+  alignas(8) std::array<std::uint8_t, kMaxMessageBytes> encode_buffer_{};
+};
+
+}  // namespace exc::telemetry
