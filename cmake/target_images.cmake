@@ -3,8 +3,13 @@
 # project of this one: configured and built with the outer build, through ccache when it compiles
 # through ccache. Its tools are Debian packages; a test build without them stops here and names them.
 #
-# Sets EXC_TARGET_SMOKE_IMAGE (the smoke image's ELF), EXC_QEMU_SYSTEM_ARM, EXC_ARM_OBJDUMP,
-# EXC_ARM_NM and EXC_ARM_SIZE for the tests.
+# The firmware's image compiles the cycle's own libraries' sources (their SOURCES, so a source added
+# to one of them is in the image too): included after those libraries are defined.
+#
+# Sets EXC_TARGET_SMOKE_IMAGE (the smoke image's ELF), EXC_TARGET_FIRMWARE_IMAGE (the firmware's),
+# EXC_QEMU_SYSTEM_ARM, EXC_ARM_OBJDUMP, EXC_ARM_NM and EXC_ARM_SIZE for the tests and the harness.
+# EXC_TARGET_IMAGES_REQUIRED (the test build): a missing tool stops the configuration; otherwise the
+# build goes on without images and says so.
 include(ExternalProject)
 
 find_program(EXC_TARGET_GXX arm-none-eabi-g++)
@@ -43,15 +48,40 @@ endif()
 if(_exc_target_missing)
   list(REMOVE_DUPLICATES _exc_target_missing)
   string(REPLACE ";" ", " _exc_target_missing "${_exc_target_missing}")
-  message(FATAL_ERROR "The test build runs the firmware's Cortex-M7 images under QEMU (docs/target.md) and "
-                      "misses the Debian packages: ${_exc_target_missing}. Install them with "
-                      "'tools/install-deps test' (or apt-get install the packages named).")
+  if(EXC_TARGET_IMAGES_REQUIRED)
+    message(FATAL_ERROR "The test build runs the firmware's Cortex-M7 images under QEMU (docs/target.md) and "
+                        "misses the Debian packages: ${_exc_target_missing}. Install them with "
+                        "'tools/install-deps test' (or apt-get install the packages named).")
+  endif()
+  message(STATUS "No Cortex-M7 firmware image (excavator-sim --firmware-target needs one): missing ${_exc_target_missing}; "
+                 "'tools/install-deps test' installs them")
+  return()
 endif()
+
+# The cycle's sources, absolute, from the libraries that hold them.
+set(_exc_firmware_sources "")
+foreach(_exc_lib exc_model exc_safety exc_control exc_settings_blob exc_firmware_cycle exc_hal_protocol)
+  get_target_property(_exc_dir ${_exc_lib} SOURCE_DIR)
+  get_target_property(_exc_sources ${_exc_lib} SOURCES)
+  foreach(_exc_s ${_exc_sources})
+    if(NOT IS_ABSOLUTE ${_exc_s})
+      set(_exc_s ${_exc_dir}/${_exc_s})
+    endif()
+    list(APPEND _exc_firmware_sources ${_exc_s})
+  endforeach()
+endforeach()
+string(REPLACE ";" "|" _exc_firmware_sources "${_exc_firmware_sources}")
+# The generated message headers (lcmtypes/) and, alone in a folder of its own, LCM's portable
+# lcm_coretypes.h that they include: the image sees no other host header.
+find_file(EXC_LCM_CORETYPES lcm/lcm_coretypes.h REQUIRED)
+set(_exc_lcm_core_dir ${CMAKE_BINARY_DIR}/target-include)
+configure_file(${EXC_LCM_CORETYPES} ${_exc_lcm_core_dir}/lcm/lcm_coretypes.h COPYONLY)
 
 get_target_property(_exc_eigen_includes Eigen3::Eigen INTERFACE_INCLUDE_DIRECTORIES)
 list(GET _exc_eigen_includes 0 _exc_eigen_include)
 set(_exc_target_binary_dir ${CMAKE_BINARY_DIR}/target-cortex-m7)
 set(EXC_TARGET_SMOKE_IMAGE ${_exc_target_binary_dir}/cortex_m7/cortex_m7_smoke.elf)
+set(EXC_TARGET_FIRMWARE_IMAGE ${_exc_target_binary_dir}/cortex_m7/cortex_m7_firmware.elf)
 ExternalProject_Add(exc_target_images
   SOURCE_DIR ${EXC_SOURCE_DIR}/target
   BINARY_DIR ${_exc_target_binary_dir}
@@ -60,9 +90,13 @@ ExternalProject_Add(exc_target_images
     -DEXC_ARM_GCC:FILEPATH=${EXC_TARGET_GCC}
     -DEXC_ARM_GXX:FILEPATH=${EXC_TARGET_GXX}
     -DEXC_EIGEN3_INCLUDE_DIR:PATH=${_exc_eigen_include}
+    -DEXC_FIRMWARE_SOURCES:STRING=${_exc_firmware_sources}
+    -DEXC_LCM_INCLUDE_DIRS:STRING=${CMAKE_BINARY_DIR}/lcmtypes|${_exc_lcm_core_dir}
     -DCMAKE_C_COMPILER_LAUNCHER:STRING=${CMAKE_C_COMPILER_LAUNCHER}
     -DCMAKE_CXX_COMPILER_LAUNCHER:STRING=${CMAKE_CXX_COMPILER_LAUNCHER}
   # The inner build decides what changed (a few seconds when nothing did).
   BUILD_ALWAYS ON
   INSTALL_COMMAND ""
-  BUILD_BYPRODUCTS ${EXC_TARGET_SMOKE_IMAGE})
+  LIST_SEPARATOR |
+  DEPENDS exc_lcmtypes_generate
+  BUILD_BYPRODUCTS ${EXC_TARGET_SMOKE_IMAGE} ${EXC_TARGET_FIRMWARE_IMAGE})

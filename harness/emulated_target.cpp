@@ -302,8 +302,10 @@ void EmulatedTarget::flush() {
   outbound_.clear();
 }
 
-std::vector<TargetRecord> EmulatedTarget::receive_until(std::uint8_t end_type) {
-  const std::string waiting_for = "a record of type " + hex_type(end_type) + " (the end of a batch)";
+std::vector<TargetRecord> EmulatedTarget::receive_until(std::uint8_t end_type, int other_end_type) {
+  const std::string waiting_for = "a record of type " + hex_type(end_type) +
+                                  (other_end_type >= 0 ? " or " + hex_type(static_cast<std::uint8_t>(other_end_type)) : std::string()) +
+                                  " (the end of a batch)";
   open_link(waiting_for);
   std::vector<TargetRecord> batch;
   const double deadline = now_s() + timeout_s_;
@@ -323,7 +325,7 @@ std::vector<TargetRecord> EmulatedTarget::receive_until(std::uint8_t end_type) {
         batch.push_back({v.type, std::vector<std::uint8_t>(v.payload, v.payload + v.payload_bytes)});
         last_type_ = v.type;
         last_bytes_ = v.payload_bytes;
-        if (v.type == end_type) {
+        if (v.type == end_type || v.type == other_end_type) {
           inbound_.erase(inbound_.begin(), inbound_.begin() + static_cast<std::ptrdiff_t>(inbound_begin_));
           inbound_begin_ = 0;
           return batch;

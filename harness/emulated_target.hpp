@@ -56,8 +56,9 @@ class EmulatedTarget {
   void send(std::uint8_t type, const std::vector<std::uint8_t>& payload) { send(type, payload.data(), payload.size()); }
   // Writes the outbound buffer into the target's FIFO (waiting, within the timeout, while it is full).
   void flush();
-  // Reads records until one of end_type, which is the last of those returned.
-  std::vector<TargetRecord> receive_until(std::uint8_t end_type);
+  // Reads records until one of end_type (or of other_end_type, when given), which is the last of
+  // those returned.
+  std::vector<TargetRecord> receive_until(std::uint8_t end_type, int other_end_type = -1);
 
   // Waits for QEMU to end and returns the target's exit status (its semihosting exit code).
   int wait_for_exit();

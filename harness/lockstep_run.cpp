@@ -14,6 +14,8 @@
 
 #include "app/allocation_counter.hpp"
 #include "app/firmware_node.hpp"
+#include "harness/firmware_end.hpp"
+#include "harness/target_firmware.hpp"
 #include "app/tracking_metrics.hpp"
 #include "hal/fault_injecting_bus.hpp"
 #include "hal/memory_bus.hpp"
@@ -184,12 +186,33 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
   fc.theta_true = theta_of(scene.soil);
   fc.wait_for_start = options.wait_for_start;
-  const Model firmware_model = build_model(firmware.machine);
-  app::FirmwareNode node(firmware_model, firmware.task, fc, firmware_port, publisher.get());
-  app::PlantNode plant_node(plant, plant_port, publisher.get());
-
   const double duration = options.duration > 0 ? options.duration : scene.duration;
   const std::int64_t cycles = lockstep_cycles(scene, options.duration);
+  const Model firmware_model = build_model(firmware.machine);
+  std::unique_ptr<FirmwareEnd> firmware_end_node;
+  if (options.firmware_target.empty()) {
+    firmware_end_node = std::make_unique<HostFirmware>(
+        std::make_unique<app::FirmwareNode>(firmware_model, firmware.task, fc, firmware_port, publisher.get()));
+  } else {
+    if (options.observer || options.node_observer)
+      throw std::invalid_argument("a run on " + options.firmware_target + " takes no observer of the in-process node");
+    const std::string image = options.firmware_image.empty() ? firmware_target_image(options.firmware_target) : options.firmware_image;
+    if (image.empty())
+      throw std::invalid_argument("--firmware-target " + options.firmware_target +
+                                  ": this build made no firmware image (configure with the Cortex-M7 toolchain: tools/install-deps "
+                                  "test, then cmake; or set EXC_FIRMWARE_IMAGE)");
+    app::FirmwareImageSettings settings;
+    settings.scene = scene.name;
+    settings.machine = firmware.machine;
+    settings.task = firmware.task;
+    settings.node = fc;
+    settings.cycles = cycles;
+    firmware_end_node = std::make_unique<TargetFirmware>(image, settings, firmware_end, publisher.get());
+  }
+  FirmwareEnd& fw = *firmware_end_node;
+  const app::FirmwareNode* const host_node = fw.node();  // null on a target
+  app::PlantNode plant_node(plant, plant_port, publisher.get());
+
   const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
   TrackingMetrics metrics;
   const auto wall_start = std::chrono::steady_clock::now();
@@ -242,8 +265,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         if (fault.kind == FaultSchedule::Kind::rock) plant.set_soil_stiffness_scale(fault_on ? fault.magnitude : 1.0);
         if (fault.kind == FaultSchedule::Kind::pump_loss) plant.set_pump_flow_scale(fault_on ? 1 - fault.magnitude : 1.0);
       }
-      if (k == last_begin) {
-        control_last_begin = node.control_timing();
+      if (k == last_begin && host_node != nullptr) {
+        control_last_begin = host_node->control_timing();
         plant_last_begin = plant_node.step_timing();
         last_taken = true;
       }
@@ -252,12 +275,14 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
           throw std::runtime_error("lockstep: the operator station's SUPERVISOR frame did not go out");
         ++next_supervisor;
       }
-      node.begin_cycle();
+      fw.begin_cycle();
       if (!plant_node.poll()) plant_node.coast();  // a SYNC lost in a burst: the machine moves on
-      node.end_cycle();
+      fw.end_cycle();
+      const app::CycleStatus& st = fw.status();
+      const Vec4 q_desired(st.q_desired[0], st.q_desired[1], st.q_desired[2], st.q_desired[3]);
       cycles_run = k + 1;
-      if (cycles_run == first_end) {
-        control_first_end = node.control_timing();
+      if (cycles_run == first_end && host_node != nullptr) {
+        control_first_end = host_node->control_timing();
         plant_first_end = plant_node.step_timing();
         first_taken = true;
       }
@@ -270,9 +295,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         result.peak_pressure = std::max(result.peak_pressure, s.hydraulics.max_pressure);
         result.min_pressure = std::min(result.min_pressure, s.hydraulics.min_pressure);
       }
-      if (node.tracking()) {
-        metrics.add(s.q_a, node.q_desired());
-        const double tt = node.task_time();
+      if (st.tracking) {
+        metrics.add(s.q_a, q_desired);
+        const double tt = st.task_time;
         const std::size_t c = starts.empty() ? 0
             : static_cast<std::size_t>(std::max<std::ptrdiff_t>(0, std::upper_bound(starts.begin(), starts.end(), tt) - starts.begin() - 1));
         CycleRecord& rec = cycles_acc[c];
@@ -280,23 +305,23 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
         rec.end = s.time;
         ++rec.samples;
         for (int j = 0; j < 4; ++j) {
-          const double e = s.q_a[j] - node.q_desired()[j];
+          const double e = s.q_a[j] - q_desired[j];
           cycle_sum_sq[c][j] += e * e;
           rec.max_error[j] = std::max(rec.max_error[j], std::abs(e));
         }
         rec.peak_soil_force = std::max(rec.peak_soil_force, s.soil_force.norm());
-        for (int i = 0; i < 6; ++i) rec.theta_hat[i] = node.last_output().theta_hat[i];
+        for (int i = 0; i < 6; ++i) rec.theta_hat[i] = st.theta_hat[i];
       }
-      if (result.first_safe_stop_time < 0 && node.supervisor().safe_stops() > 0) {
+      if (result.first_safe_stop_time < 0 && st.safe_stops > 0) {
         // The firmware's clock (the schedule's): the plant's lags it by every SYNC a burst dropped.
-        result.first_safe_stop_time = node.time();
-        result.first_fault_detected_time = node.supervisor().fault_detected_time();
-        result.first_fault_code = static_cast<int>(node.supervisor().last_fault());
+        result.first_safe_stop_time = static_cast<double>(st.cycle) * scene.cycle;
+        result.first_fault_detected_time = st.fault_detected_time;
+        result.first_fault_code = st.last_fault;
       }
-      if (options.observer) options.observer(k, plant, node);
-      if (options.node_observer) options.node_observer(k, plant_node, node);
+      if (options.observer) options.observer(k, plant, *host_node);
+      if (options.node_observer) options.node_observer(k, plant_node, *host_node);
       if (plant_node.failed()) break;
-      if (options.stop_at_safe_state && node.supervisor().safe_stops() > 0) break;
+      if (options.stop_at_safe_state && st.safe_stops > 0) break;
       if (options.progress && (k + 1) % progress_every == 0) {
         // On a terminal the line is redrawn in place; in a log, one line per tenth of the run.
         std::fprintf(stderr, interactive ? "\r  %-10s %5.1f / %.1f s simulated" : "  %-10s %5.1f / %.1f s simulated\n",
@@ -308,10 +333,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     // At rest from the first sample after the last that moved; never, if the last one moved.
     if (!moving_now) result.machine_at_rest_time = last_moving < 0 ? 0.0 : last_moving + scene.cycle;
   }
-  result.estop = node.supervisor().emergency_sent();
   result.cpu_seconds = thread_cpu_seconds() - cpu_start;
   if (options.progress && interactive) std::fprintf(stderr, "\n");
-  node.publish_counters();
+  const app::RunSummaryRecord outcome = fw.finish();
+  const app::CycleStatus& last = fw.status();
+  result.estop = outcome.emergency_sent;
   plant_node.publish_counters();
   if (publisher) {
     publisher->stop();
@@ -328,18 +354,19 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
   for (int j = 0; j < 4; ++j) {
     result.rms_error[j] = metrics.rms(j);
     result.max_error[j] = metrics.max_abs(j);
-    result.measured_rms_error[j] = node.measured_tracking().rms(j);
-    result.measured_max_error[j] = node.measured_tracking().max_abs(j);
+    result.measured_rms_error[j] = outcome.measured_rms[j];
+    result.measured_max_error[j] = outcome.measured_max[j];
   }
   const Vec6 truth = theta_of(scene.soil);
   for (int i = 0; i < 6; ++i) {
-    result.theta_hat[i] = node.last_output().theta_hat[i];
+    result.theta_hat[i] = last.theta_hat[i];
     result.theta_true[i] = truth[i];
   }
   result.reanchor_count = plant.state().reanchor_count;
-  result.control_step = timing_of(node.control_timing());
+  const control::PerfCounter control_timing = host_node != nullptr ? host_node->control_timing() : empty_counter;
+  result.control_step = timing_of(control_timing);
   if (!first_taken) {
-    control_first_end = node.control_timing();
+    control_first_end = control_timing;
     plant_first_end = plant_node.step_timing();
   }
   const double period = scene.cycle;
@@ -348,12 +375,13 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
                                      timing_between(empty_counter, plant_first_end)};
   if (last_taken)
     result.last_second = TimingWindow{static_cast<double>(last_begin) * period, static_cast<double>(cycles_run) * period,
-                                      timing_between(control_last_begin, node.control_timing()),
+                                      timing_between(control_last_begin, control_timing),
                                       timing_between(plant_last_begin, plant_node.step_timing())};
-  result.firmware_cycle = timing_of(node.cycle_timing());
-  result.heap_allocations_in_loop = allocations;
-  result.safe_stops = node.supervisor().safe_stops();
-  result.rx_rejected = firmware_port.rx_stats().rejected() + plant_port.rx_stats().rejected();
+  result.firmware_cycle = host_node != nullptr ? timing_of(host_node->cycle_timing()) : Timing{};
+  result.target = fw.target_figures();
+  result.heap_allocations_in_loop = result.target ? result.target->heap_calls_after_start_up : allocations;
+  result.safe_stops = last.safe_stops;
+  result.rx_rejected = (host_node != nullptr ? firmware_port.rx_stats().rejected() : outcome.rx_rejected) + plant_port.rx_stats().rejected();
   for (std::size_t c = 0; c < cycles_acc.size(); ++c) {
     CycleRecord& rec = cycles_acc[c];
     for (int j = 0; j < 4; ++j)
@@ -366,20 +394,21 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     result.flow_saturated_seconds = static_cast<double>(h.saturated_substeps) * step;
     result.relief_seconds = static_cast<double>(h.relief_substeps) * step;
     result.cavitation_seconds = static_cast<double>(h.cavitation_substeps) * step;
-    result.pump_limited_cycles = node.supervisor().pump_limited_cycles();
+    result.pump_limited_cycles = outcome.pump_limited_cycles;
   }
-  result.task_finished = node.trajectory_finished();
-  result.task_finish_time = node.finish_time();
+  result.task_finished = outcome.trajectory_finished;
+  result.task_finish_time = outcome.finish_time;
+  const char* const mode = safety::to_string(static_cast<safety::Mode>(outcome.mode));
   if (plant_node.failed()) {
     result.ok = false;
     result.failure = std::string("plant stopped: ") + plant.status().text();
-  } else if (node.supervisor().safe_stops() > 0) {
+  } else if (last.safe_stops > 0) {
     result.ok = false;
-    result.failure = "the firmware went to its safe state " + std::to_string(node.supervisor().safe_stops()) + " time(s), the last for " +
-                     node.supervisor().last_fault_text() + " (mode " + safety::to_string(node.mode()) + " at the end)";
+    result.failure = "the firmware went to its safe state " + std::to_string(last.safe_stops) + " time(s), the last for " +
+                     outcome.last_fault_text + " (mode " + mode + " at the end)";
   } else if (metrics.samples() == 0) {
     result.ok = false;
-    result.failure = std::string("the firmware never tracked (mode ") + safety::to_string(node.mode()) + ")";
+    result.failure = std::string("the firmware never tracked (mode ") + mode + ")";
   }
   return result;
 }

@@ -7,12 +7,14 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
 #include "harness/scene_source.hpp"
+#include "harness/target_figures.hpp"
 #include "control/controller_config.hpp"
 #include "hal/can_protocol.hpp"
 #include "settings/enum_table.hpp"
@@ -110,6 +112,10 @@ struct RunRecord {
   std::uint64_t pump_limited_cycles = 0;  // firmware cycles whose openings asked more than the pumps give
   bool task_finished = false;         // the task ran to its end (then the machine held its final pose)
   double task_finish_time = 0;        // s
+  // A run on an emulated target (LockstepOptions::firmware_target): the image's own figures. Its
+  // heap_allocations_in_loop are then the image's allocator calls after start-up, and the host's
+  // timing figures above are left empty (count 0): the host did not run the firmware.
+  std::optional<TargetFigures> target;
 };
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
@@ -188,6 +194,11 @@ struct LockstepOptions {
   // The run's floating-point mode (the thread's own is restored after it): flush_subnormals, the
   // loop's; ieee only to measure what it saves (docs/floating-point.md).
   app::FloatMode float_mode = app::FloatMode::flush_subnormals;
+  // Where the firmware runs: "" in this process, "cortex-m7" its image on the emulated Cortex-M7
+  // (processor in the loop, docs/target.md; firmware_image: the ELF, empty for this build's). The
+  // observers take the in-process node and are refused with a target.
+  std::string firmware_target;
+  std::string firmware_image;
 };
 
 // The cycles a run of `scene` lasts: `duration` s, or the scene's own duration when it is 0.

@@ -71,6 +71,7 @@ Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
     lo.telemetry = output;
     lo.log_every = options.log_every;
     lo.progress = options.progress;
+    lo.firmware_target = options.firmware_target;
     summary.runs.push_back(run_lockstep(bundle.scene, bundle.firmware, lo));
     summary.all_ok = summary.all_ok && summary.runs.back().ok;
   }

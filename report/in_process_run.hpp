@@ -18,6 +18,7 @@ struct RunOptions {
   std::string lcm_url;                   // empty: no telemetry
   std::uint32_t log_every = 1;           // the per-cycle channels every Nth cycle (LockstepOptions::log_every)
   bool progress = true;
+  std::string firmware_target;           // "": in this process; "cortex-m7": on the emulated target (LockstepOptions)
 };
 
 struct Summary {

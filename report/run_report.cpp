@@ -105,8 +105,41 @@ void print_summary(const Summary& summary, std::ostream& out) {
                     "in %llu cycles); reliefs open %.3f s; make-up at the vapour floor %.3f s\n",
                     "", r.min_pressure * 1e-6, r.peak_pressure * 1e-6, r.flow_saturated_seconds,
                     static_cast<unsigned long long>(r.pump_limited_cycles), r.relief_seconds, r.cavitation_seconds);
+    if (r.target) {
+      const TargetFigures& t = *r.target;
+      out << format("%-10s on %s: instructions per cycle median %llu, p99 %llu, max %llu (cycle %llu); per stage (max):", "",
+                    t.name.c_str(), static_cast<unsigned long long>(t.per_cycle().median),
+                    static_cast<unsigned long long>(t.per_cycle().p99), static_cast<unsigned long long>(t.per_cycle().max),
+                    static_cast<unsigned long long>(t.worst_cycle));
+      for (int s = 0; s + 1 < app::kTargetStages; ++s)
+        out << format(" %s %llu", app::kTargetStageNames[s], static_cast<unsigned long long>(t.stages[static_cast<std::size_t>(s)].max));
+      out << format("; stack %llu of %llu bytes; flash %llu bytes, RAM %llu bytes; heap calls after start-up %llu\n",
+                    static_cast<unsigned long long>(t.stack_bytes), static_cast<unsigned long long>(t.stack_size_bytes),
+                    static_cast<unsigned long long>(t.flash_bytes), static_cast<unsigned long long>(t.ram_bytes),
+                    static_cast<unsigned long long>(t.heap_calls_after_start_up));
+    }
     if (!r.ok) out << "  FAILED: " << r.failure << "\n";
   }
+}
+
+// A run on an emulated target: the image's instructions per cycle and per stage, stack, size, heap.
+nlohmann::json target_json(const TargetFigures& t) {
+  auto figures = [](const InstructionFigures& f) {
+    return nlohmann::json{{"median", f.median}, {"p99", f.p99}, {"max", f.max}, {"cycles", f.cycles}};
+  };
+  nlohmann::json stages;
+  for (int s = 0; s + 1 < app::kTargetStages; ++s) stages[app::kTargetStageNames[s]] = figures(t.stages[static_cast<std::size_t>(s)]);
+  return {{"name", t.name},
+          {"image", t.image},
+          {"instructions_per_cycle", figures(t.per_cycle())},
+          {"worst_cycle", t.worst_cycle},
+          {"instructions_per_stage", stages},
+          {"stack_bytes", t.stack_bytes},
+          {"stack_size_bytes", t.stack_size_bytes},
+          {"flash_bytes", t.flash_bytes},
+          {"ram_bytes", t.ram_bytes},
+          {"heap_calls_after_start_up", t.heap_calls_after_start_up},
+          {"start_up_instructions", t.start_up_instructions}};
 }
 
 nlohmann::json to_json(const Summary& summary) {
@@ -150,6 +183,7 @@ nlohmann::json to_json(const Summary& summary) {
                            {"cavitation_seconds", r.cavitation_seconds}};
     run["task_finished"] = r.task_finished;
     if (r.task_finished) run["task_finish_time"] = r.task_finish_time;
+    if (r.target) run["target"] = target_json(*r.target);
     nlohmann::json cycles = nlohmann::json::array();
     for (const CycleRecord& k : r.cycles) {
       nlohmann::json theta;

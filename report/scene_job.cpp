@@ -1,5 +1,7 @@
 #include "scene_job.hpp"
 
+#include "harness/target_firmware.hpp"
+
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 
@@ -93,6 +95,15 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
   options.duration_override = job.duration;
   options.progress = job.progress;
   options.log_every = job.log_every;
+  options.firmware_target = job.firmware_target;
+  // A target without its image is refused before anything runs or is written.
+  if (!job.firmware_target.empty()) {
+    const std::string image = firmware_target_image(job.firmware_target);
+    if (image.empty() || !std::filesystem::exists(image))
+      throw std::invalid_argument("--firmware-target " + job.firmware_target + ": no firmware image" +
+                                  (image.empty() ? std::string(" was built (configure with the Cortex-M7 toolchain: tools/install-deps test, then cmake)")
+                                                 : " at " + image + " (build it: cmake --build <build> --target exc_target_images)"));
+  }
   // Which controllers: --controller, else the scene's controller.type, else the registry's default set
   // (the paper's comparison, and on a valve-commanded machine the industry's flow-based baseline beside it).
   const control::ControllerConfig& cc = bundle.firmware.controller;

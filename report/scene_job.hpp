@@ -23,6 +23,7 @@ struct SceneJob {
   std::uint32_t log_every = 1;           // the per-cycle channels every Nth cycle (--log-every)
   bool report = true;
   bool progress = true;
+  std::string firmware_target;           // --firmware-target: "" in this process, "cortex-m7" on the emulated target
 };
 
 // A scene job loaded and sized, before anything is run or written.

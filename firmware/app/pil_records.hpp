@@ -7,10 +7,11 @@
 //   host   settings_chunk ... settings_end                  the settings blob, in pieces
 //   target ready | refused (text)                           the blob checked at boot
 //   per cycle k:
+//   host   begin                                            the harness's cycle k begins
 //   target frame ... awaiting_inputs                        begin_cycle: SYNC (and heartbeat, stop)
 //   host   frame ... inputs_done                            the plant's answer and the operator's frames
 //   target frame ... telemetry ... cycle_done (status)      end_cycle: commands, messages, the cycle's state
-//   host   run_end                                          instead of the inputs: the run is over
+//   host   run_end begin                                    the run is over (no cycle begins)
 //   target telemetry ... summary                            the last counters, the run's outcome; exit 0
 #include <cstddef>
 #include <cstdint>
@@ -27,6 +28,7 @@ enum class PilRecord : std::uint8_t {
   frame_in = 0x03,
   inputs_done = 0x04,
   run_end = 0x05,
+  begin = 0x06,
   // target to host
   ready = 0x10,
   refused = 0x11,
@@ -203,6 +205,7 @@ struct RunSummaryRecord {
   char last_fault_text[160] = "";
   std::uint64_t heap_calls_after_start_up = 0;
   std::uint64_t stack_bytes_used = 0;  // high-water mark of the painted stack
+  std::uint64_t heap_bytes_used = 0;   // the heap's break: what start-up took of it
   std::uint64_t start_up_instructions = 0;
 };
 
@@ -220,6 +223,7 @@ inline std::size_t encode_summary(const RunSummaryRecord& s, std::uint8_t* out, 
   w.bytes(s.last_fault_text, sizeof s.last_fault_text);
   w.u64(s.heap_calls_after_start_up);
   w.u64(s.stack_bytes_used);
+  w.u64(s.heap_bytes_used);
   w.u64(s.start_up_instructions);
   return w.ok() ? w.size() : 0;
 }
@@ -238,6 +242,7 @@ inline bool decode_summary(const std::uint8_t* in, std::size_t n, RunSummaryReco
   s.last_fault_text[sizeof s.last_fault_text - 1] = 0;
   s.heap_calls_after_start_up = r.u64();
   s.stack_bytes_used = r.u64();
+  s.heap_bytes_used = r.u64();
   s.start_up_instructions = r.u64();
   return r.done();
 }

@@ -20,13 +20,14 @@ class PerfCounter {
 
   void reset() {
     count_ = overruns_ = 0;
-    sum_us_ = 0;
+    sum_us_ = last_us_ = 0;
     min_us_ = std::numeric_limits<double>::infinity();
     max_us_ = 0;
     histogram_.fill(0);
   }
 
   void record_us(double us) {
+    last_us_ = us;
     ++count_;
     sum_us_ += us;
     min_us_ = std::min(min_us_, us);
@@ -42,6 +43,7 @@ class PerfCounter {
   std::uint64_t overruns() const { return overruns_; }
   double min_us() const { return count_ ? min_us_ : 0; }
   double max_us() const { return max_us_; }
+  double last_us() const { return last_us_; }  // the latest sample (0 before any)
   double mean_us() const { return count_ ? sum_us_ / static_cast<double>(count_) : 0; }
   // Upper edge of the bucket holding the given fraction (0..1) of the samples: a conservative
   // (at most 5 % high) percentile, capped by the exact max.
@@ -80,6 +82,7 @@ class PerfCounter {
   const char* name_;
   double budget_us_;
   std::uint64_t count_ = 0, overruns_ = 0;
+  double last_us_ = 0;
   double sum_us_ = 0;
   double min_us_ = std::numeric_limits<double>::infinity();
   double max_us_ = 0;

@@ -34,6 +34,23 @@ class TelemetrySink {
     return put(index, encode_buffer_.data(), static_cast<std::size_t>(size));
   }
 
+  // An already encoded exlcm message (another sink's, e.g. an emulated target's over its link), stamped
+  // with this sink's sequence number for its channel and handed on as publish() does: one sequence
+  // per channel in a log, whoever encoded the messages. seq is every exlcm type's third field, after
+  // the 8-byte fingerprint and utime: bytes 16-23, big-endian.
+  bool publish_encoded(Channel channel, std::uint8_t* bytes, std::size_t size) {
+    const auto index = static_cast<std::size_t>(channel);
+    if (index >= channel_count || size < 24) return false;
+    if (size > kMaxMessageBytes) {
+      note_too_large();
+      return false;
+    }
+    if (every_[index] > 1 && offered_[index]++ % every_[index] != 0) return true;
+    const std::uint64_t seq = next_sequence_[index]++;
+    for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<std::uint8_t>(seq >> (56 - 8 * i));
+    return put(index, bytes, size);
+  }
+
  protected:
   // Record the per-cycle channels (per_cycle(): EXC_STATE, EXC_COMMAND, EXC_CONTROLLER) every Nth
   // message only, from the first; the others whole. seq counts the recorded ones.

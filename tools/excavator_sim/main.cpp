@@ -70,6 +70,11 @@ int main(int argc, char** argv) {
       "run's log (default 1: every cycle; the other channels are always whole)";
   run->add_option("--log-every", log_every, log_every_help)
       ->check(exc::cli::count_in(1, exc::telemetry::kMaxPerCycleEvery));
+  std::string firmware_target;
+  run->add_option("--firmware-target", firmware_target,
+                  "run the firmware on an emulated processor against the plant (processor in the loop): cortex-m7, its "
+                  "image under QEMU (docs/target.md); the summary adds the image's instructions per cycle and per stage")
+      ->check(CLI::IsMember({"cortex-m7"}));
   run->add_flag("--no-report", no_report, "skip the CSV export, plots and report page");
   run->add_flag("--quiet", quiet, "no progress output");
 
@@ -270,6 +275,7 @@ int main(int argc, char** argv) {
     job.log_every = log_every;
     job.report = !no_report;
     job.progress = !quiet;
+    job.firmware_target = firmware_target;
     return exc::sim::run_scene_job(job).exit_code;
   } catch (const std::exception& e) {
     std::cerr << "excavator-sim: " << e.what() << "\n";
