@@ -8,7 +8,9 @@
 #include "control/pump_pacing.hpp"
 #include "model/actuator_friction.hpp"
 #include "model/model.hpp"
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
+#include "control/controller_config_reader.hpp"
+#include "control/task_reader.hpp"
 
 namespace exc::app {
 namespace {

@@ -13,7 +13,7 @@
 #include "control/task.hpp"
 #include "model/machine.hpp"
 #include "model/terrain.hpp"
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
 #include "settings/document.hpp"
 
 namespace exc::app {

@@ -1,12 +1,12 @@
 #pragma once
 // The scene's `controller:` section (gains, Lyapunov weights, adaptation rates, soil-parameter
-// bounds, filter cut-offs, watchdog), parsed and validated at start-up. Every field is optional:
-// a scene without `controller:` gets the embedded defaults below (docs/control.md lists them); the
-// reader (controller_config.cpp) declares each field's unit and range once. Errors (SettingsError)
-// name the file, the line and column, the field and the allowed range. Start-up code: allocates.
+// bounds, filter cut-offs, watchdog) as the cycle takes it. Every field is optional: a scene without
+// `controller:` gets the embedded defaults below (docs/control.md lists them); the reader
+// (controller_config_reader.hpp) declares each field's unit and range once and validates them at
+// start-up on the host. Nothing here reads a file, so the firmware's image compiles it.
+#include <cstddef>
+#include <cstdint>
 #include <string>
-
-#include <yaml-cpp/yaml.h>
 
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
@@ -16,7 +16,7 @@
 #include "control/valve_inner_loop.hpp"
 #include "safety/velocity_plausibility.hpp"
 #include "model/machine.hpp"
-#include "settings/section_reader.hpp"
+#include "settings/enum_table.hpp"
 
 namespace exc::control {
 
@@ -175,13 +175,6 @@ inline constexpr double kTrackingLimitMultiple = 5;
 // The default tracking-error limit for a command interface (ControllerConfig::tracking_error_limit).
 Vec4 default_tracking_error_limit(CommandInterface interface);
 ControllerConfig controller_defaults(const Machine& nominal);
-// Reads the `controller:` section into c (a field the section does not give keeps c's value, which
-// is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
-// Hurwitz gains, ...).
-void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
-// The `controller:` section of a parsed scene file (absent: the defaults), the rest of the file left to
-// its readers: a sweep's case that changes only controller settings reads them again so.
-ControllerConfig read_controller_config(const settings::Document& scene, const Machine& nominal);
 // Through the valves eq. 27's default rates are the force-commanded machine's times this (period / T_f).
 double valve_adaptation_scale(const ControllerConfig& c);
 // Switches the command interface of a configuration (a bench variant on other actuators), carrying

@@ -1,14 +1,11 @@
 #pragma once
 // The machine description (pins, bodies, limits, hydraulics) as read from a machine file such as
-// machines/reference-20t.yaml. Loading validates every field; errors (SettingsError) name file,
-// line, column, field and reason. This is start-up code: it may allocate. Nothing built from it
-// allocates afterwards.
+// machines/reference-20t.yaml by machine_reader.hpp (which validates every field). The structs and
+// what the cycle asks of them; nothing here reads a file, so the firmware's image compiles it.
 #include <array>
 #include <string>
 #include <vector>
 
-#include "settings/document.hpp"
-#include "settings/settings_error.hpp"
 #include "types.hpp"
 
 namespace exc {
@@ -41,7 +38,7 @@ struct ReferencePose {
 // `hydraulics:` section, optional: a file without it gets these defaults). The plant runs the
 // circuit with its true machine's numbers; the firmware reads its nominal machine's (for a valve
 // loop). Plain numbers: unit, source and allowed range with each; the ranges are declared once, by
-// the reader in machine.cpp, which also checks a struct built in C++ (validate_hydraulics).
+// the reader in machine_reader.cpp, which also checks a struct built in C++ (validate_hydraulics).
 struct HydraulicParameters {
   // s, spool lag of the pilot-operated main valves (mobile valves: 30-100 ms). Range [0, 1].
   double valve_time_constant = 0.03;
@@ -193,22 +190,8 @@ struct Machine {
   Vec4 speed_max() const;
 };
 
-// Reads and validates a machine file (read and parsed once). Throws SettingsError.
-Machine load_machine(const std::string& path);
-// The same from a parsed machine file (or a tree of it with values set: a sweep's case).
-Machine read_machine(const settings::Document& machine_file);
-// Same, from YAML text; 'file_for_errors' is what errors name as the file.
-Machine load_machine_from_string(const std::string& yaml, const std::string& file_for_errors);
-// The reference machine compiled into the binary (same numbers as machines/reference-20t.yaml).
-Machine reference_machine();
-// The built-in machine's file as it was compiled in (what a sweep's digest covers for scenes without
-// a machine file).
-const char* reference_machine_text();
 // The hydraulics without dry friction and internal leakage, viscous friction kept: the machine as it
 // was modelled before them, for comparisons (the fidelity chart) and for tests of one element.
 HydraulicParameters without_dry_friction_and_leakage(HydraulicParameters p);
-// Checks hydraulics built or changed in C++ against the ranges the machine file's reader declares
-// (SettingsError naming machine.source and the field, e.g. "hydraulics.pump_flow").
-void validate_hydraulics(const Machine& machine);
 
 }  // namespace exc
