@@ -126,9 +126,25 @@ std::int64_t lockstep_cycles(const plant::Scene& scene, double duration) {
   return static_cast<std::int64_t>(std::llround((duration > 0 ? duration : scene.duration) / scene.cycle));
 }
 
+app::FirmwareImageSettings lockstep_image_settings(const plant::Scene& scene, const app::FirmwareSettings& firmware,
+                                                   const LockstepOptions& options) {
+  app::FirmwareNodeConfig fc;
+  fc.controller = firmware.controller;
+  fc.controller.law = options.controller;
+  fc.site_map = firmware.terrain;
+  fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
+  fc.theta_true = theta_of(scene.soil);
+  fc.wait_for_start = options.wait_for_start;
+  return app::image_settings(firmware, fc, options.duration > 0 ? options.duration : scene.duration);
+}
+
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
+  return run_lockstep(scene, lockstep_image_settings(scene, firmware, options), options);
+}
+
+RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettings& firmware, const LockstepOptions& options) {
   RunRecord result;
-  result.controller = options.controller;
+  result.controller = firmware.node.controller.law;
   // This thread runs the loop and starts the telemetry thread: subnormals flushed from here on, the
   // caller's mode back at the end (docs/floating-point.md).
   const app::LoopFloatModeScope float_mode(options.float_mode);
@@ -177,15 +193,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     if (!publisher->start(&error)) throw std::runtime_error("telemetry: " + error);
   }
 
-  app::FirmwareNodeConfig fc;
-  fc.controller = firmware.controller;
-  fc.controller.law = options.controller;
-  fc.site_map = firmware.terrain;
-  fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
-  fc.theta_true = theta_of(scene.soil);
-  fc.wait_for_start = options.wait_for_start;
   const Model firmware_model = build_model(firmware.machine);
-  app::FirmwareNode node(firmware_model, firmware.task, fc, firmware_port, publisher.get());
+  app::FirmwareNode node(firmware_model, firmware.task, firmware.node, firmware_port, publisher.get());
   app::PlantNode plant_node(plant, plant_port, publisher.get());
 
   const double duration = options.duration > 0 ? options.duration : scene.duration;

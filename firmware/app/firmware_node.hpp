@@ -23,6 +23,7 @@
 #include "control/valve_inner_loop.hpp"
 #include "hal/can_ports.hpp"
 #include "app/can_stats_message.hpp"
+#include "app/firmware_node_config.hpp"
 #include "app/subnormal_scan.hpp"
 #include "safety/supervisor.hpp"
 #include "app/tracking_metrics.hpp"
@@ -33,18 +34,6 @@ class TelemetryPublisher;
 }
 
 namespace exc::app {
-
-struct FirmwareNodeConfig {
-  control::ControllerConfig controller;  // its law names the control law the node runs
-  Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
-  double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
-  // Hold until an operator's start (SUPERVISOR Command = start) before tracking; false: the task
-  // starts by itself after track_delay (the default: runs without an operator station).
-  bool wait_for_start = false;
-  // Simulation only: the plant's true soil parameters, for telemetry and the Lyapunov value.
-  bool theta_known = false;
-  Vec6 theta_true = Vec6::Zero();
-};
 
 // Cycles between the node's counter messages (EXC_TIMING per stage, EXC_CAN_STATS).
 inline constexpr int kCounterPeriod = 100;

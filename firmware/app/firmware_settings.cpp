@@ -107,6 +107,16 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene) {
   return read_firmware_settings(scene, read_scene_machine(top, scene));
 }
 
+FirmwareImageSettings image_settings(const FirmwareSettings& settings, const FirmwareNodeConfig& node, double duration) {
+  FirmwareImageSettings image;
+  image.scene = settings.name;
+  image.machine = settings.machine;
+  image.task = settings.task;
+  image.node = node;
+  image.cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / node.controller.period));
+  return image;
+}
+
 FirmwareSettings load_firmware_settings(const std::string& path) {
   return read_firmware_settings(settings::Document::load(path));
 }

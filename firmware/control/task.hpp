@@ -60,4 +60,18 @@ struct Task {
   double timing_scale = 1;             // > 1 when fit_timing slowed the path down (times multiplied)
 };
 
+// The most work cycles a task has (task.repeat's upper bound), as the settings blob carries them.
+inline constexpr std::size_t kMaxTaskCycles = 1000;
+
+// The settings blob's field list (app/settings_blob.hpp): what the cycle and a run's record read.
+// Left out: waypoint_times, swing, path and efforts, from which the reader built and checked the
+// trajectory on the host.
+template <typename Visitor>
+void visit_fields(Visitor& v, Task& t) {
+  v.choice("type", t.type, kTaskTypes);
+  v("trajectory", t.trajectory);
+  v("cycle_starts", t.cycle_starts, kMaxTaskCycles);
+  v("timing_scale", t.timing_scale);
+}
+
 }  // namespace exc::control

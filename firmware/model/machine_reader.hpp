@@ -1,7 +1,8 @@
 #pragma once
 // Reading a machine file (machines/reference-20t.yaml) into a Machine (machine.hpp) with the settings
 // reader: every field validated; errors (SettingsError) name file, line, column, field and reason.
-// Start-up code on the host: allocates, throws.
+// Start-up code on the host: allocates, throws; the firmware's image gets its machine from the
+// settings blob instead (app/settings_blob.hpp).
 #include <string>
 
 #include "model/machine.hpp"
