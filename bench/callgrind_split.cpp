@@ -12,10 +12,17 @@
 extern char** environ;
 
 namespace exc::bench {
+namespace {
+
+// The run_lockstep that runs the loop, from the node's settings (the other builds those and calls it:
+// a toggle matching both would switch collection off inside the loop).
+constexpr const char* kLoopFunction = "exc::sim::run_lockstep(exc::plant::Scene const&, exc::app::FirmwareImageSettings const&";
+
+}  // namespace
 
 const std::vector<Stage>& loop_stages() {
   static const std::vector<Stage> s = {
-      {"the loop (run_lockstep, start-up included)", 0, {"exc::sim::run_lockstep("}},
+      {"the loop (run_lockstep, start-up included)", 0, {kLoopFunction}},
       {"firmware: SYNC and heartbeat (FirmwareNode::begin_cycle)", 1, {"exc::app::FirmwareNode::begin_cycle()"}},
       {"plant node (PlantNode::poll)", 1, {"exc::app::PlantNode::poll()"}},
       {"CAN read: SYNC and command (PlantCanPort::poll_sync)", 2, {"exc::hal::PlantCanPort::poll_sync("}},
@@ -47,7 +54,7 @@ const std::vector<Stage>& loop_stages() {
 const std::vector<std::string>& loop_toggles() {
   // Counted only inside the loop and the telemetry thread: the model functions also run while the
   // scene loads (the effort-feasibility check), which is not a cycle's cost.
-  static const std::vector<std::string> t = {"exc::sim::run_lockstep*", "exc::telemetry::TelemetryPublisher::run*"};
+  static const std::vector<std::string> t = {std::string(kLoopFunction) + "*", "exc::telemetry::TelemetryPublisher::run*"};
   return t;
 }
 

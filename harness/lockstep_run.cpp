@@ -128,9 +128,25 @@ std::int64_t lockstep_cycles(const plant::Scene& scene, double duration) {
   return static_cast<std::int64_t>(std::llround((duration > 0 ? duration : scene.duration) / scene.cycle));
 }
 
+app::FirmwareImageSettings lockstep_image_settings(const plant::Scene& scene, const app::FirmwareSettings& firmware,
+                                                   const LockstepOptions& options) {
+  app::FirmwareNodeConfig fc;
+  fc.controller = firmware.controller;
+  fc.controller.law = options.controller;
+  fc.site_map = firmware.terrain;
+  fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
+  fc.theta_true = theta_of(scene.soil);
+  fc.wait_for_start = options.wait_for_start;
+  return app::image_settings(firmware, fc, options.duration > 0 ? options.duration : scene.duration);
+}
+
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options) {
+  return run_lockstep(scene, lockstep_image_settings(scene, firmware, options), options);
+}
+
+RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettings& firmware, const LockstepOptions& options) {
   RunRecord result;
-  result.controller = options.controller;
+  result.controller = firmware.node.controller.law;
   // This thread runs the loop and starts the telemetry thread: subnormals flushed from here on, the
   // caller's mode back at the end (docs/floating-point.md).
   const app::LoopFloatModeScope float_mode(options.float_mode);
@@ -179,20 +195,13 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
     if (!publisher->start(&error)) throw std::runtime_error("telemetry: " + error);
   }
 
-  app::FirmwareNodeConfig fc;
-  fc.controller = firmware.controller;
-  fc.controller.law = options.controller;
-  fc.site_map = firmware.terrain;
-  fc.theta_known = true;  // simulation: the true soil goes into telemetry and the Lyapunov value
-  fc.theta_true = theta_of(scene.soil);
-  fc.wait_for_start = options.wait_for_start;
   const double duration = options.duration > 0 ? options.duration : scene.duration;
   const std::int64_t cycles = lockstep_cycles(scene, options.duration);
   const Model firmware_model = build_model(firmware.machine);
   std::unique_ptr<FirmwareEnd> firmware_end_node;
   if (options.firmware_target.empty()) {
     firmware_end_node = std::make_unique<HostFirmware>(
-        std::make_unique<app::FirmwareNode>(firmware_model, firmware.task, fc, firmware_port, publisher.get()));
+        std::make_unique<app::FirmwareNode>(firmware_model, firmware.task, firmware.node, firmware_port, publisher.get()));
   } else {
     if (options.observer || options.node_observer)
       throw std::invalid_argument("a run on " + options.firmware_target + " takes no observer of the in-process node");
@@ -201,13 +210,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& f
       throw std::invalid_argument("--firmware-target " + options.firmware_target +
                                   ": this build made no firmware image (configure with the Cortex-M7 toolchain: tools/install-deps "
                                   "test, then cmake; or set EXC_FIRMWARE_IMAGE)");
-    app::FirmwareImageSettings settings;
-    settings.scene = scene.name;
-    settings.machine = firmware.machine;
-    settings.task = firmware.task;
-    settings.node = fc;
-    settings.cycles = cycles;
-    firmware_end_node = std::make_unique<TargetFirmware>(image, settings, firmware_end, publisher.get());
+    firmware_end_node = std::make_unique<TargetFirmware>(image, firmware, firmware_end, publisher.get());
   }
   FirmwareEnd& fw = *firmware_end_node;
   const app::FirmwareNode* const host_node = fw.node();  // null on a target

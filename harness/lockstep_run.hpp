@@ -13,6 +13,7 @@
 
 #include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
+#include "app/settings_blob.hpp"
 #include "harness/scene_source.hpp"
 #include "harness/target_figures.hpp"
 #include "control/controller_config.hpp"
@@ -207,5 +208,13 @@ std::int64_t lockstep_cycles(const plant::Scene& scene, double duration);
 // Runs the plant's scene against the firmware's settings (which may differ on purpose: a wrong
 // model, other gains). The plant starts from the scene's initial state.
 RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareSettings& firmware, const LockstepOptions& options);
+// What the firmware's node of that run is built from (options.controller its law, options.wait_for_start,
+// the scene's true soil as theta_true), as the settings blob carries it to the firmware's image.
+app::FirmwareImageSettings lockstep_image_settings(const plant::Scene& scene, const app::FirmwareSettings& firmware,
+                                                   const LockstepOptions& options);
+// The same run from those (decoded from a blob, say): the node is built from them alone, so
+// options.controller and options.wait_for_start are theirs to say; the run lasts the scene's duration
+// (or options.duration) in the plant's cycles, as above.
+RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettings& firmware, const LockstepOptions& options);
 
 }  // namespace exc::sim

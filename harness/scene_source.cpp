@@ -8,6 +8,8 @@
 
 #include "control/controller_config.hpp"
 #include "settings/section_reader.hpp"
+#include "model/machine_reader.hpp"
+#include "control/controller_config_reader.hpp"
 
 namespace exc::sim {
 namespace {

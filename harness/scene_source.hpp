@@ -10,7 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "app/firmware_settings.hpp"
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
 #include "settings/document.hpp"
 #include "sim_plant/scene.hpp"
 

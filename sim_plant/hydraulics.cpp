@@ -7,6 +7,7 @@
 #include "sim_plant/chamber.hpp"
 #include "sim_plant/flow_sharing.hpp"
 #include "sim_plant/spool_valve.hpp"
+#include "model/machine_reader.hpp"
 
 namespace exc::plant {
 

@@ -3,7 +3,7 @@
 
 #include <cmath>
 
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
 #include "settings/section_reader.hpp"
 #include "sim_plant/integration_methods.hpp"
 

@@ -10,7 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "model/machine.hpp"
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
 #include "settings/document.hpp"
 #include "sim_plant/actuators.hpp"
 #include "sim_plant/integrators.hpp"

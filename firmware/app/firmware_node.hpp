@@ -22,6 +22,7 @@
 #include "control/state_estimator.hpp"
 #include "control/task.hpp"
 #include "hal/can_ports.hpp"
+#include "app/firmware_node_config.hpp"
 #include "model/model.hpp"
 #include "safety/supervisor.hpp"
 
@@ -30,18 +31,6 @@ class TelemetrySink;
 }
 
 namespace exc::app {
-
-struct FirmwareNodeConfig {
-  control::ControllerConfig controller;  // its law names the control law the node runs
-  Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
-  double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
-  // Hold until an operator's start (SUPERVISOR Command = start) before tracking; false: the task
-  // starts by itself after track_delay (the default: runs without an operator station).
-  bool wait_for_start = false;
-  // Simulation only: the plant's true soil parameters, for telemetry and the Lyapunov value.
-  bool theta_known = false;
-  Vec6 theta_true = Vec6::Zero();
-};
 
 class FirmwareNode {
  public:

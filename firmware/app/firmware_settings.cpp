@@ -8,7 +8,9 @@
 #include "control/pump_pacing.hpp"
 #include "model/actuator_friction.hpp"
 #include "model/model.hpp"
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
+#include "control/controller_config_reader.hpp"
+#include "control/task_reader.hpp"
 
 namespace exc::app {
 namespace {
@@ -103,6 +105,16 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene, const S
 FirmwareSettings read_firmware_settings(const settings::Document& scene) {
   settings::SectionReader top(scene);
   return read_firmware_settings(scene, read_scene_machine(top, scene));
+}
+
+FirmwareImageSettings image_settings(const FirmwareSettings& settings, const FirmwareNodeConfig& node, double duration) {
+  FirmwareImageSettings image;
+  image.scene = settings.name;
+  image.machine = settings.machine;
+  image.task = settings.task;
+  image.node = node;
+  image.cycles = static_cast<std::int64_t>(std::llround((duration > 0 ? duration : settings.duration) / node.controller.period));
+  return image;
 }
 
 FirmwareSettings load_firmware_settings(const std::string& path) {

@@ -9,11 +9,13 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "app/firmware_node_config.hpp"
+#include "app/settings_blob.hpp"
 #include "control/controller_config.hpp"
 #include "control/task.hpp"
 #include "model/machine.hpp"
 #include "model/terrain.hpp"
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
 #include "settings/document.hpp"
 
 namespace exc::app {
@@ -40,5 +42,9 @@ FirmwareSettings load_firmware_settings(const std::string& path);
 FirmwareSettings read_firmware_settings(const settings::Document& scene);
 // The same against its machine already read (read_scene_machine: the file loaded once for both sides).
 FirmwareSettings read_firmware_settings(const settings::Document& scene, const SceneMachine& machine);
+
+// What the firmware's image runs (settings_blob.hpp): these settings, the node built with `node`, for
+// `duration` s (0: the run's duration) in whole periods of node.controller.period, rounded.
+FirmwareImageSettings image_settings(const FirmwareSettings& settings, const FirmwareNodeConfig& node, double duration = 0);
 
 }  // namespace exc::app

@@ -6,6 +6,7 @@
 
 #include "control/law_stages.hpp"
 #include "control/lyapunov.hpp"
+#include "settings/settings_error.hpp"
 
 namespace exc::control {
 

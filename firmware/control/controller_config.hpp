@@ -1,12 +1,12 @@
 #pragma once
 // The scene's `controller:` section (gains, Lyapunov weights, adaptation rates, soil-parameter
-// bounds, filter cut-offs, watchdog), parsed and validated at start-up. Every field is optional:
-// a scene without `controller:` gets the embedded defaults below (docs/control.md lists them); the
-// reader (controller_config.cpp) declares each field's unit and range once. Errors (SettingsError)
-// name the file, the line and column, the field and the allowed range. Start-up code: allocates.
+// bounds, filter cut-offs, watchdog) as the cycle takes it. Every field is optional: a scene without
+// `controller:` gets the embedded defaults below (docs/control.md lists them); the reader
+// (controller_config_reader.hpp) declares each field's unit and range once and validates them at
+// start-up on the host. Nothing here reads a file, so the firmware's image compiles it.
+#include <cstddef>
+#include <cstdint>
 #include <string>
-
-#include <yaml-cpp/yaml.h>
 
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
@@ -16,7 +16,7 @@
 #include "control/valve_inner_loop.hpp"
 #include "safety/velocity_plausibility.hpp"
 #include "model/machine.hpp"
-#include "settings/section_reader.hpp"
+#include "settings/enum_table.hpp"
 
 namespace exc::control {
 
@@ -48,6 +48,18 @@ struct ExternalForceSettings {
   double force_scale = 30000;  // N: the residual's noise n0 per sample (least squares' measurement noise)
   double dead_zone = 300;      // N: of each cylinder's residual, no update below it (noise, friction)
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, ExternalForceSettings& e) {
+  v("observer", e.observer);
+  v("cutoff_hz", e.cutoff_hz);
+  v("identification_memory", e.identification_memory);
+  v("force_scale", e.force_scale);
+  v("dead_zone", e.dead_zone);
+}
+
+// The longest control law's name the settings blob carries.
+inline constexpr std::size_t kMaxLawName = 64;
 
 struct ControllerConfig {
   // The control law to run, by its name in the registry (controller_registry.hpp).
@@ -151,6 +163,45 @@ struct ControllerConfig {
     return g;
   }
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above that the cycle reads is
+// added here too. Left out: law_given, adaptation_rate_derived and tracking_error_limit_derived, which
+// say how the reader came by a value (the host's business, before the blob is made).
+template <typename Visitor>
+void visit_fields(Visitor& v, ControllerConfig& c) {
+  v("law", c.law, kMaxLawName);
+  v("period", c.period);
+  v("gains", c.gains);
+  v("lyapunov_q", c.lyapunov_q);
+  v("adaptation_rate", c.adaptation_rate);
+  v("tracking_dead_zone", c.tracking_dead_zone);
+  v("theta_min", c.theta_min);
+  v("theta_max", c.theta_max);
+  v("theta_initial", c.theta_initial);
+  v.choice("regressor_acceleration", c.regressor_acceleration, kRegressorAccelerations);
+  v("external_force", c.external_force);
+  v("soil_contact", c.soil_contact);
+  v("integral_action", c.integral_action);
+  v("lyapunov_q_integral", c.lyapunov_q_integral);
+  v("sl_lambda", c.sl_lambda);
+  v("sl_kd", c.sl_kd);
+  v("sl_adaptation_rate", c.sl_adaptation_rate);
+  v("actuator_lag", c.actuator_lag);
+  v("actuator_lag_target", c.actuator_lag_target);
+  v.choice("command_interface", c.command_interface, kCommandInterfaces);
+  v("valves", c.valves);
+  v("flow_kp", c.flow_kp);
+  v("filter", c.filter);
+  v("watchdog_timeout", c.watchdog_timeout);
+  v("supervisor_timeout", c.supervisor_timeout);
+  v("max_missed_deadlines", c.max_missed_deadlines);
+  v("plausibility", c.plausibility);
+  v("pressure_plausibility", c.pressure_plausibility);
+  v("tracking_error_limit", c.tracking_error_limit);
+  v("blend_time", c.blend_time);
+  v("stop_ramp_time", c.stop_ramp_time);
+  v("pump_pacing", c.pump_pacing);
+  v("pump_pacing_share", c.pump_pacing_share);
+}
 
 // The defaults a nominal machine implies (before the scene's section is read): the force loop's T_f
 // is its spools' time constant (at least 5 ms), the spool lead aims at a third of it.
@@ -175,13 +226,6 @@ inline constexpr double kTrackingLimitMultiple = 5;
 // The default tracking-error limit for a command interface (ControllerConfig::tracking_error_limit).
 Vec4 default_tracking_error_limit(CommandInterface interface);
 ControllerConfig controller_defaults(const Machine& nominal);
-// Reads the `controller:` section into c (a field the section does not give keeps c's value, which
-// is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
-// Hurwitz gains, ...).
-void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
-// The `controller:` section of a parsed scene file (absent: the defaults), the rest of the file left to
-// its readers: a sweep's case that changes only controller settings reads them again so.
-ControllerConfig read_controller_config(const settings::Document& scene, const Machine& nominal);
 // Through the valves eq. 27's default rates are the force-commanded machine's times this (period / T_f).
 double valve_adaptation_scale(const ControllerConfig& c);
 // Switches the command interface of a configuration (a bench variant on other actuators), carrying

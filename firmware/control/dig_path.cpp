@@ -4,6 +4,8 @@
 #include <cmath>
 #include <sstream>
 
+#include "settings/settings_error.hpp"
+
 namespace exc::control {
 namespace {
 

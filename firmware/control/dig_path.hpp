@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "settings/settings_error.hpp"
 #include "control/inverse_kinematics.hpp"
 #include "control/trajectory.hpp"
 

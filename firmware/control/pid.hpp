@@ -14,6 +14,14 @@ struct PidGains {
   Vec4 kp = Vec4::Zero(), kv = Vec4::Zero(), ki = Vec4::Zero();
   Vec4 integral_limit = Vec4::Constant(1e300);  // |int e dt| bound per joint (m s or rad s)
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, PidGains& g) {
+  v("kp", g.kp);
+  v("kv", g.kv);
+  v("ki", g.ki);
+  v("integral_limit", g.integral_limit);
+}
 
 class Pid {
  public:

@@ -27,6 +27,12 @@ struct SoilContactSettings {
   bool use_site_map = true;     // take contact and depth from the site map when the firmware has one
   double contact_force = 2000;  // N: without a map, the tip force estimate that tells contact
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, SoilContactSettings& s) {
+  v("use_site_map", s.use_site_map);
+  v("contact_force", s.contact_force);
+}
 
 class SoilContactEstimator {
  public:

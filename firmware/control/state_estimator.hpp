@@ -20,6 +20,13 @@ struct EstimatorConfig {
   double velocity_cutoff_hz = 25;      // Butterworth low-pass on qd_a
   double acceleration_cutoff_hz = 15;  // filtered derivative of the filtered velocity
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, EstimatorConfig& c) {
+  v("period", c.period);
+  v("velocity_cutoff_hz", c.velocity_cutoff_hz);
+  v("acceleration_cutoff_hz", c.acceleration_cutoff_hz);
+}
 
 // The two stages' coefficients, by the bilinear (Tustin) transform at the period.
 struct EstimatorCoefficients {

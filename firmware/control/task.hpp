@@ -17,16 +17,16 @@
 //     dump: {swing_deg: 90, x: 6.0, z: 3.5, pitch_deg: -40, open_pitch_deg: 45}
 //     times: {to_dump: 6, dump: 2, back: 6}
 //     repeat: 5
-// Every field is declared once, in task.cpp, with the settings reader. Errors (SettingsError) name
-// the file, the line and column, the field (task.waypoints[2].q[1]) and the allowed values; limits
-// (stroke, speed, reach) are checked here, before the run starts, and named at the waypoint's line.
-#include <string>
+// Every field is declared once, in task_reader.cpp, with the settings reader. Errors (SettingsError)
+// name the file, the line and column, the field (task.waypoints[2].q[1]) and the allowed values;
+// limits (stroke, speed, reach) are checked there, before the run starts, and named at the waypoint's
+// line. This header is the task as the cycle takes it; nothing here reads a file.
+#include <cstddef>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
 #include "control/dig_path.hpp"
-#include "settings/section_reader.hpp"
+#include "control/trajectory.hpp"
+#include "settings/enum_table.hpp"
 
 namespace exc::control {
 
@@ -60,9 +60,18 @@ struct Task {
   double timing_scale = 1;             // > 1 when fit_timing slowed the path down (times multiplied)
 };
 
-// Reads the `task:` section (required: an absent one is an error).
-Task read_task(settings::SectionReader& task, const Machine& machine, const TrajectoryCheckOptions& options = {});
-// The `task:` section of a parsed scene file (the rest of the file left to its readers).
-Task read_task(const settings::Document& scene, const Machine& machine, const TrajectoryCheckOptions& options = {});
+// The most work cycles a task has (task.repeat's upper bound), as the settings blob carries them.
+inline constexpr std::size_t kMaxTaskCycles = 1000;
+
+// The settings blob's field list (app/settings_blob.hpp): what the cycle and a run's record read.
+// Left out: waypoint_times, swing, path and efforts, from which the reader built and checked the
+// trajectory on the host.
+template <typename Visitor>
+void visit_fields(Visitor& v, Task& t) {
+  v.choice("type", t.type, kTaskTypes);
+  v("trajectory", t.trajectory);
+  v("cycle_starts", t.cycle_starts, kMaxTaskCycles);
+  v("timing_scale", t.timing_scale);
+}
 
 }  // namespace exc::control

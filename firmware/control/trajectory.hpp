@@ -22,13 +22,22 @@ class CubicSpline {
   CubicSpline() = default;
   // times strictly increasing, at least two points. Throws std::invalid_argument otherwise (the
   // parsers check first and name the field; this is the last line of defence).
-  CubicSpline(std::vector<double> times, std::vector<Point> points)
-      : t_(std::move(times)), y_(std::move(points)) {
-    if (t_.size() < 2 || t_.size() != y_.size())
+  CubicSpline(std::vector<double> times, std::vector<Point> points) {
+    if (times.size() < 2 || times.size() != points.size())
       throw std::invalid_argument("CubicSpline: need >= 2 waypoints with one time each");
-    for (std::size_t i = 1; i < t_.size(); ++i)
-      if (!(t_[i] > t_[i - 1])) throw std::invalid_argument("CubicSpline: times must increase");
+    if (!assign(std::move(times), std::move(points))) throw std::invalid_argument("CubicSpline: times must increase");
+  }
+  // The same without throwing (the settings blob's decoder, app/settings_blob.hpp): false, the spline
+  // left as it was, unless there are at least two points, one time each, the times strictly increasing.
+  bool assign(std::vector<double> times, std::vector<Point> points) {
+    if (times.size() < 2 || times.size() != points.size()) return false;
+    for (std::size_t i = 1; i < times.size(); ++i)
+      if (!(times[i] > times[i - 1])) return false;
+    t_ = std::move(times);
+    y_ = std::move(points);
+    last_ = 0;
     solve_second_derivatives();
+    return true;
   }
 
   bool empty() const { return t_.empty(); }
@@ -112,5 +121,23 @@ class CubicSpline {
 
 // The desired active-joint trajectory q_d(t) = [swing rad, L_boom, L_arm, L_bucket] (m).
 using JointTrajectory = CubicSpline<kNumActive>;
+
+// The most knots of a trajectory the settings blob carries (app/settings_blob.hpp): 40 bytes each in
+// the blob and 72 in the spline (1.4 MB at most in the target's RAM). The longest shipped task,
+// truck_loading's five cycles sampled every 10 ms, has about 11000; a longer one is refused when its
+// blob is made.
+inline constexpr std::size_t kMaxTrajectoryKnots = 20000;
+
+// The settings blob's field list: the knots; the decoder builds the spline through them (the same
+// arithmetic as the host's, so the same spline bit for bit) or refuses knots that make none.
+template <typename Visitor, int N>
+void visit_fields(Visitor& v, CubicSpline<N>& s) {
+  std::vector<double> times = s.times();
+  std::vector<typename CubicSpline<N>::Point> points = s.points();
+  v("times", times, kMaxTrajectoryKnots);
+  v("points", points, kMaxTrajectoryKnots);
+  if (v.decoding() && !s.assign(std::move(times), std::move(points)))
+    v.refuse("times", "at least 2 knots, as many points as times, the times strictly increasing");
+}
 
 }  // namespace exc::control

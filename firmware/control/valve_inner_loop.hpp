@@ -68,6 +68,16 @@ struct ValveLoopSettings {
   // Holding a pose: |e| below which a function's valve stays centred (rad swing, m cylinders).
   Vec4 hold_window = Vec4::Constant(1e-3);
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, ValveLoopSettings& s) {
+  v("force_time_constant", s.force_time_constant);
+  v("spool_lag_target", s.spool_lag_target);
+  v("force_integral_time", s.force_integral_time);
+  v("opening_band", s.opening_band);
+  v("position_gain", s.position_gain);
+  v("hold_window", s.hold_window);
+}
 
 // What the valve stage sends and what it found.
 struct ValveCommand {

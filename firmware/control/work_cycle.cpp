@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "settings/settings_error.hpp"
+
 namespace exc::control {
 namespace {
 

@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "sin_cos.hpp"
+
 namespace exc {
 
 namespace {
@@ -22,7 +24,7 @@ void front_positions(const Model& model, const Vec12& q, Workspace& ws) {
       ws.joint_cos[i] = 1.0;
       ws.joint_sin[i] = 0.0;
     } else {
-      ::sincos(q[i], &ws.joint_sin[i], &ws.joint_cos[i]);
+      sin_cos(q[i], &ws.joint_sin[i], &ws.joint_cos[i]);
     }
   }
   front_positions_from_joint_trig(model, q, ws);

@@ -1,14 +1,12 @@
 #pragma once
 // The machine description (pins, bodies, limits, hydraulics) as read from a machine file such as
-// machines/reference-20t.yaml. Loading validates every field; errors (SettingsError) name file,
-// line, column, field and reason. This is start-up code: it may allocate. Nothing built from it
-// allocates afterwards.
+// machines/reference-20t.yaml by machine_reader.hpp (which validates every field). The structs and
+// what the cycle asks of them; nothing here reads a file, so the firmware's image compiles it. Each
+// struct's visit_fields lists the fields the settings blob carries (app/settings_blob.hpp).
 #include <array>
 #include <string>
 #include <vector>
 
-#include "settings/document.hpp"
-#include "settings/settings_error.hpp"
 #include "types.hpp"
 
 namespace exc {
@@ -18,17 +16,38 @@ struct BodyInertia {
   Vec3 com = Vec3::Zero();     // centre of mass in the body frame (m)
   Vec3 inertia = Vec3::Zero(); // principal inertia about the com, body axes [Ixx Iyy Izz] (kg m^2)
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, BodyInertia& b) {
+  v("mass", b.mass);
+  v("com", b.com);
+  v("inertia", b.inertia);
+}
 
 struct CylinderLimits {
   double min_length = 0, max_length = 0;  // pin to pin (m)
   double min_force = 0, max_force = 0;    // N (negative = pull)
   double max_speed = 0;                   // m/s
 };
+template <typename Visitor>
+void visit_fields(Visitor& v, CylinderLimits& c) {
+  v("min_length", c.min_length);
+  v("max_length", c.max_length);
+  v("min_force", c.min_force);
+  v("max_force", c.max_force);
+  v("max_speed", c.max_speed);
+}
 
 struct SwingLimits {
   double min_torque = 0, max_torque = 0;  // N m
   double max_speed = 0;                   // rad/s
 };
+template <typename Visitor>
+void visit_fields(Visitor& v, SwingLimits& s) {
+  v("min_torque", s.min_torque);
+  v("max_torque", s.max_torque);
+  v("max_speed", s.max_speed);
+}
 
 struct ReferencePose {
   Vec4 q_a = Vec4::Zero();
@@ -41,7 +60,7 @@ struct ReferencePose {
 // `hydraulics:` section, optional: a file without it gets these defaults). The plant runs the
 // circuit with its true machine's numbers; the firmware reads its nominal machine's (for a valve
 // loop). Plain numbers: unit, source and allowed range with each; the ranges are declared once, by
-// the reader in machine.cpp, which also checks a struct built in C++ (validate_hydraulics).
+// the reader in machine_reader.cpp, which also checks a struct built in C++ (validate_hydraulics).
 struct HydraulicParameters {
   // s, spool lag of the pilot-operated main valves (mobile valves: 30-100 ms). Range [0, 1].
   double valve_time_constant = 0.03;
@@ -161,6 +180,41 @@ struct HydraulicParameters {
   // motor can drive. 0: none. Range [0, 1e7].
   double swing_brake_torque = 65e3;
 };
+// The settings blob's field list (app/settings_blob.hpp): what the firmware's cycle reads (valve
+// stage, friction model, pump pacing, pressure monitor). Left out, the plant's alone: piston_leakage,
+// spool_leakage, swing_drain_leakage, pilot_cutoff_time, engine_rundown_time, load_holding_valves,
+// swing_brake_torque. A field the firmware comes to read is added here (the blob's round-trip test,
+// tests/firmware_control/test_settings_blob_runs.cpp, runs with the left-out ones poisoned).
+template <typename Visitor>
+void visit_fields(Visitor& v, HydraulicParameters& p) {
+  v("valve_time_constant", p.valve_time_constant);
+  v("bulk_modulus", p.bulk_modulus);
+  v("dead_volume", p.dead_volume);
+  v("swing_volume", p.swing_volume);
+  v("supply_pressure", p.supply_pressure);
+  v("tank_pressure", p.tank_pressure);
+  v("valve_pressure_drop", p.valve_pressure_drop);
+  v("laminar_pressure", p.laminar_pressure);
+  v("pump_flow", p.pump_flow);
+  v("pumps_merged", p.pumps_merged);
+  v("pump_of", p.pump_of);
+  v("load_sensing_margin", p.load_sensing_margin);
+  v("main_relief_pressure", p.main_relief_pressure);
+  v("port_relief_pressure", p.port_relief_pressure);
+  v("swing_relief_pressure", p.swing_relief_pressure);
+  v("relief_override", p.relief_override);
+  v("makeup_pressure_drop", p.makeup_pressure_drop);
+  v("vapour_pressure", p.vapour_pressure);
+  v("pilot_full_stroke", p.pilot_full_stroke);
+  v("dead_zone_extend", p.dead_zone_extend);
+  v("dead_zone_retract", p.dead_zone_retract);
+  v("viscous_friction", p.viscous_friction);
+  v("seal_preload", p.seal_preload);
+  v("seal_pressure_friction", p.seal_pressure_friction);
+  v("breakaway_ratio", p.breakaway_ratio);
+  v("stribeck_velocity", p.stribeck_velocity);
+  v("swing_breakaway_pressure", p.swing_breakaway_pressure);
+}
 
 struct Machine {
   std::string name;
@@ -192,23 +246,37 @@ struct Machine {
   Vec4 effort_max() const;
   Vec4 speed_max() const;
 };
+// The settings blob's field list (app/settings_blob.hpp): everything build_model and the cycle read.
+// Left out: name and source (the run is named by its scene), reference_poses (checked against the
+// geometry when the file is read) and terrain_flat_height (the scene's terrain carries the ground).
+template <typename Visitor>
+void visit_fields(Visitor& v, Machine& m) {
+  v("gravity", m.gravity);
+  v("swing_height", m.swing_height);
+  v("C", m.C);
+  v("D", m.D);
+  v("E", m.E);
+  v("F", m.F);
+  v("H", m.H);
+  v("G", m.G);
+  v("I", m.I);
+  v("K", m.K);
+  v("M", m.M);
+  v("L", m.L);
+  v("T", m.T);
+  v("JL", m.JL);
+  v("JK", m.JK);
+  v("bodies", m.bodies);
+  v("swing", m.swing);
+  v("boom", m.boom);
+  v("arm", m.arm);
+  v("bucket", m.bucket);
+  v("relief_pressure", m.relief_pressure);
+  v("hydraulics", m.hydraulics);
+}
 
-// Reads and validates a machine file (read and parsed once). Throws SettingsError.
-Machine load_machine(const std::string& path);
-// The same from a parsed machine file (or a tree of it with values set: a sweep's case).
-Machine read_machine(const settings::Document& machine_file);
-// Same, from YAML text; 'file_for_errors' is what errors name as the file.
-Machine load_machine_from_string(const std::string& yaml, const std::string& file_for_errors);
-// The reference machine compiled into the binary (same numbers as machines/reference-20t.yaml).
-Machine reference_machine();
-// The built-in machine's file as it was compiled in (what a sweep's digest covers for scenes without
-// a machine file).
-const char* reference_machine_text();
 // The hydraulics without dry friction and internal leakage, viscous friction kept: the machine as it
 // was modelled before them, for comparisons (the fidelity chart) and for tests of one element.
 HydraulicParameters without_dry_friction_and_leakage(HydraulicParameters p);
-// Checks hydraulics built or changed in C++ against the ranges the machine file's reader declares
-// (SettingsError naming machine.source and the field, e.g. "hydraulics.pump_flow").
-void validate_hydraulics(const Machine& machine);
 
 }  // namespace exc

@@ -3,6 +3,7 @@
 #include "newton_euler.hpp"
 
 #include "lie_group.hpp"
+#include "sin_cos.hpp"
 
 namespace exc {
 
@@ -87,7 +88,7 @@ void tree_kinematics_from_front(const Model& model, Workspace& ws, const Vec12& 
   }
   ws.qd = qd;
   double s0, c0;  // the swing's sin, cos (about z)
-  ::sincos(ws.q[0], &s0, &c0);
+  sin_cos(ws.q[0], &s0, &c0);
   set_pose(ws.f_parent[0], Vec3(c0, s0, 0), Vec3(-s0, c0, 0), Vec3::UnitZ(), model.home[0].topRightCorner<3, 1>());
   ws.X_Wi[0] = ws.f_parent[0];
   ws.V[0] = model.screw[0] * qd[0];

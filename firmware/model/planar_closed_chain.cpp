@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "loop_closure.hpp"
+#include "sin_cos.hpp"
 
 namespace exc {
 
@@ -174,7 +175,7 @@ void rates(Workspace& ws, const LoopRates& r) {
 void twists(const Model& m, Workspace& ws) {
   const double w0 = ws.qd[kSwing];
   double s0, c0;
-  ::sincos(ws.q[kSwing], &s0, &c0);
+  sin_cos(ws.q[kSwing], &s0, &c0);
   double* f0 = ws.f_parent[0].data();  // column-major: rotation about z, then the home's offset
   f0[0] = c0, f0[1] = s0, f0[2] = 0, f0[3] = 0, f0[4] = -s0, f0[5] = c0, f0[6] = 0, f0[7] = 0;
   f0[8] = 0, f0[9] = 0, f0[10] = 1, f0[11] = 0;

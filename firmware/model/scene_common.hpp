@@ -5,13 +5,13 @@
 // the other's, so a misspelt section is refused by both:
 //   the firmware  controller, task                 (firmware/app/firmware_settings)
 //   the plant     soil, initial_state, actuators, integrator, sensors, checks   (sim_plant/scene)
-// Start-up code: allocates, throws SettingsError.
+// What they are; scene_common_reader.hpp reads them.
 #include <string>
 #include <vector>
 
 #include "model/machine.hpp"
 #include "model/terrain.hpp"
-#include "settings/section_reader.hpp"
+#include "settings/declaration.hpp"
 
 namespace exc {
 
@@ -22,17 +22,6 @@ inline const std::vector<std::string> kPlantSceneSections = {"soil",       "init
 // A run's duration (s): the scene's `duration` and the programs' --duration overrides.
 inline constexpr settings::Bounds kRunDurationBounds{1e-3, 28800};
 
-// The machine a scene names (its `machine` key), opened and parsed once: the file resolved against
-// the scene's directory, or the built-in machine when the scene names none. Both sides read their
-// sections against it, so a scene's machine file is loaded once however many read the scene.
-struct SceneMachine {
-  std::string file;             // absolute path of the machine file, empty for the built-in reference machine
-  settings::Document document;  // the file as parsed (the built-in machine's text for the built-in one)
-  Machine machine;
-};
-// Reads the scene's `machine` key (an error in the machine file is placed at the key).
-SceneMachine read_scene_machine(settings::SectionReader& top, const settings::Document& scene);
-
 struct SceneCommon {
   std::string name, description;
   std::string machine_file;  // absolute path of the machine file, empty for the built-in reference machine
@@ -41,9 +30,5 @@ struct SceneCommon {
   Terrain terrain;
   double duration = 10;                // s
 };
-
-// Reads the shared keys from the scene's top level (their values recorded in its effective tree;
-// the machine as an absolute path when the scene names one), the machine being `machine`.
-SceneCommon read_scene_common(settings::SectionReader& top, const SceneMachine& machine);
 
 }  // namespace exc

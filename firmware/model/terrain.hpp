@@ -19,5 +19,11 @@ struct Terrain {
   // World z of the ground at horizontal distance x from the swing axis.
   double height_at(double x) const;
 };
+// The settings blob's field list (app/settings_blob.hpp): the profile's first num_points points.
+template <typename Visitor>
+void visit_fields(Visitor& v, Terrain& t) {
+  v("height", t.height);
+  v.counted("profile", t.profile, t.num_points);
+}
 
 }  // namespace exc

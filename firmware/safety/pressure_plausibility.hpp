@@ -42,6 +42,16 @@ struct PressurePlausibilitySettings {
   double moving_share = 0.02;   // of the function's top speed: faster is "moving"
   int debounce = 3;             // sensor sets in a row for the range and the step tests
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, PressurePlausibilitySettings& s) {
+  v("enabled", s.enabled);
+  v("range_margin", s.range_margin);
+  v("step_factor", s.step_factor);
+  v("frozen_sets", s.frozen_sets);
+  v("moving_share", s.moving_share);
+  v("debounce", s.debounce);
+}
 
 enum class PressureTest : std::uint8_t { none, range, step, frozen };
 const char* to_string(PressureTest test);

@@ -43,6 +43,18 @@ struct PlausibilitySettings {
   int frozen_sets = 200;
   Vec4 frozen_speed = Vec4::Constant(0.01);
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, PlausibilitySettings& s) {
+  v("enabled", s.enabled);
+  v("velocity_floor", s.velocity_floor);
+  v("velocity_fraction", s.velocity_fraction);
+  v("window", s.window);
+  v("lag", s.lag);
+  v("debounce", s.debounce);
+  v("frozen_sets", s.frozen_sets);
+  v("frozen_speed", s.frozen_speed);
+}
 
 class VelocityPlausibility {
  public:

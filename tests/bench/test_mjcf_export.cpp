@@ -18,6 +18,7 @@
 #include "mjcf_export.hpp"
 #include "model/closed_chain.hpp"
 #include "model/loop_closure.hpp"
+#include "model/machine_reader.hpp"
 #include "scratch_files.hpp"
 #ifdef EXC_HAVE_MUJOCO
 #include "mujoco_peer.hpp"

@@ -10,6 +10,8 @@
 #include "control/task.hpp"
 #include "scenes.hpp"
 #include "tracking_run.hpp"
+#include "model/machine_reader.hpp"
+#include "control/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

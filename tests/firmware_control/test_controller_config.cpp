@@ -4,6 +4,8 @@
 #include "control/controller_config.hpp"
 #include "model/machine.hpp"
 #include "settings_error_check.hpp"
+#include "model/machine_reader.hpp"
+#include "control/controller_config_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

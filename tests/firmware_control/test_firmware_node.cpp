@@ -21,6 +21,8 @@
 #include "hal/memory_bus.hpp"
 #include "model/closed_chain.hpp"
 #include "scenes.hpp"
+#include "model/machine_reader.hpp"
+#include "control/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

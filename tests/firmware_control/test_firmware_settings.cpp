@@ -11,6 +11,7 @@
 #include "control/effort_feasibility.hpp"
 #include "scenes.hpp"
 #include "settings_error_check.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 

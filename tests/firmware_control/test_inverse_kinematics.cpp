@@ -5,6 +5,7 @@
 
 #include "control/inverse_kinematics.hpp"
 #include "model/closed_chain.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

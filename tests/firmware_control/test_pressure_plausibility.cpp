@@ -7,6 +7,7 @@
 
 #include "safety/pressure_plausibility.hpp"
 #include "model/machine.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using safety::PressurePlausibility;

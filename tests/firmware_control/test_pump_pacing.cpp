@@ -8,6 +8,7 @@
 #include "control/path_stop.hpp"
 #include "control/pump_pacing.hpp"
 #include "model/machine.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -7,6 +7,8 @@
 #include "model/closed_chain.hpp"
 #include "scenes.hpp"
 #include "settings_error_check.hpp"
+#include "model/machine_reader.hpp"
+#include "control/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

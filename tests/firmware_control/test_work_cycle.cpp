@@ -10,6 +10,8 @@
 #include "model/closed_chain.hpp"
 #include "model/workspace.hpp"
 #include "scenes.hpp"
+#include "model/machine_reader.hpp"
+#include "control/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

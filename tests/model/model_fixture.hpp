@@ -7,6 +7,7 @@
 #include "model/closed_chain.hpp"
 #include "model/forward_dynamics.hpp"
 #include "model/loop_closure.hpp"
+#include "model/machine_reader.hpp"
 
 namespace exc::test {
 

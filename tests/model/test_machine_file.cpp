@@ -7,6 +7,7 @@
 #include "model/machine.hpp"
 #include "settings_error_check.hpp"
 #include "text_file.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 

@@ -4,6 +4,7 @@
 
 #include "app/allocation_counter.hpp"
 #include "model_fixture.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 

@@ -7,6 +7,7 @@
 
 #include "model/closed_chain.hpp"
 #include "plant_scenes.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using namespace exc::plant;

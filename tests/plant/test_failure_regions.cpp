@@ -24,6 +24,7 @@
 #include "scratch_files.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "telemetry/lcm_output.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using namespace exc::plant;

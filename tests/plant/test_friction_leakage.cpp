@@ -14,6 +14,7 @@
 #include "model/closed_chain.hpp"
 #include "plant_scenes.hpp"
 #include "sim_plant/coulomb_friction.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using namespace exc::plant;

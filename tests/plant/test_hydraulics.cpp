@@ -14,6 +14,7 @@
 #include "model/closed_chain.hpp"
 #include "plant_scenes.hpp"
 #include "sim_plant/flow_sharing.hpp"
+#include "model/machine_reader.hpp"
 
 using namespace exc;
 using namespace exc::plant;

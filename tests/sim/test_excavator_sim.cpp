@@ -27,6 +27,7 @@
 #include "run_report.hpp"
 #include "log_channels.hpp"
 #include "sim_runs.hpp"
+#include "model/machine_reader.hpp"
 
 namespace fs = std::filesystem;
 

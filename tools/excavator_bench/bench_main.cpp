@@ -30,6 +30,7 @@
 #include "sim_plant/plant.hpp"
 #include "output_files/helper_program.hpp"
 #include "option_checks.hpp"
+#include "model/machine_reader.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;

@@ -3,6 +3,8 @@
 // lockstep (the next cycle starts when the plant has answered or the sensor timeout expired), so a
 // run is deterministic and equals the in-process run of excavator-sim; --realtime runs on absolute
 // deadlines of the controller's period instead, and a run that misses them says so.
+// --write-settings-blob writes, instead of running, what the firmware's image runs the scene from
+// (app/settings_blob.hpp) and exits.
 #include <CLI/CLI.hpp>
 
 #include "model/scene_common.hpp"
@@ -12,9 +14,11 @@
 #include <atomic>
 #include <csignal>
 #include <exception>
+#include <cstdint>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <vector>
 
 #include "app/firmware_node.hpp"
 #include "app/firmware_runner.hpp"
@@ -24,6 +28,7 @@
 #include "app/node_io.hpp"
 #include "app/realtime_setup.hpp"
 #include "app/run_summary.hpp"
+#include "app/settings_blob.hpp"
 #include "control/controller_registry.hpp"
 #include "settings/section_reader.hpp"
 
@@ -40,10 +45,10 @@ int main(int argc, char** argv) {
   // is computed, so start-up and the loop share one arithmetic (docs/floating-point.md).
   exc::app::set_loop_float_mode();
   CLI::App app{"excavator-firmware: the controller on a SocketCAN interface (see README, docs/vcan.md)."};
-  std::string iface, scene_path, controller, json_path, lcm_url;
+  std::string iface, scene_path, controller, json_path, lcm_url, blob_path;
   double duration = 0, sensor_timeout_ms = 0, startup_s = 60, max_overrun_fraction = 0.01;
   bool realtime = false, print_config = false, wait_for_start = false;
-  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config)");
+  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config or --write-settings-blob)");
   app.add_option("--scene", scene_path, "scene file (its machine, controller and task sections)")->required();
   app.add_option("--controller", controller, "the control law (default: the scene's controller.type, else adaptive):\n" +
                                                  exc::control::controller_registry().help())
@@ -67,8 +72,12 @@ int main(int argc, char** argv) {
   app.add_flag("--wait-for-start", wait_for_start, "hold until an operator's start (SUPERVISOR frame, excavator-operator start)");
   app.add_flag("--print-config", print_config,
                "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
+  app.add_option("--write-settings-blob", blob_path,
+                 "write the settings blob the firmware's image runs the scene from (its nominal machine, controller, "
+                 "task and run length, with --controller, --duration and --wait-for-start; docs/programs.md) to this "
+                 "file, and exit");
   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
-  if (!print_config && iface.empty()) {
+  if (!print_config && blob_path.empty() && iface.empty()) {
     std::cerr << "excavator-firmware: --can is required\n";
     return 2;
   }
@@ -93,6 +102,15 @@ int main(int argc, char** argv) {
     fc.site_map = settings.terrain;
     fc.wait_for_start = wait_for_start;
     const char* const law_name = fc.controller.law.c_str();
+    if (!blob_path.empty()) {
+      const std::vector<std::uint8_t> blob = exc::app::encode_settings_blob(exc::app::image_settings(settings, fc, duration));
+      std::ofstream blob_file = exc::output::open_file(blob_path);
+      blob_file.write(reinterpret_cast<const char*>(blob.data()), static_cast<std::streamsize>(blob.size()));
+      exc::output::finish_file(blob_file, blob_path);
+      std::printf("excavator-firmware: %s: the settings blob of %s (%s), %zu bytes\n", blob_path.c_str(), settings.name.c_str(),
+                  law_name, blob.size());
+      return 0;
+    }
 
     const double period_s = settings.controller.period;
     const auto period_ns = static_cast<std::int64_t>(std::llround(period_s * 1e9));

@@ -18,6 +18,7 @@
 #include "model/forward_dynamics.hpp"
 #include "output_files/output_file.hpp"
 #include "option_checks.hpp"
+#include "model/machine_reader.hpp"
 
 namespace {
 

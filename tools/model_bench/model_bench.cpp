@@ -14,6 +14,7 @@
 
 #include "model/closed_chain.hpp"
 #include "model/forward_dynamics.hpp"
+#include "model/machine_reader.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-#include "model/scene_common.hpp"
+#include "model/scene_common_reader.hpp"
 
 namespace exc {
 

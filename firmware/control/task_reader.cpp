@@ -1,6 +1,6 @@
 // The `task:` section: every field declared once with the settings reader; the trajectory built
 // and checked against the machine's limits, a failed check named at the waypoint's line.
-#include "control/task.hpp"
+#include "control/task_reader.hpp"
 
 #include <algorithm>
 #include <cmath>
