@@ -60,7 +60,7 @@ endif()
 
 # The cycle's sources, absolute, from the libraries that hold them.
 set(_exc_firmware_sources "")
-foreach(_exc_lib exc_model exc_safety exc_control exc_settings_blob exc_firmware_cycle exc_hal_protocol)
+foreach(_exc_lib exc_settings_error exc_model exc_safety exc_control exc_settings_blob exc_firmware_cycle exc_hal_protocol)
   get_target_property(_exc_dir ${_exc_lib} SOURCE_DIR)
   get_target_property(_exc_sources ${_exc_lib} SOURCES)
   foreach(_exc_s ${_exc_sources})

@@ -36,14 +36,23 @@ LogVolume lockstep_log_volume(std::int64_t cycles, const std::string& channel_su
   v.per_cycle_bytes = event_bytes<exlcm::machine_state_t>(Channel::state, channel_suffix) +
                       event_bytes<exlcm::command_t>(Channel::command, channel_suffix) +
                       event_bytes<exlcm::controller_state_t>(Channel::controller, channel_suffix);
-  // Every kCounterPeriod cycles and once after the last: the firmware's stages and CAN counters, the
-  // plant's step (EXC_TIMING stage 4) and CAN counters (sim_plant/plant_node.cpp).
-  const std::uint64_t counter_rounds = n / app::kCounterPeriod + 1;
-  const std::uint64_t counters = (app::kTimingStages + 1) * event_bytes<exlcm::timing_t>(Channel::timing, channel_suffix) +
-                                 2 * event_bytes<exlcm::can_stats_t>(Channel::can_stats, channel_suffix);
+  // The counters: the firmware's parts one every other cycle from every kCounterPeriod-th on (its stages, its CAN
+  // counters; the interval only in real time), the plant's step (EXC_TIMING stage 4) and CAN counters
+  // every kCounterPeriod cycles (sim_plant/plant_node.cpp); each side's whole round once after the last.
+  const std::uint64_t timing = event_bytes<exlcm::timing_t>(Channel::timing, channel_suffix);
+  const std::uint64_t can = event_bytes<exlcm::can_stats_t>(Channel::can_stats, channel_suffix);
+  std::uint64_t counters = (app::kTimingStages + 1) * timing + 2 * can;  // the end's
+  counters += n / app::kCounterPeriod * (timing + can);                    // the plant's
+  for (int part = 0; part < app::kCounterParts; ++part) {
+    if (part == app::kTimingStages) continue;  // the interval: real time only
+    const std::uint64_t p = static_cast<std::uint64_t>(part);
+    const std::uint64_t published_at = 2 * p + 1;  // the step that publishes the part
+    const std::uint64_t rounds = n >= app::kCounterPeriod + published_at ? (n - published_at) / app::kCounterPeriod : 0;
+    counters += rounds * (part < app::kTimingStages ? timing : can);
+  }
   // A run's start: init -> wait_sensors -> hold -> track, each change on EXC_FAULT (inactive).
   constexpr std::uint64_t kStartModeChanges = 3;
-  v.bytes = v.per_cycle_messages * v.per_cycle_bytes + counter_rounds * counters +
+  v.bytes = v.per_cycle_messages * v.per_cycle_bytes + counters +
             kStartModeChanges * event_bytes<exlcm::fault_t>(Channel::fault, channel_suffix) +
             event_bytes<exlcm::telemetry_stats_t>(Channel::telemetry_stats, channel_suffix);
   return v;

@@ -39,7 +39,7 @@ TargetFirmware::TargetFirmware(const std::string& image, const app::FirmwareImag
   const std::vector<std::uint8_t> blob = app::encode_settings_blob(settings);
   for (std::size_t at = 0; at < blob.size(); at += kSettingsChunkBytes)
     target_.send(type_of(app::PilRecord::settings_chunk), blob.data() + at, std::min(kSettingsChunkBytes, blob.size() - at));
-  target_.send(type_of(app::PilRecord::settings_end), nullptr, 0);
+  target_.send(type_of(app::PilRecord::settings_chunk), nullptr, 0);  // the end
   target_.flush();
   const std::vector<TargetRecord> answer = target_.receive_until(type_of(app::PilRecord::ready), type_of(app::PilRecord::refused));
   if (answer.back().type == type_of(app::PilRecord::refused))
@@ -78,7 +78,8 @@ void TargetFirmware::end_cycle() {
   for (hal::CanFrame f; bus_.receive(f);) target_.send(type_of(app::PilRecord::frame_in), payload, app::encode_frame(f, payload, sizeof payload));
   target_.send(type_of(app::PilRecord::inputs_done), nullptr, 0);
   target_.flush();
-  const TargetRecord& done = forward(target_.receive_until(type_of(app::PilRecord::cycle_done)));
+  const std::vector<TargetRecord> records = target_.receive_until(type_of(app::PilRecord::cycle_done));
+  const TargetRecord& done = forward(records);
   if (!app::decode_status(done.payload.data(), done.payload.size(), status_))
     throw EmulatedTargetError("the firmware image " + target_.image() + " sent a cycle status that does not decode");
   const bool commanded = status_.instructions[2] != 0 || status_.instructions[3] != 0;
@@ -93,7 +94,8 @@ app::RunSummaryRecord TargetFirmware::finish() {
   target_.send(type_of(app::PilRecord::run_end), nullptr, 0);
   target_.send(type_of(app::PilRecord::begin), nullptr, 0);
   target_.flush();
-  const TargetRecord& last = forward(target_.receive_until(type_of(app::PilRecord::summary)));
+  const std::vector<TargetRecord> records = target_.receive_until(type_of(app::PilRecord::summary));
+  const TargetRecord& last = forward(records);
   app::RunSummaryRecord summary;
   if (!app::decode_summary(last.payload.data(), last.payload.size(), summary))
     throw EmulatedTargetError("the firmware image " + target_.image() + " sent a run summary that does not decode");

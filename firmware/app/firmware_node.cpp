@@ -299,8 +299,11 @@ void FirmwareNode::publish_cycle(const safety::Transition& transition) {
       text[0] = 0;
     publish_fault(stop ? supervisor_.last_fault() : safety::FirmwareFault::none, stop ? 2 : 0, stop, text);
   }
-  // The cycle's scope: read to telemetry encoded, the periodic counter messages included.
-  if (cycle_ % kCounterPeriod == 0) publish_counters();
+  // The cycle's scope: read to telemetry encoded, the periodic counter messages included, a step a
+  // cycle from each kCounterPeriod-th on.
+  const std::uint64_t step = cycle_ % kCounterPeriod;
+  if (cycle_ >= kCounterPeriod && step < static_cast<std::uint64_t>(kCounterSteps))
+    counters_.publish_step(static_cast<int>(step), *telemetry_, port_, time(), this->utime());
 }
 
 void FirmwareNode::publish_fault(safety::FirmwareFault code, std::int8_t severity, bool active, const char* text) {

@@ -1,7 +1,6 @@
 #include "app/loop_counters.hpp"
 
 #include "app/timing_message.hpp"
-#include "exlcm/timing_t.hpp"
 #include "telemetry/telemetry_sink.hpp"
 
 namespace exc::app {
@@ -34,22 +33,33 @@ control::PerfCounter& LoopCounters::counter(LoopStage s) {
   return cycle;
 }
 
-void LoopCounters::publish(telemetry::TelemetrySink& out, const hal::FirmwareCanPort& port, double window_end, std::int64_t utime) {
-  exlcm::timing_t m{};
-  for (const LoopStage s : {LoopStage::cycle, LoopStage::read, LoopStage::update, LoopStage::write, LoopStage::telemetry,
-                            LoopStage::estimate, LoopStage::law, LoopStage::actuation, LoopStage::monitors}) {
-    fill_timing((*this)[s], static_cast<std::int8_t>(s), utime, m);
-    out.publish(telemetry::Channel::timing, m);
+void LoopCounters::publish_step(int step, telemetry::TelemetrySink& out, const hal::FirmwareCanPort& port, double window_end,
+                                std::int64_t utime) {
+  static constexpr LoopStage kStages[kTimingStages] = {LoopStage::cycle,    LoopStage::read,     LoopStage::update,
+                                                       LoopStage::write,    LoopStage::telemetry, LoopStage::estimate,
+                                                       LoopStage::law,      LoopStage::actuation, LoopStage::monitors};
+  if (step % 2 == 1) {
+    if (made_ == Made::timing) out.publish(telemetry::Channel::timing, timing_);
+    if (made_ == Made::can_stats) out.publish(telemetry::Channel::can_stats, can_stats_);
+    made_ = Made::none;
+    return;
   }
-  if (interval.count() > 0) {
-    fill_timing(interval, static_cast<std::int8_t>(LoopStage::interval), utime, m);
-    m.overruns = static_cast<std::int64_t>(deadline_overruns);
-    m.skipped = static_cast<std::int64_t>(skipped_deadlines);
-    out.publish(telemetry::Channel::timing, m);
+  const int part = step / 2;
+  if (part < kTimingStages) {
+    fill_timing((*this)[kStages[part]], static_cast<std::int8_t>(kStages[part]), utime, timing_);
+    made_ = Made::timing;
+  } else if (part == kTimingStages) {
+    if (interval.count() == 0) return;
+    fill_timing(interval, static_cast<std::int8_t>(LoopStage::interval), utime, timing_);
+    timing_.overruns = static_cast<std::int64_t>(deadline_overruns);
+    timing_.skipped = static_cast<std::int64_t>(skipped_deadlines);
+    made_ = Made::timing;
+  } else {
+    // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
+    const double load = bus_load_.update(port.tx_stats().bus_ns + port.rx_bus_ns(), window_end);
+    can_stats_ = can_stats_message(port.rx_stats(), port.tx_stats(), 0, utime, load);
+    made_ = Made::can_stats;
   }
-  // The firmware sends or receives every frame of the two-node bus: its counts are the bus's.
-  const double load = bus_load_.update(port.tx_stats().bus_ns + port.rx_bus_ns(), window_end);
-  out.publish(telemetry::Channel::can_stats, can_stats_message(port.rx_stats(), port.tx_stats(), 0, utime, load));
 }
 
 }  // namespace exc::app

@@ -4,7 +4,7 @@
 // this file; the payloads are little-endian with fixed-width fields, whatever either end's layout.
 //
 // A run:
-//   host   settings_chunk ... settings_end                  the settings blob, in pieces
+//   host   settings_chunk ... settings_chunk (empty)         the settings blob, in pieces of at most 4000 bytes
 //   target ready | refused (text)                           the blob checked at boot
 //   per cycle k:
 //   host   begin                                            the harness's cycle k begins
@@ -23,8 +23,7 @@ namespace exc::app {
 
 enum class PilRecord : std::uint8_t {
   // host to target
-  settings_chunk = 0x01,
-  settings_end = 0x02,
+  settings_chunk = 0x01,  // an empty one ends the blob
   frame_in = 0x03,
   inputs_done = 0x04,
   run_end = 0x05,
@@ -112,6 +111,7 @@ class RecordReader {
   }
   const std::uint8_t* in_;
   std::size_t n_, at_ = 0;
+  bool ok_ = true;
 };
 
 // A CAN frame with its bus times: frame_in and frame_out.

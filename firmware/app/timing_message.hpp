@@ -25,7 +25,7 @@ inline void fill_timing(const control::PerfCounter& c, std::int8_t stage, std::i
   m.bin_width_us = span / 64;
   std::fill(std::begin(m.bins), std::end(m.bins), 0);
   const auto& h = c.histogram();
-  for (int b = 0; b < control::PerfCounter::kBuckets; ++b) {
+  for (int b = 0; b <= c.top_bucket(); ++b) {
     if (h[b] == 0) continue;
     const double centre = control::PerfCounter::upper_edge_us(b) / std::sqrt(control::PerfCounter::kRatio);
     const int bin = std::min(63, static_cast<int>(centre / m.bin_width_us));

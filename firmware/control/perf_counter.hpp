@@ -24,6 +24,7 @@ class PerfCounter {
     min_us_ = std::numeric_limits<double>::infinity();
     max_us_ = 0;
     histogram_.fill(0);
+    top_ = 0;
   }
 
   void record_us(double us) {
@@ -33,7 +34,9 @@ class PerfCounter {
     min_us_ = std::min(min_us_, us);
     max_us_ = std::max(max_us_, us);
     if (us > budget_us_) ++overruns_;
-    ++histogram_[bucket_of(us)];
+    const int b = bucket_of(us);
+    ++histogram_[b];
+    top_ = std::max(top_, b);
   }
   void record_ns(std::int64_t ns) { record_us(static_cast<double>(ns) * 1e-3); }
 
@@ -49,11 +52,14 @@ class PerfCounter {
   // (at most 5 % high) percentile, capped by the exact max.
   double percentile_us(double fraction) const {
     if (count_ == 0) return 0;
-    const double target = fraction * static_cast<double>(count_);
+    // The samples to reach, as a whole count (the same test as seen >= fraction x count for a whole
+    // seen): a 32-bit core converts a 64-bit count to double in a library call, once here rather than
+    // per bucket.
+    const std::uint64_t target = std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(fraction * static_cast<double>(count_))));
     std::uint64_t seen = 0;
-    for (int b = 0; b < kBuckets; ++b) {
+    for (int b = 0; b <= top_; ++b) {
       seen += histogram_[b];
-      if (static_cast<double>(seen) >= target && seen > 0) return std::min(upper_edge_us(b), max_us_);
+      if (seen >= target) return std::min(upper_edge_us(b), max_us_);
     }
     return max_us_;
   }
@@ -63,20 +69,30 @@ class PerfCounter {
   // Upper edge of a bucket: 0.1 us * 1.05^(bucket + 1), from a table filled once (the telemetry
   // message re-bins every non-empty bucket by its edge each time it is published).
   static double upper_edge_us(int bucket) {
-    static const std::array<double, kBuckets> edges = [] {
-      std::array<double, kBuckets> e{};
-      for (int b = 0; b < kBuckets; ++b) e[static_cast<std::size_t>(b)] = kFirstEdgeUs * std::pow(kRatio, b + 1);
-      return e;
-    }();
     if (bucket < 0 || bucket >= kBuckets) return kFirstEdgeUs * std::pow(kRatio, bucket + 1);
-    return edges[static_cast<std::size_t>(bucket)];
+    return edges()[static_cast<std::size_t>(bucket)];
   }
+  // The highest bucket holding a sample (0 before any): the percentiles and a telemetry message's
+  // re-binning stop there, not at the last of the 336.
+  int top_bucket() const { return top_; }
 
  private:
+  static const std::array<double, kBuckets>& edges() {
+    static const std::array<double, kBuckets> e = [] {
+      std::array<double, kBuckets> t{};
+      for (int b = 0; b < kBuckets; ++b) t[static_cast<std::size_t>(b)] = kFirstEdgeUs * std::pow(kRatio, b + 1);
+      return t;
+    }();
+    return e;
+  }
+  // The bucket whose edges hold us: the edges at or below it, counted by bisection of the table (a
+  // logarithm per sample cost a few hundred instructions on a Cortex-M7 for each of the loop's ten
+  // counters; this costs about nine comparisons).
   static int bucket_of(double us) {
     if (!(us > kFirstEdgeUs)) return 0;
-    const int b = static_cast<int>(std::log(us / kFirstEdgeUs) / std::log(kRatio));
-    return std::clamp(b, 0, kBuckets - 1);
+    const auto& e = edges();
+    const int b = static_cast<int>(std::upper_bound(e.begin(), e.end(), us) - e.begin());
+    return std::min(b, kBuckets - 1);
   }
 
   const char* name_;
@@ -87,6 +103,7 @@ class PerfCounter {
   double min_us_ = std::numeric_limits<double>::infinity();
   double max_us_ = 0;
   std::array<std::uint32_t, kBuckets> histogram_{};
+  int top_ = 0;
 };
 
 }  // namespace exc::control

@@ -208,7 +208,10 @@ bool Supervisor::check_standstill(Mode mode, std::uint64_t cycle, bool complete,
   if (why[0] == 0) return false;
   escalated_ = true;
   FaultEvent& e = push_event(fault_code_, 2, true);
-  std::snprintf(e.text, sizeof e.text, "controlled stop escalated to the emergency stop %.2f s after it: %s (%s)", since, why, fault_text_);
+  // A longer text is cut at the event's (fault_t's) field.
+  if (std::snprintf(e.text, sizeof e.text, "controlled stop escalated to the emergency stop %.2f s after it: %s (%s)", since, why,
+                    fault_text_) < 0)
+    e.text[0] = 0;
   return true;
 }
 

@@ -18,19 +18,21 @@ class TelemetrySink {
   // The largest encoding a sink takes (timing_t, the largest exlcm type, is 593 bytes).
   static constexpr std::size_t kMaxMessageBytes = 1024;
 
-  // Allocation-free. Sets msg.seq to this channel's next sequence number (0, 1, 2, ...) and hands its
-  // encoding to the sink; false if it was refused (too large, or the sink was full).
+  // Allocation-free. Hands the message's encoding to the sink with its seq this channel's next
+  // sequence number (0, 1, 2, ...; msg.seq itself is not read); false if it was refused (too large,
+  // or the sink was full).
   template <class Msg>
-  bool publish(Channel channel, Msg msg) {
+  bool publish(Channel channel, const Msg& msg) {
     const auto index = static_cast<std::size_t>(channel);
     if (index >= channel_count) return false;
     if (every_[index] > 1 && offered_[index]++ % every_[index] != 0) return true;  // left out on purpose
-    msg.seq = static_cast<std::int64_t>(next_sequence_[index]++);
+    // Encoded as given, then its seq stamped into the bytes (stamp_sequence): no copy of the message.
     const int size = msg.encode(encode_buffer_.data(), 0, static_cast<int>(kMaxMessageBytes));
-    if (size < 0) {
+    if (size < 24) {
       note_too_large();
       return false;
     }
+    stamp_sequence(index, encode_buffer_.data());
     return put(index, encode_buffer_.data(), static_cast<std::size_t>(size));
   }
 
@@ -46,8 +48,7 @@ class TelemetrySink {
       return false;
     }
     if (every_[index] > 1 && offered_[index]++ % every_[index] != 0) return true;
-    const std::uint64_t seq = next_sequence_[index]++;
-    for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<std::uint8_t>(seq >> (56 - 8 * i));
+    stamp_sequence(index, bytes);
     return put(index, bytes, size);
   }
 
@@ -67,6 +68,12 @@ class TelemetrySink {
   virtual void note_too_large() {}
 
  private:
+  // This channel's next sequence number into an encoding's seq (bytes 16-23, big-endian).
+  void stamp_sequence(std::size_t index, std::uint8_t* bytes) {
+    const std::uint64_t seq = next_sequence_[index]++;
+    for (int i = 0; i < 8; ++i) bytes[16 + i] = static_cast<std::uint8_t>(seq >> (56 - 8 * i));
+  }
+
   std::array<std::uint64_t, channel_count> next_sequence_{};
   std::array<std::uint64_t, channel_count> offered_{};  // messages offered per channel (per_cycle_every)
   std::array<std::uint32_t, channel_count> every_{};    // record every Nth (1: all)

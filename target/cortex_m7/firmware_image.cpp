@@ -34,6 +34,7 @@ using exc::target::InstructionClock;
 using exc::target::TargetLink;
 
 constexpr int kBadLink = 2, kRefused = 3, kLinkBroken = 4;
+constexpr std::size_t kMaxBlobBytes = 4u << 20;
 
 std::uint8_t type_of(PilRecord r) { return static_cast<std::uint8_t>(r); }
 
@@ -43,14 +44,20 @@ std::uint8_t type_of(PilRecord r) { return static_cast<std::uint8_t>(r); }
   std::exit(kLinkBroken);
 }
 
-void send(TargetLink& link, PilRecord type, const void* bytes, std::size_t n) {
-  const TargetLink::Status s = link.send(type_of(type), bytes, n);
-  if (s != TargetLink::Status::ok) broken(link, s, "sending");
-}
-
 void flush(TargetLink& link) {
   const TargetLink::Status s = link.flush();
   if (s != TargetLink::Status::ok) broken(link, s, "flushing");
+}
+
+// A record into the outbound buffer; a full one goes to the host first (the host reads records, not
+// writes: a batch may take several).
+void send(TargetLink& link, PilRecord type, const void* bytes, std::size_t n) {
+  TargetLink::Status s = link.send(type_of(type), bytes, n);
+  if (s == TargetLink::Status::outbound_full) {
+    flush(link);
+    s = link.send(type_of(type), bytes, n);
+  }
+  if (s != TargetLink::Status::ok) broken(link, s, "sending");
 }
 
 // The frames the firmware sent and the messages it published, onto the link.
@@ -80,12 +87,31 @@ int main(int argc, char** argv) {
     return kBadLink;
   }
 
-  // The settings, in pieces up to settings_end.
+  // The settings, piece by piece (each its own batch: the blob is larger than the link's buffer), up
+  // to an empty piece.
   std::vector<std::uint8_t> blob;
-  if (const TargetLink::Status s = link.receive_until(type_of(PilRecord::settings_end)); s != TargetLink::Status::ok)
-    broken(link, s, "receiving the settings");
-  for (exc::hal::LinkRecordView r; link.next(r);)
-    if (r.type == type_of(PilRecord::settings_chunk)) blob.insert(blob.end(), r.payload, r.payload + r.payload_bytes);
+  for (bool more = true; more;) {
+    if (const TargetLink::Status s = link.receive_until(type_of(PilRecord::settings_chunk)); s != TargetLink::Status::ok)
+      broken(link, s, "receiving the settings");
+    for (exc::hal::LinkRecordView r; link.next(r);) {
+      if (r.type != type_of(PilRecord::settings_chunk)) continue;
+      if (r.payload_bytes == 0) more = false;
+      // Sized once from the blob's own length field (bytes 8-11), not grown by doubling: the heap's
+      // break is part of the image's RAM, and the decoder checks that length anyway.
+      if (blob.empty() && r.payload_bytes >= 12) {
+        const std::size_t total = static_cast<std::size_t>(r.payload[8]) | static_cast<std::size_t>(r.payload[9]) << 8 |
+                                  static_cast<std::size_t>(r.payload[10]) << 16 | static_cast<std::size_t>(r.payload[11]) << 24;
+        if (total <= kMaxBlobBytes) blob.reserve(total);
+      }
+      if (blob.size() + r.payload_bytes > kMaxBlobBytes) {
+        const char why[] = "settings blob over the image's limit (4 MiB)";
+        send(link, PilRecord::refused, why, sizeof why - 1);
+        flush(link);
+        return kRefused;
+      }
+      blob.insert(blob.end(), r.payload, r.payload + r.payload_bytes);
+    }
+  }
   auto settings = std::make_unique<exc::app::FirmwareImageSettings>();
   std::string error;
   if (!exc::app::decode_settings_blob(blob.data(), blob.size(), *settings, error)) {

@@ -14,7 +14,7 @@ namespace exc::target {
 
 class TargetLink {
  public:
-  static constexpr std::size_t kBufferBytes = 16 * 1024;      // each way: a cycle's records, encoded
+  static constexpr std::size_t kBufferBytes = 8 * 1024;       // each way: a cycle's records, encoded (a settings piece, 4 KiB, inbound)
   static constexpr std::size_t kMaxPayloadBytes = 4 * 1024;   // the longest record received
   static constexpr std::size_t kReadChunkBytes = 4 * 1024;    // raw bytes taken from the FIFO per read
 

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <string>
 
-#include "model/machine.hpp"
+#include "model/machine_reader.hpp"
 #include "safety/supervisor.hpp"
 
 using namespace exc;
