@@ -122,6 +122,38 @@ void SectionReader::fail_at(const YAML::Mark& mark, const std::string& field, co
   throw SettingsError(file_, known ? mark.line + 1 : 0, known ? mark.column + 1 : 0, field, reason);
 }
 
+namespace {
+
+// Edits (insert, delete, replace, swap two neighbours) from a to b: how far a misspelling is.
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<std::vector<std::size_t>> d(a.size() + 1, std::vector<std::size_t>(b.size() + 1, 0));
+  for (std::size_t i = 0; i <= a.size(); ++i) d[i][0] = i;
+  for (std::size_t j = 0; j <= b.size(); ++j) d[0][j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i)
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      d[i][j] = std::min({d[i - 1][j] + 1, d[i][j - 1] + 1, d[i - 1][j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) d[i][j] = std::min(d[i][j], d[i - 2][j - 2] + 1);
+    }
+  return d[a.size()][b.size()];
+}
+
+// A word close enough to `word` to be its misspelling (at most 2 edits, and fewer than half its
+// letters), the closest of `candidates`; "" when none is.
+std::string closest(const std::string& word, const std::vector<std::string>& candidates) {
+  std::string best;
+  std::size_t best_distance = 3;
+  for (const std::string& c : candidates) {
+    const std::size_t e = edit_distance(word, c);
+    if (e > 0 && e < best_distance && 2 * e < std::max(word.size(), c.size())) {
+      best = c;
+      best_distance = e;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
 void SectionReader::fail(const std::string& key, const std::string& reason) const {
   fail_at(mark_of(key), field(key), reason);
 }
@@ -391,7 +423,8 @@ void SectionReader::finish() const {
     if (known) continue;
     std::string list;
     for (const std::string& d : declared_) list += (list.empty() ? "" : ", ") + d;
-    fail_at(kv.first.Mark(), field(key), "unknown key; allowed keys: " + list);
+    const std::string near = closest(key, declared_);
+    fail_at(kv.first.Mark(), field(key), "unknown key; " + (near.empty() ? std::string() : "did you mean " + near + "? ") + "allowed keys: " + list);
   }
 }
 

@@ -120,10 +120,12 @@ TEST_CASE("firmware/settings accept the plant's sections without reading them an
       "integrator: {method: rk4}\nsensors: {seed: 3}\ninitial_state: {q_a: [0, 2.4, 2.5, 1.9]}\nchecks: {}\n";
   CHECK_NOTHROW(read(plant_sections + kTask));
   check_error("name: x\nduration: 2\nsoyl: {preset: loam}\n" + std::string(kTask), "soyl", "soyl",
-              "unknown key; allowed keys: name, description, machine, terrain, duration, controller, task, soil, "
+              "unknown key; did you mean soil? allowed keys: name, description, machine, terrain, duration, controller, task, soil, "
               "initial_state, actuators, integrator, sensors, checks");
   check_error("name: x\nduration: 2\n", "task", "name: x", "missing: the firmware needs a task (type: joint_waypoints, dig, truck_loading)");
   check_error("name: x\n" + std::string(kTask), "duration", "name: x", "missing: how long the run lasts");
+  // An unknown key spelt nearly as a declared one: named with it, as git and cargo do.
+  check_error("name: x\nduration: 2\ntask_: {}\n" + std::string(kTask), "task_", "task_", "unknown key; did you mean task? allowed keys:");
   check_error("name: x\nduration: 2\nterrain: {height: 50}\n" + std::string(kTask), "terrain.height", "50",
               "is 50 m; allowed range [-20, 20] m");
   check_error("name: x\nduration: 2\ncontroller: {kp: 3}\n" + std::string(kTask), "controller.kp", "3}",
