@@ -8,8 +8,7 @@
 #
 # Sets EXC_TARGET_SMOKE_IMAGE (the smoke image's ELF), EXC_TARGET_FIRMWARE_IMAGE (the firmware's),
 # EXC_QEMU_SYSTEM_ARM, EXC_ARM_OBJDUMP, EXC_ARM_NM and EXC_ARM_SIZE for the tests and the harness.
-# EXC_TARGET_IMAGES_REQUIRED (the test build): a missing tool stops the configuration; otherwise the
-# build goes on without images and says so.
+# A missing tool stops the configuration, naming its Debian package.
 include(ExternalProject)
 
 find_program(EXC_TARGET_GXX arm-none-eabi-g++)
@@ -48,14 +47,9 @@ endif()
 if(_exc_target_missing)
   list(REMOVE_DUPLICATES _exc_target_missing)
   string(REPLACE ";" ", " _exc_target_missing "${_exc_target_missing}")
-  if(EXC_TARGET_IMAGES_REQUIRED)
-    message(FATAL_ERROR "The test build runs the firmware's Cortex-M7 images under QEMU (docs/target.md) and "
-                        "misses the Debian packages: ${_exc_target_missing}. Install them with "
-                        "'tools/install-deps test' (or apt-get install the packages named).")
-  endif()
-  message(STATUS "No Cortex-M7 firmware image (excavator-sim --firmware-target needs one): missing ${_exc_target_missing}; "
-                 "'tools/install-deps test' installs them")
-  return()
+  message(FATAL_ERROR "The firmware's Cortex-M7 images (docs/target.md; EXC_TARGET_IMAGES, on in the test build, whose "
+                      "tests run them under QEMU): this build misses the Debian packages: ${_exc_target_missing}. Install them with "
+                      "'tools/install-deps test' (or apt-get install the packages named).")
 endif()
 
 # The cycle's sources, absolute, from the libraries that hold them.

@@ -208,8 +208,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
     const std::string image = options.firmware_image.empty() ? firmware_target_image(options.firmware_target) : options.firmware_image;
     if (image.empty())
       throw std::invalid_argument("--firmware-target " + options.firmware_target +
-                                  ": this build made no firmware image (configure with the Cortex-M7 toolchain: tools/install-deps "
-                                  "test, then cmake; or set EXC_FIRMWARE_IMAGE)");
+                                  ": this build made no firmware image (the test build makes it; another build with "
+                                  "-DEXC_TARGET_IMAGES=ON, after tools/install-deps test; or set EXC_FIRMWARE_IMAGE)");
     firmware_end_node = std::make_unique<TargetFirmware>(image, firmware, firmware_end, publisher.get());
   }
   FirmwareEnd& fw = *firmware_end_node;

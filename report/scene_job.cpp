@@ -101,7 +101,7 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
     const std::string image = firmware_target_image(job.firmware_target);
     if (image.empty() || !std::filesystem::exists(image))
       throw std::invalid_argument("--firmware-target " + job.firmware_target + ": no firmware image" +
-                                  (image.empty() ? std::string(" was built (configure with the Cortex-M7 toolchain: tools/install-deps test, then cmake)")
+                                  (image.empty() ? std::string(" was built (the test build makes it; another build with -DEXC_TARGET_IMAGES=ON, after tools/install-deps test)")
                                                  : " at " + image + " (build it: cmake --build <build> --target exc_target_images)"));
   }
   // Which controllers: --controller, else the scene's controller.type, else the registry's default set
