@@ -17,7 +17,8 @@ constexpr int kCylinderLength = 4;  // boom, arm, bucket: length at 4 + 2 c, rat
 constexpr int kPressureValid = 10;
 constexpr int kPressures = 11;      // A, B of swing, boom, arm, bucket at 11 + 2 axis (+1)
 constexpr int kPumps = 19;
-constexpr int kCount = 21;
+constexpr int kSpools = 21;         // swing, boom, arm, bucket
+constexpr int kCount = 25;
 static_assert(kCount <= static_cast<int>(kMaxDataSignals));
 }  // namespace sens
 
@@ -128,6 +129,7 @@ void FirmwareCanPort::apply(const MessageSpec& message, const CanFrame& frame, S
         state.pressure_b[axis] = v[sens::kPressures + 2 * axis + 1];
       }
       for (int pump = 0; pump < kPumpCount; ++pump) state.pump_pressure[pump] = v[sens::kPumps + pump];
+      for (int axis = 0; axis < kAxisCount; ++axis) state.spool[axis] = v[sens::kSpools + axis];
       if (frame_counter(frame) == nibble(cycle_)) have_sensors_ = true;
       break;
     case can_id::plant_heartbeat:
@@ -282,6 +284,7 @@ bool PlantCanPort::write(const SensorState& sensor) {
     v[sens::kPressures + 2 * axis + 1] = sensor.pressure_b[axis];
   }
   for (int pump = 0; pump < kPumpCount; ++pump) v[sens::kPumps + pump] = sensor.pump_pressure[pump];
+  for (int axis = 0; axis < kAxisCount; ++axis) v[sens::kSpools + axis] = sensor.spool[axis];
   return transmit(spec_of(can_id::sens_machine), nibble(sensor.cycle), v);
 }
 

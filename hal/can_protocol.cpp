@@ -58,6 +58,9 @@ constexpr SignalSpec cmd_pilot[] = {
   {prefix "Length", start, 20, false, 1e-5, 0, 0, 10.48575, "m"},             \
   {prefix "Rate", start + 20, 16, true, 1e-4, 0, -3.2768, 3.2767, "m/s"}
 #define EXC_PRESSURE(name, start) {name, start, 16, false, 1000, 0, 0, 65535000, "Pa"}
+// Spool positions 12 bits at 0.1 % of the stroke (an LVDT's resolution on a valve actuator; the spool
+// lies in -1..1 of its stroke, the range leaves room to report a reading beyond it).
+#define EXC_SPOOL(name, start) {name, start, 12, true, 1e-3, 0, -2.048, 2.047, ""}
 constexpr SignalSpec sens_machine[] = {
     counter_signal,
     {"PlantState", 4, 4, false, 1, 0, 0, 15, ""},
@@ -78,9 +81,14 @@ constexpr SignalSpec sens_machine[] = {
     EXC_PRESSURE("BucketPressureB", 280),
     EXC_PRESSURE("Pump1Pressure", 296),
     EXC_PRESSURE("Pump2Pressure", 312),
+    EXC_SPOOL("SwingSpool", 328),
+    EXC_SPOOL("BoomSpool", 340),
+    EXC_SPOOL("ArmSpool", 352),
+    EXC_SPOOL("BucketSpool", 364),
     crc_at(48)};
 #undef EXC_CYLINDER
 #undef EXC_PRESSURE
+#undef EXC_SPOOL
 constexpr SignalSpec fw_heartbeat[] = {
     counter_signal, {"FirmwareMode", 4, 4, false, 1, 0, 0, 15, ""}, crc_at(2)};
 constexpr SignalSpec plant_heartbeat[] = {

@@ -75,7 +75,7 @@ const char* to_string(SupervisorCommand command);
 
 inline constexpr std::size_t kMessageCount = 10;
 // The most data signals of any message (SENS_MACHINE): a buffer of this size holds any decoded frame.
-inline constexpr std::size_t kMaxDataSignals = 21;
+inline constexpr std::size_t kMaxDataSignals = 25;
 inline constexpr std::int64_t kCyclePeriodNs = 1'000'000;  // one SYNC per millisecond
 inline constexpr int kHeartbeatPeriodCycles = 100;
 inline constexpr int kEmergencyRepeatCycles = 10;

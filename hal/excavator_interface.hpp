@@ -29,6 +29,9 @@ struct SensorState {
   std::array<double, kAxisCount> pressure_a{};
   std::array<double, kAxisCount> pressure_b{};
   std::array<double, kPumpCount> pump_pressure{};  // Pa
+  // Main-valve spool positions as their LVDTs measure them, -1..1 of the stroke from neutral
+  // (positive towards positive motion); hydraulic plant only, like the pressures.
+  std::array<double, kAxisCount> spool{};
   // The pressures are measured (the hydraulic plant); false for the force-commanded fidelities.
   // Plant: what it sends; firmware: what the last sensor frame said.
   bool pressure_valid = false;

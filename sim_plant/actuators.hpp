@@ -51,6 +51,7 @@ class ActuatorModel {
   void set_pump_flow_scale(double scale) { circuit_.set_pump_flow_scale(scale); }
   void set_pilot_supply(bool on) { circuit_.set_pilot_supply(on); }
   void set_engine_running(bool on) { circuit_.set_engine_running(on); }
+  void set_safety_solenoids(bool energised) { circuit_.set_safety_solenoids(energised); }
   const Vec4& spool() const { return circuit_.spool(); }
   const Vec4& pressure_a() const { return circuit_.pressure_a(); }  // cylinder bore side; swing: port A
   const Vec4& pressure_b() const { return circuit_.pressure_b(); }

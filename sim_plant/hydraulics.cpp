@@ -51,8 +51,9 @@ void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
   target_.setZero();
   spool_.setZero();
   stuck_ = -1;
-  pilot_on_ = engine_on_ = true;
-  pilot_ = engine_ = 1;
+  pilot_on_ = engine_on_ = solenoids_on_ = true;
+  pilot_ = engine_ = shutoff_ = 1;
+  solenoid_off_time_ = -1;
   const double low = 2.0 * hp_.tank_pressure;
   for (int i = 0; i < kNumActive; ++i) {
     const double f = hold[i];
@@ -128,10 +129,18 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // The safety hardware: the pilot supply (first order) and the engine's flow (linear run-down).
   pilot_ += ((pilot_on_ ? 1.0 : 0.0) - pilot_) * pilot_lag_gain_;
   engine_ = std::clamp(engine_ + (engine_on_ ? dt : -dt) / hp_.engine_rundown_time, 0.0, 1.0);
+  // The emergency stop's solenoids: the pump-line shut-off (linear over its closing time) and the
+  // time since they dropped, which the holding valves' closing counts.
+  shutoff_ = std::clamp(shutoff_ + (solenoids_on_ ? dt : -dt) / hp_.pump_shutoff_time, 0.0, 1.0);
+  solenoid_off_time_ = solenoids_on_ ? -1.0 : std::max(solenoid_off_time_, 0.0) + dt;
   const bool holding_closed = holding_valves_closed();
+  const bool bucket_closed = bucket_holding_valve_closed();
   r.pilot_supply = pilot_;
   r.engine_flow = engine_;
+  r.pump_line_open = shutoff_;
   r.holding_valves_closed = holding_closed;
+  r.bucket_holding_valve_closed = bucket_closed;
+  r.swing_brake_applied = swing_brake_applied();
   // Spools: lag toward the target (what the pilots push, as far as the supply gives them), then the
   // dead zone of the direction they moved in.
   const double lag_gain = spool_lag_gain_;
@@ -144,7 +153,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // relief), summed per pump; the flow-sharing factor follows (flow_sharing.hpp). It is taken from
   // the pressures at the start of the substep.
   const int pumps = hp_.pumps_merged ? 1 : kNumPumps;
-  const double pump_limit = hp_.pump_flow * pump_flow_scale_ * engine_ / pumps;
+  const double pump_limit = hp_.pump_flow * pump_flow_scale_ * std::min(engine_, shutoff_) / pumps;
   double demand[kNumPumps] = {0, 0};
   for (int i = 0; i < kNumActive; ++i) {
     const double a = r.opening[i];
@@ -195,6 +204,8 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
     // cap side, the arm's rod side (in-flow, through its check, stays open).
     if (holding_closed && i == 1) va.meter_out_gain = va.leakage_gain = 0;
     if (holding_closed && i == 2) vb.meter_out_gain = vb.leakage_gain = 0;
+    // The bucket's double pilot-operated check, when fitted: both ports blocked.
+    if (bucket_closed && i == 3) va.meter_out_gain = va.leakage_gain = vb.meter_out_gain = vb.leakage_gain = 0;
     const double swept_a = g_.area_a[i] * qd_a[i] * dt, swept_b = -g_.area_b[i] * qd_a[i] * dt;
     const ChamberStep sa = step(va, p_a_[i], va1, hp_.bulk_modulus, dt, swept_a, hp_.vapour_pressure);
     const ChamberStep sb = step(vb, p_b_[i], vb1, hp_.bulk_modulus, dt, swept_b, hp_.vapour_pressure);

@@ -72,7 +72,10 @@ struct HydraulicReport {
   int solver_iterations = 0;            // of the eight chamber solves in the last substep
   // The safety hardware: pilot supply and engine flow (0..1), the load-holding valves closed.
   double pilot_supply = 1, engine_flow = 1;
+  double pump_line_open = 1;  // the pump-line shut-off's opening (0..1)
   bool holding_valves_closed = false;
+  bool bucket_holding_valve_closed = false;
+  bool swing_brake_applied = false;
   HydraulicEnergy energy;
 };
 
@@ -102,12 +105,24 @@ class HydraulicCircuit {
   // centre; a stuck spool keeps its opening); back on, it recovers likewise. Engine stop: the pumps'
   // flow falls linearly to zero over hydraulics.engine_rundown_time (and rises so on a restart).
   // Load-holding valves (hydraulics.load_holding_valves): closed while the supply is below half.
+  // The emergency stop's safety solenoids (de-energised: false): the pump-line shut-off's flow
+  // falls to zero over hydraulics.pump_shutoff_time, the load-holding valves (and the bucket's, when
+  // fitted) close hydraulics.holding_valve_close_time after the drop, the swing brake is dumped at
+  // once; energised again, the shut-off reopens likewise and the valves and the brake follow the
+  // pilot supply.
   void set_pilot_supply(bool on) { pilot_on_ = on; }
   void set_engine_running(bool on) { engine_on_ = on; }
+  void set_safety_solenoids(bool energised) { solenoids_on_ = energised; }
   double pilot_supply() const { return pilot_; }   // 0..1 of the pilot pressure
   double engine_flow() const { return engine_; }   // 0..1 of the pumps' rated flow
-  bool holding_valves_closed() const { return hp_.load_holding_valves && pilot_ < 0.5; }
-  bool swing_brake_applied() const { return hp_.swing_brake_torque > 0 && pilot_ < 0.5; }
+  double pump_line_open() const { return shutoff_; }  // 0..1: the pump-line shut-off's opening
+  bool holding_valves_closed() const {
+    return hp_.load_holding_valves && (pilot_ < 0.5 || solenoid_off_time_ >= hp_.holding_valve_close_time);
+  }
+  bool bucket_holding_valve_closed() const {
+    return hp_.bucket_holding_valve && solenoid_off_time_ >= hp_.holding_valve_close_time;
+  }
+  bool swing_brake_applied() const { return hp_.swing_brake_torque > 0 && (pilot_ < 0.5 || !solenoids_on_); }
 
   // Advance spools, pumps and chambers over dt; q_a is the position at the end, qd_a the velocity
   // over the substep (the piston sweeps A qd_a dt).
@@ -146,8 +161,9 @@ class HydraulicCircuit {
   Vec4 relief_setting_ = Vec4::Zero();
   double k_relief_ = 0, k_makeup_ = 0;
   double pump_flow_scale_ = 1;
-  bool pilot_on_ = true, engine_on_ = true;
-  double pilot_ = 1, engine_ = 1;
+  bool pilot_on_ = true, engine_on_ = true, solenoids_on_ = true;
+  double pilot_ = 1, engine_ = 1, shutoff_ = 1;
+  double solenoid_off_time_ = -1;  // s since the safety solenoids dropped; negative while energised
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();
   Vec4 v_a_ = Vec4::Zero(), v_b_ = Vec4::Zero();  // chamber volumes at the end of the last substep
   // The two first-order lags' gains (pilot supply, spools) for the step `lag_dt_`: the plant's step

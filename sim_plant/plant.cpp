@@ -64,7 +64,11 @@ void Plant::reset() {
   none.rhod = rhod_;
   fill_state(none);
   sensors_.sample(0, mech_.q_a, mech_.qd_a, actuators_.pressure_a(), actuators_.pressure_b(),
-                  actuators_.hydraulics().report().pump_pressure);
+                  actuators_.hydraulics().report().pump_pressure, measured_spools());
+}
+
+const Vec4* Plant::measured_spools() const {
+  return actuators_.fidelity().has(kHydraulicCircuit) ? &actuators_.spool() : nullptr;
 }
 
 bool Plant::accept_command(const ActuatorCommand& command) {
@@ -354,7 +358,7 @@ PlantStatus Plant::step(const ActuatorCommand& command) {
   }
   fill_state(start);
   sensors_.sample(state_.cycle, mech_.q_a, mech_.qd_a, actuators_.pressure_a(), actuators_.pressure_b(),
-                  actuators_.hydraulics().report().pump_pressure);
+                  actuators_.hydraulics().report().pump_pressure, measured_spools());
   return status_;
 }
 

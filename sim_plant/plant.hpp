@@ -62,10 +62,12 @@ class Plant {
   void release_spool() { actuators_.release_spool(); }
   // The hydraulic machine's pumps deliver `scale` of their flow from now on (1: the machine's).
   void set_pump_flow_scale(double scale) { actuators_.set_pump_flow_scale(scale); }
-  // The machine's safety hardware (kHydraulicCircuit; HydraulicCircuit): the pilot cut-off and the
-  // engine stop. Their state: hydraulics() of actuators(), or PlantNode's PlantState bits.
+  // The machine's safety hardware (kHydraulicCircuit; HydraulicCircuit): the pilot cut-off, the
+  // engine stop and the emergency stop's solenoids (pump-line shut-off, holding valves, swing
+  // brake). Their state: state().hydraulics, or PlantNode's PlantState bits.
   void set_pilot_supply(bool on) { actuators_.set_pilot_supply(on); }
   void set_engine_running(bool on) { actuators_.set_engine_running(on); }
+  void set_safety_solenoids(bool energised) { actuators_.set_safety_solenoids(energised); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.
@@ -85,6 +87,8 @@ class Plant {
   double constraint_residual() const { return state_.constraint_residual; }
 
  private:
+  // The spools the sensors measure: the hydraulic circuit's, none on a force-commanded plant.
+  const Vec4* measured_spools() const;
   bool accept_command(const ActuatorCommand& command);
   bool apply_limits(const Vec4& qd_start);
   Vec4 apply_dry_friction(const MechanicalState& before);

@@ -134,8 +134,10 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   if (hold && !holding_) ++holds_;
   holding_ = hold;
   // The machine's safety controller on the firmware's emergency stop (FW_EMERGENCY EmergencyStop):
-  // pilot supply cut (every spool springs to centre), engine stopped (the pumps run down), and so
-  // the load-holding valves closed; all back when the stop is released (docs/safety.md). On a lost
+  // pilot supply cut (every spool springs to centre), engine stopped (the pumps run down), and its
+  // safety solenoids dropped: the pump-line shut-off unloads the pumps, the load-holding valves close
+  // and the swing brake is dumped, whatever the main spools do; all back when the stop is released
+  // (docs/safety.md). On a lost
   // link (commands had come, then none within the timeout, or SYNC fell silent) it drops the enable
   // as an autonomy kit's receiver does: the pilot supply cut, so the load-holding valves and the
   // swing's brake hold; the engine runs on. Both come back with the next valid command set. Before
@@ -145,6 +147,7 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
   if (hydraulic) {
     plant_.set_pilot_supply(!pilot_cut);
     plant_.set_engine_running(!command_.emergency_stop);
+    plant_.set_safety_solenoids(!command_.emergency_stop);
   }
 
   // Any other command goes to the plant as the kind it is: a kind the actuators cannot use (efforts
@@ -187,6 +190,7 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
     sensors_.pressure_b[c + 1] = r.pressure_b[c];
   }
   for (int p = 0; p < hal::kPumpCount; ++p) sensors_.pump_pressure[p] = r.pump_pressure[p];
+  for (int j = 0; j < 4; ++j) sensors_.spool[j] = r.spool[j];
   sensors_.pressure_valid = hydraulic;
   apply_sensor_fault();
   const plant::HydraulicReport& h = plant_.state().hydraulics;

@@ -59,6 +59,8 @@ void read_sensors(SectionReader& sens, SensorParameters& sp) {
   sens.number("pressure_quantum", sp.pressure_quantum, {0, 1e7}, "Pa", "pressure resolution");
   sens.number("pressure_noise", sp.pressure_noise, {0, 5e6}, "Pa",
               "standard deviation on every chamber and pump pressure reading (transmitter noise, pump ripple)");
+  sens.number("spool_noise", sp.spool_noise, {0, 0.1}, "",
+              "standard deviation of each spool position reading, a fraction of the stroke (hydraulic plant)");
   sens.whole("seed", sp.seed, 0, 4294967295.0, "", "noise seed (runs are reproducible)");
   sens.whole("latency_cycles", sp.latency_cycles, 0, SensorParameters::kMaxLatency, "", "readings lag by this many cycles");
   sens.finish();

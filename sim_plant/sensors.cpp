@@ -9,7 +9,9 @@ SensorModel::SensorModel(const SensorParameters& params) : params_(params) { res
 
 void SensorModel::reset() {
   rng_.seed(params_.seed);
+  spool_rng_.seed(params_.seed ^ 0x5A5A5A5A5A5A5A5AULL);
   normal_.reset();
+  spool_normal_.reset();
   ring_.fill(SensorReading{});
   write_index_ = read_index_ = filled_ = 0;
 }
@@ -22,7 +24,7 @@ double SensorModel::quantise(double v, double quantum) {
 }
 
 void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, const Vec4& p_a,
-                         const Vec4& p_b, const Vec2& pump) {
+                         const Vec4& p_b, const Vec2& pump, const Vec4* spool) {
   SensorReading& r = ring_[write_index_];
   for (int i = 0; i < 4; ++i) {
     // Noise first, then the converter's quantisation, as a real encoder chain does.
@@ -44,6 +46,11 @@ void SensorModel::sample(std::int64_t cycle, const Vec4& q_a, const Vec4& qd_a, 
   r.swing_pressure.x() = pressure(p_a[0]);
   r.swing_pressure.y() = pressure(p_b[0]);
   for (int i = 0; i < 2; ++i) r.pump_pressure[i] = pressure(pump[i]);
+  // The spools' LVDTs (the bus quantises them, 0.1 % of the stroke).
+  for (int i = 0; i < 4; ++i) {
+    const double n = spool != nullptr && params_.spool_noise > 0 ? params_.spool_noise * spool_normal_(spool_rng_) : 0.0;
+    r.spool[i] = spool != nullptr ? (*spool)[i] + n : 0.0;
+  }
   r.cycle = cycle;
   const int n = static_cast<int>(ring_.size());
   const int latency = params_.latency_cycles;

@@ -179,11 +179,23 @@ struct HydraulicParameters {
   // swing motor's own torque (machine file's swing.max_torque, 65 kN m), a brake that holds what the
   // motor can drive. 0: none. Range [0, 1e7].
   double swing_brake_torque = 65e3;
+  // The emergency stop's own safety solenoids (safety.md, "Stopping a stuck spool"), de-energised to
+  // stop by the machine's safety controller on FW_EMERGENCY, whatever the main spools do:
+  // s, the pump-line shut-off with load-sensing unloading: the pumps' delivered flow falls linearly to
+  // zero over it (estimate: 50-150 ms for unloading and de-stroke, no datasheet figure found; 50 ms
+  // nominal). The engine stop stays beside it. Range [1e-3, 1].
+  double pump_shutoff_time = 0.05;
+  // s, the load-holding valves' closing once their solenoid drops (estimate: a solenoid-piloted
+  // poppet, tens of ms). They also close while the pilot supply is cut, as before. Range [0, 1].
+  double holding_valve_close_time = 0.05;
+  // A double pilot-operated check valve on both bucket ports, on the same solenoid (no source puts
+  // one on a 20 t machine's bucket: off on the reference machine).
+  bool bucket_holding_valve = false;
 };
 // The settings blob's field list (app/settings_blob.hpp): what the firmware's cycle reads (valve
 // stage, friction model, pump pacing, pressure monitor). Left out, the plant's alone: piston_leakage,
 // spool_leakage, swing_drain_leakage, pilot_cutoff_time, engine_rundown_time, load_holding_valves,
-// swing_brake_torque. A field the firmware comes to read is added here (the blob's round-trip test,
+// swing_brake_torque, pump_shutoff_time, holding_valve_close_time, bucket_holding_valve. A field the firmware comes to read is added here (the blob's round-trip test,
 // tests/firmware_control/test_settings_blob_runs.cpp, runs with the left-out ones poisoned).
 template <typename Visitor>
 void visit_fields(Visitor& v, HydraulicParameters& p) {

@@ -177,7 +177,13 @@ void read_hydraulics(SectionReader& h, HydraulicParameters& p, double relief_pre
   h.flag("load_holding_valves", p.load_holding_valves,
          "load-holding valves on the boom's cap and the arm's rod side, closed while the pilot supply is cut");
   h.number("swing_brake_torque", p.swing_brake_torque, {0, 1e7}, "N m",
-           "the swing parking brake, applied while the pilot supply is cut (0: none)");
+           "the swing parking brake, applied while the pilot supply is cut or on an emergency stop (0: none)");
+  h.number("pump_shutoff_time", p.pump_shutoff_time, {1e-3, 1}, "s",
+           "on an emergency stop the pump-line shut-off's flow falls linearly to zero over this time");
+  h.number("holding_valve_close_time", p.holding_valve_close_time, {0, 1}, "s",
+           "on an emergency stop the load-holding valves close this long after their solenoid drops");
+  h.flag("bucket_holding_valve", p.bucket_holding_valve,
+         "a holding valve on both bucket ports, closed on an emergency stop (none on the reference machine)");
   h.finish();
 }
 

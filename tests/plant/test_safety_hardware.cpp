@@ -1,7 +1,9 @@
 // The machine's safety hardware (docs/safety.md; sim_plant/hydraulics.hpp): the pilot cut-off, the
-// engine stop and the load-holding valves, each against the law it is stated with: the spools
-// follow the pilot supply's first-order decay, the pumps' flow its linear run-down, and a raised
-// boom whose spool is stuck open in the lowering direction is held once the pilot supply is cut.
+// engine stop, the emergency stop's own solenoids (pump-line shut-off, load-holding valves, swing
+// brake) and the bucket holding valve option, each against the law it is stated with: the spools
+// follow the pilot supply's first-order decay, the pumps' flow its linear run-down, the pump line
+// its linear closing, and a raised boom whose spool is stuck open in the lowering direction is held
+// once the pilot supply is cut or the holding valves' solenoid drops.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -18,7 +20,23 @@ using plant::test::valve;
 
 namespace {
 
-
+// Steps the plant span s with centred valves and returns the slope (m/s, rad/s) of a least-squares
+// line through function f's position over it: its net motion, a ring's periods averaged out.
+double fitted_slope(Plant& plant, int f, double span) {
+  double st = 0, sq = 0, stt = 0, stq = 0;
+  int n = 0;
+  const double t0 = plant.state().time;
+  while (plant.state().time - t0 < span - 1e-9) {
+    REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+    const double t = plant.state().time - t0, q = plant.state().q_a[f];
+    st += t;
+    sq += q;
+    stt += t * t;
+    stq += t * q;
+    ++n;
+  }
+  return (n * stq - st * sq) / (n * stt - st * st);
+}
 
 }  // namespace
 
@@ -148,4 +166,84 @@ TEST_CASE("plant/friction: a bucket pressed into its end stop by a stuck spool l
   CHECK(worst_gain < 1e-3);
   CHECK(rest_from >= 0);
   CHECK(rest_from < 3.0);
+}
+
+TEST_CASE("plant/safety hardware: the emergency stop's solenoids shut the pump line over its closing time, whatever the spools do, with the engine and the pilot supply still on") {
+  // A boom spool stuck open to raise it, the engine running and the pilot supply on: the pumps feed
+  // it until the pump-line shut-off closes; its opening falls linearly (half at half the closing
+  // time), the meter-in flow with it, and none passes once it is shut.
+  Plant plant(hydraulic_scene());
+  const HydraulicParameters& hp = plant.scene().machine.hydraulics;
+  plant.stick_spool(1, 0.8);
+  for (int k = 0; k < 300; ++k) REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+  const double fed = plant.state().hydraulics.meter_in_flow[1];
+  REQUIRE(fed > 1e-4);  // m^3/s: the pumps drive the raising boom
+  plant.set_safety_solenoids(false);
+  const double t0 = plant.state().time;
+  double open_at_half = -1, t_shut = -1;
+  for (int k = 0; k < 200; ++k) {
+    REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+    const double t = plant.state().time - t0;
+    if (open_at_half < 0 && t >= 0.5 * hp.pump_shutoff_time - 1e-9) open_at_half = plant.state().hydraulics.pump_line_open;
+    if (t_shut < 0 && plant.state().hydraulics.pump_line_open == 0) t_shut = t;
+  }
+  CHECK(open_at_half == doctest::Approx(0.5).epsilon(0.05));
+  CHECK(t_shut == doctest::Approx(hp.pump_shutoff_time).epsilon(0.05));
+  CHECK(plant.state().hydraulics.meter_in_flow[1] == 0.0);
+  CHECK(plant.state().hydraulics.pilot_supply == 1.0);
+  CHECK(plant.state().hydraulics.engine_flow == 1.0);
+  // Energised again, the line reopens and the stuck spool is fed again.
+  plant.set_safety_solenoids(true);
+  for (int k = 0; k < 200; ++k) REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+  CHECK(plant.state().hydraulics.meter_in_flow[1] > 0.5 * fed);
+}
+
+TEST_CASE("plant/safety hardware: on their own solenoid the load-holding valves close after their closing time and hold a boom stuck lowering with the pilot supply still on, and the swing brake is dumped at once") {
+  Plant plant(hydraulic_scene());
+  const HydraulicParameters& hp = plant.scene().machine.hydraulics;
+  plant.stick_spool(1, -0.5);  // lowering, pilot supply on: the old trigger (supply below half) never comes
+  for (int k = 0; k < 100; ++k) REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+  REQUIRE(plant.state().qd_a[1] < -0.01);
+  CHECK_FALSE(plant.state().hydraulics.swing_brake_applied);
+  plant.set_safety_solenoids(false);
+  REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+  CHECK(plant.state().hydraulics.swing_brake_applied);  // the first step after the drop
+  const double t0 = plant.state().time - plant.scene().cycle;
+  double t_closed = -1;
+  for (int k = 0; k < 2500; ++k) {
+    REQUIRE(plant.step(valve(Vec4::Zero())).ok());
+    if (t_closed < 0 && plant.state().hydraulics.holding_valves_closed) t_closed = plant.state().time - t0;
+  }
+  CHECK(t_closed == doctest::Approx(hp.holding_valve_close_time).epsilon(0.05).scale(1e-3));
+  // The boom rings on its trapped oil (about 2 Hz): its net motion is the slope of a line fitted over
+  // 2 s, as the stop requirement judges drift.
+  const double creep = fitted_slope(plant, 1, 2.0);
+  MESSAGE("boom stuck at -0.5 with the pilot supply on: held by the holding valve's solenoid, " << creep * 1e3
+                                                                                                << " mm/s fitted 2.5-4.5 s after the drop");
+  CHECK(std::abs(creep) < 1e-3);
+}
+
+TEST_CASE("plant/safety hardware: a bucket stuck open the way its load runs drains through its spool with the pumps shut and no holding valve, and is held with the machine file's bucket_holding_valve") {
+  // The bucket curled in (1.75 m) at the reference pose: its load extends it, so a spool stuck open
+  // that way lets it run out to tank whatever the pumps do, the residual risk the reference machine
+  // declares (no source puts a holding valve on a 20 t bucket).
+  double creep[2] = {0, 0};
+  for (const bool fitted : {false, true}) {
+    plant::test::SceneText t;
+    t.actuators = "fidelity: hydraulic";
+    t.q_a = "[0.0, 2.4626, 2.3231, 1.75]";
+    Scene scene = t.scene();
+    scene.machine.hydraulics.bucket_holding_valve = fitted;
+    Plant p(scene);
+    p.stick_spool(3, 0.5);
+    p.set_safety_solenoids(false);
+    p.set_pilot_supply(false);
+    p.set_engine_running(false);
+    for (int k = 0; k < 1500; ++k) REQUIRE(p.step(valve(Vec4::Zero())).ok());
+    creep[fitted ? 1 : 0] = fitted_slope(p, 3, 1.0);
+    MESSAGE("bucket stuck open at 0.5, everything shut: " << creep[fitted ? 1 : 0] * 1e3 << " mm/s 1.5-2.5 s after the stop, bucket holding valve "
+                                                           << std::string(fitted ? "fitted" : "not fitted"));
+  }
+  CHECK(creep[0] > 0.05);  // m/s: the reference machine's residual risk, gravity drains it
+  CHECK(std::abs(creep[1]) < 1e-3);  // held by the option
 }

@@ -3,8 +3,9 @@
 // what the sender put in each frame (JSON lines, in capture order: {"line", "message", "signals":
 // {name: physical value}}), named by DBC signal here, independently of the ports' own mapping. An
 // independent DBC decoder (tests/vcan/canmatrix_decode.py) then decodes the capture and compares.
-// Every frame kind goes out: SYNC, the three command sets in turn, SENS_MACHINE with every pressure,
-// both heartbeats, both emergency frames and the operator station's SUPERVISOR (every command).
+// Every frame kind goes out: SYNC, the three command sets in turn, SENS_MACHINE with every pressure
+// and spool position, both heartbeats, both emergency frames and the operator station's SUPERVISOR
+// (every command).
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -71,6 +72,7 @@ SensorState sensors_at(std::uint64_t k) {
     s.pressure_b[a] = 5e6 + 4e6 * std::cos(0.9 * t + a);
   }
   s.pump_pressure = {30e6 + 4e6 * std::sin(2 * t), 29e6 + 4e6 * std::cos(2 * t)};
+  for (int a = 0; a < kAxisCount; ++a) s.spool[a] = 1.02 * std::sin(1.7 * t + a);  // past the stroke's ends, both ways
   s.pressure_valid = (k / 50) % 2 == 0;
   s.plant_state = static_cast<std::uint8_t>(k % 9);
   s.plant_faults = static_cast<std::uint8_t>(k % 200);
@@ -86,7 +88,9 @@ Signals sensor_signals(const SensorState& s) {
           {"BoomPressureA", s.pressure_a[kBoom]},     {"BoomPressureB", s.pressure_b[kBoom]},
           {"ArmPressureA", s.pressure_a[kArm]},       {"ArmPressureB", s.pressure_b[kArm]},
           {"BucketPressureA", s.pressure_a[kBucket]}, {"BucketPressureB", s.pressure_b[kBucket]},
-          {"Pump1Pressure", s.pump_pressure[0]},      {"Pump2Pressure", s.pump_pressure[1]}};
+          {"Pump1Pressure", s.pump_pressure[0]},      {"Pump2Pressure", s.pump_pressure[1]},
+          {"SwingSpool", s.spool[kSwing]},            {"BoomSpool", s.spool[kBoom]},
+          {"ArmSpool", s.spool[kArm]},                {"BucketSpool", s.spool[kBucket]}};
 }
 
 CommandState command_at(std::uint64_t k, const char*& message, Signals& signals) {
