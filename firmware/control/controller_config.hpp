@@ -11,6 +11,7 @@
 #include "control/control_types.hpp"
 #include "control/pid.hpp"
 #include "safety/pressure_plausibility.hpp"
+#include "safety/spool_monitor.hpp"
 #include "control/soil_contact.hpp"
 #include "control/state_estimator.hpp"
 #include "control/valve_inner_loop.hpp"
@@ -133,6 +134,9 @@ struct ControllerConfig {
   // The chamber pressures' range, steps and stuck-at readings on the valve interface (docs/safety.md,
   // H4); its limits come from the machine file's hydraulics section (pressure_plausibility.hpp).
   safety::PressurePlausibilitySettings pressure_plausibility;
+  // The spool monitor (safety/spool_monitor.hpp; docs/safety.md, H1): each measured spool against
+  // its command through the valve's lag, valve interface.
+  safety::SpoolMonitorSettings spool_monitor;
   // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
   // machine far from where it was told to go must stop; rad (swing), m (cylinders). On the valve
   // interface the default is kTrackingLimitMultiple x what the valve machine reaches
@@ -196,6 +200,7 @@ void visit_fields(Visitor& v, ControllerConfig& c) {
   v("max_missed_deadlines", c.max_missed_deadlines);
   v("plausibility", c.plausibility);
   v("pressure_plausibility", c.pressure_plausibility);
+  v("spool_monitor", c.spool_monitor);
   v("tracking_error_limit", c.tracking_error_limit);
   v("blend_time", c.blend_time);
   v("stop_ramp_time", c.stop_ramp_time);

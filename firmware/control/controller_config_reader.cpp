@@ -103,6 +103,17 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   pp.number("moving_share", c.pressure_plausibility.moving_share, {1e-3, 1}, "", "of the function's top speed: faster counts as moving");
   pp.whole("debounce", c.pressure_plausibility.debounce, 1, 1000, "", "sensor sets in a row the range or the step test must fail");
   pp.finish();
+  SectionReader sm = r.section("spool_monitor",
+                               "each measured main-valve spool against its command through the valve's lag, valve interface (docs/safety.md, H1)");
+  sm.flag("enabled", c.spool_monitor.enabled, "the monitor runs (a fault, emergency stop, when a spool disagrees)");
+  sm.number("excess", c.spool_monitor.excess, {0.01, 2}, "",
+            "of the stroke: a spool further from neutral than expected by more than this disagrees");
+  sm.number("band", c.spool_monitor.band, {0.005, 1}, "",
+            "of the stroke: a spool this far on the wrong side of neutral, or off neutral with neutral expected, disagrees");
+  sm.number("neutral_expected", c.spool_monitor.neutral_expected, {0, 0.5}, "",
+            "of the stroke: an expected spool nearer neutral than this counts as neutral commanded");
+  sm.whole("debounce", c.spool_monitor.debounce, 1, 1000, "", "sensor sets in a row a test must fail");
+  sm.finish();
   // Derived: eq. 27 reads the tracking error as the soil's doing. Through the valves the effort arrives
   // through the force loop's T_f, whose lag the update would read as soil: the rates are those of the
   // force-commanded machine scaled by period / T_f (docs/control.md).

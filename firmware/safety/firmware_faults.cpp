@@ -20,6 +20,7 @@ const char* to_string(FirmwareFault fault) {
     case FirmwareFault::operator_stop: return "operator stop";
     case FirmwareFault::operator_link_lost: return "operator link lost";
     case FirmwareFault::pressure_implausible: return "pressure implausible";
+    case FirmwareFault::spool_disagreement: return "spool disagreement";
   }
   return "unknown";
 }

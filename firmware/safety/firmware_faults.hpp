@@ -26,6 +26,9 @@ enum class FirmwareFault : std::uint16_t {
   // The operator station's link fell silent: it had sent keep-alives (SUPERVISOR Command = none),
   // then nothing for controller.supervisor_timeout. Stops as an operator's stop does, latched.
   operator_link_lost = 15,
+  // A main-valve spool's measured position disagrees with the one its command leads to: further
+  // from neutral, the other way, or off neutral with neutral commanded (spool_monitor.hpp).
+  spool_disagreement = 16,
 };
 
 // The stop a fault takes. controlled: valves centred, EmergencyStop = 0 (the valves still obey).
@@ -52,6 +55,7 @@ constexpr StopKind stop_of(FirmwareFault fault) {
     case FirmwareFault::plant_fault:
     case FirmwareFault::plant_holding:
     case FirmwareFault::velocity_implausible:
+    case FirmwareFault::spool_disagreement:
     case FirmwareFault::fatal_error: return StopKind::emergency;
   }
   return StopKind::emergency;  // an unknown code: the stronger stop

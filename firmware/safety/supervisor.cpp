@@ -26,7 +26,8 @@ Supervisor::Supervisor(const Machine& nominal, const SupervisorSettings& setting
       pump_flow_(nominal.hydraulics.pump_flow),
       plausibility_(settings.plausibility, settings.period),
       frozen_position_(settings.plausibility),
-      pressure_monitor_(nominal, settings.pressure_plausibility, settings.period) {}
+      pressure_monitor_(nominal, settings.pressure_plausibility, settings.period),
+      spool_monitor_(settings.spool_monitor, nominal.hydraulics.valve_time_constant, settings.period) {}
 
 char* Supervisor::raise(FirmwareFault fault, double t) {
   if (fault_) return nullptr;
@@ -280,6 +281,15 @@ void Supervisor::check_flow(double t, bool active, const Vec4& expected_velocity
                 "flow implausible at t = %.3f s: %s took %.4f %s over %.2f s, asked %.4f (velocity %.3f, flow asked %.3f)", t, name_of(j),
                 plausibility_.delivered()[j], unit_of(j), plausibility_.settings().window, plausibility_.asked()[j], velocity[j],
                 plausibility_.expected()[j]);
+}
+
+void Supervisor::check_spools(double t, bool active, const Vec4& measured) {
+  const int j = spool_monitor_.check(active, measured);
+  if (j < 0 || fault_) return;
+  char* text = raise(FirmwareFault::spool_disagreement, t);
+  std::snprintf(text, sizeof pending_text_, "spool disagreement at t = %.3f s: %s spool at %.3f, expected %.3f (%s) for %d sets", t,
+                name_of(j), measured[j], spool_monitor_.expected()[j], to_string(spool_monitor_.failed_test()),
+                spool_monitor_.settings().debounce);
 }
 
 void Supervisor::update_pump_warning(double t, bool limited, double demanded_flow) {

@@ -23,6 +23,7 @@
 #include "safety/firmware_faults.hpp"
 #include "safety/frozen_position.hpp"
 #include "safety/pressure_plausibility.hpp"
+#include "safety/spool_monitor.hpp"
 #include "safety/state_machine.hpp"
 #include "safety/velocity_plausibility.hpp"
 
@@ -36,6 +37,7 @@ struct SupervisorSettings {
   Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();  // rad, m
   PlausibilitySettings plausibility;
   PressurePlausibilitySettings pressure_plausibility;
+  SpoolMonitorSettings spool_monitor;
 };
 
 // What the flow plausibility monitor measures: positions, the oil columns' compression F / K_h
@@ -119,6 +121,12 @@ class Supervisor {
   // The flow plausibility monitor and the frozen-position test on this cycle's valve command
   // (expected velocity) against what arrived (valve interface; active: no restart).
   void check_flow(double t, bool active, const Vec4& expected_velocity, const FlowMeasurement& m, const Vec4& velocity);
+  // The spool monitor: this cycle's measured spools against the expected ones (active: valve
+  // interface with spools measured, commanding, the set complete), then the spool targets just sent
+  // (every cycle; centred valves: zeros), which the next set is expected to follow.
+  void check_spools(double t, bool active, const Vec4& measured);
+  void command_spools(const Vec4& target) { spool_monitor_.command(target); }
+  void restart_spools() { spool_monitor_.reset(); }
   // The pump-limited warning's debounce, raise and clear (FirmwareFault::pump_limited).
   void update_pump_warning(double t, bool limited, double demanded_flow);
   // A real-time loop's wake-up: kept deadlines or not; max_missed_deadlines in a row while
@@ -157,6 +165,7 @@ class Supervisor {
   const VelocityPlausibility& plausibility() const { return plausibility_; }
   const FrozenPosition& frozen_position() const { return frozen_position_; }
   const PressurePlausibility& pressure_plausibility() const { return pressure_monitor_; }
+  const SpoolMonitor& spool_monitor() const { return spool_monitor_; }
   const SupervisorSettings& settings() const { return s_; }
 
  private:
@@ -170,6 +179,7 @@ class Supervisor {
   VelocityPlausibility plausibility_;
   FrozenPosition frozen_position_;  // the reading that stops while its function is driven
   PressurePlausibility pressure_monitor_;
+  SpoolMonitor spool_monitor_;
   CreepWindow cylinder_creep_;  // the standstill's creep test on the cylinders' oil taken
   CreepWindow swing_creep_;     // and on the swing's motion
 
