@@ -1,12 +1,8 @@
 #include "app/firmware_node.hpp"
 
 #include <cstdio>
-#include <stdexcept>
-#include <string>
-#include <utility>
 
 #include "app/cycle_messages.hpp"
-#include "control/controller_registry.hpp"
 #include "exlcm/fault_t.hpp"
 #include "hal/can_protocol.hpp"
 #include "hal/clock.hpp"
@@ -23,27 +19,6 @@ control::ChamberPressures pressures_of(const hal::SensorState& s) {
 
 bool commanding(safety::Mode m) { return m == safety::Mode::hold || m == safety::Mode::track; }
 
-// Refuses a law the command interface cannot carry (a flow law on the effort interface) before it
-// is built: std::invalid_argument naming both.
-std::unique_ptr<control::Controller> checked_controller(const Model& model, const control::ControllerConfig& config) {
-  const control::ControllerEntry& law = control::controller_registry().at(config.law);
-  if (const std::string why = control::interface_misfit(law, config.command_interface); !why.empty())
-    throw std::invalid_argument("controller " + why + " (the scene's controller.command_interface is " +
-                                control::kCommandInterfaces.name_of(config.command_interface) + ")");
-  return law.make(model, config);
-}
-
-safety::SupervisorSettings supervisor_settings(const control::ControllerConfig& c) {
-  safety::SupervisorSettings s;
-  s.period = c.period;
-  s.supervisor_timeout = c.supervisor_timeout;
-  s.max_missed_deadlines = c.max_missed_deadlines;
-  s.tracking_error_limit = c.tracking_error_limit;
-  s.plausibility = c.plausibility;
-  s.pressure_plausibility = c.pressure_plausibility;
-  return s;
-}
-
 }  // namespace
 
 FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const FirmwareNodeConfig& config,
@@ -52,14 +27,11 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       config_(config),
       port_(port),
       telemetry_(telemetry),
-      controller_(checked_controller(model, config.controller)),
-      controller_id_(control::controller_registry().id_of(config.controller.law)),
-      estimator_(config.controller.filter),
       machine_(config.controller.watchdog_timeout),
       supervisor_(model.machine, supervisor_settings(config.controller)),
       path_(task, model.machine, config.controller),
-      stage_(model.machine, config.controller),
       counters_(config.controller.period),
+      step_(model, config_, supervisor_, counters_),
       period_(config.controller.period) {}
 
 FirmwareNode::~FirmwareNode() = default;
@@ -102,7 +74,7 @@ void FirmwareNode::end_cycle() {
   port_.write(command_);
   const std::int64_t write_end_ns = hal::monotonic_now_ns();
   counters_.write.record_ns(write_end_ns - write_start_ns);
-  if (tracking()) measured_.add(to_vec(sensors_.position), q_d_);
+  if (tracking()) measured_.add(to_vec(sensors_.position), desired_.q);
   publish_cycle(transition);
   const std::int64_t end_ns = hal::monotonic_now_ns();
   if (telemetry_ != nullptr) counters_.telemetry.record_ns(end_ns - write_end_ns);
@@ -133,7 +105,7 @@ safety::Transition FirmwareNode::step_mode(const safety::CycleInputs& in) {
   if (transition.changed && transition.to == safety::Mode::hold) {
     // From track, hold where the path was (its last point when it ended): the desired pose never
     // steps. From start-up or a safe stop, hold where the machine is.
-    held_q_ = transition.from == safety::Mode::track ? q_d_ : to_vec(sensors_.position);
+    held_q_ = transition.from == safety::Mode::track ? desired_.q : to_vec(sensors_.position);
     if (transition.from == safety::Mode::track && !finished_ && sm.trajectory_finished) {
       Vec4 qd_end, qdd_end;
       task_.trajectory.evaluate(task_.end_time(), held_q_, qd_end, qdd_end);
@@ -151,7 +123,7 @@ safety::Transition FirmwareNode::step_mode(const safety::CycleInputs& in) {
   }
   if (machine_.mode() == safety::Mode::safe_stop &&
       supervisor_.check_standstill(machine_.mode(), cycle_, in.complete,
-                                   stage_.flow_measurement(to_vec(sensors_.position), pressures_of(sensors_)),
+                                   step_.stage().flow_measurement(to_vec(sensors_.position), pressures_of(sensors_)),
                                    valve_interface() && sensors_.pressure_valid))
     send_stop_frame();
   return transition;
@@ -162,94 +134,16 @@ void FirmwareNode::compute_command(const safety::Transition& transition) {
   const double t = time();
   command_.cycle = cycle_;
   command_.firmware_mode = static_cast<std::uint8_t>(mode);
-  if (!commanding(mode)) {
-    // No valid sensors (or a fault): the safe state is valves centred, i.e. zero cylinder flow and
-    // the swing brake; the plant holds the machine where it is.
-    command_.mode = hal::CommandMode::valve;
-    command_.value = {0, 0, 0, 0};
-    stage_.centre();
-    supervisor_.update_pump_warning(t, false, 0);  // centred valves ask nothing
-    supervisor_.idle_pressures();
-    return;
-  }
-  const std::int64_t start_ns = hal::monotonic_now_ns();
-  const Vec4 q = to_vec(sensors_.position), qd = to_vec(sensors_.velocity);
-  const control::ChamberPressures p = pressures_of(sensors_);
+  // No valid sensors (or a fault): the safe state, valves centred.
+  if (!commanding(mode)) return step_.centre(t, sensors_, command_);
   // Entering hold/track after a stop or at start: the estimator, the law and the valve stage restart.
-  const bool restarted = transition.changed && (transition.from == safety::Mode::safe_stop || transition.from == safety::Mode::wait_sensors);
-  if (restarted) {
-    estimator_.reset(q, qd);
-    controller_->reset();
-    stage_.restart();
-  } else {
-    estimator_.update(q, qd);
-  }
-  if (mode == safety::Mode::track) {
-    path_time_ = path_.desired(t, q_d_, qd_d_, qdd_d_);
-  } else {
-    q_d_ = held_q_;
-    qd_d_.setZero();
-    qdd_d_.setZero();
-  }
-  std::int64_t now_ns = hal::monotonic_now_ns(), monitors_ns = 0;
-  counters_.estimate.record_ns(now_ns - start_ns);
-  // Each stage's time from the mark before it (lap): the monitors' two visits are added up.
-  auto lap = [&now_ns]() {
-    const std::int64_t before = now_ns;
-    now_ns = hal::monotonic_now_ns();
-    return now_ns - before;
-  };
-
-  control::ControlInput input;
-  input.t = t;
-  input.q = estimator_.position();
-  input.qd = estimator_.velocity();
-  input.qd_measured = qd;
-  input.qdd = estimator_.acceleration();
-  input.q_d = q_d_;
-  input.qd_d = qd_d_;
-  input.qdd_d = qdd_d_;
-  input.soil.site_map = &config_.site_map;
-  input.soil.theta_known = config_.theta_known;
-  input.soil.theta = config_.theta_true;
-  // What the stage after the law could not deliver last cycle (a clamped lead, a fully open valve):
-  // the adaptive laws leave those joints out of their update, the PID its integrator.
-  input.actuator_limited = stage_.limited();
-  const Vec4 sent = to_vec(command_.value);
-  input.applied = restarted ? control::AppliedEffort{}
-                            : stage_.applied(p, estimator_.velocity(), command_.mode == hal::CommandMode::effort ? &sent : nullptr,
-                                             out_.saturated);
-  out_ = controller_->update(input);
-  counters_.law.record_ns(lap());
-  supervisor_.check_law(t, out_.status == ModelStatus::ok && out_.tau.allFinite(), out_.e, mode == safety::Mode::track && transition.changed);
-
-  // Bumpless: entering hold/track from another effort-commanding mode starts from the last command.
-  if (transition.changed && commanding(transition.from)) stage_.switch_modes(t, out_.tau);
-  if (valve_interface()) {
-    supervisor_.check_pressures(t, !restarted && p.valid, complete_, sensors_);
-    // The force loop closes on the measured chamber pressures: without them it would drive the
-    // valves blind. Fault (the safe state centres the valves next cycle) rather than guess.
-    if (!out_.velocity_command) supervisor_.require_pressures(t, p.valid);
-    monitors_ns += lap();
-    const control::ValveCommand& v = stage_.valve_command(t, out_, qd_d_, q, p, mode == safety::Mode::hold);
-    command_.mode = hal::CommandMode::pilot;
-    for (int j = 0; j < 4; ++j) {
-      command_.value[j] = v.spool[j];
-      command_.pilot_a[j] = v.pilot_a[j];
-      command_.pilot_b[j] = v.pilot_b[j];
-    }
-    counters_.actuation.record_ns(lap());
-    supervisor_.update_pump_warning(t, v.pump_limited, v.demanded_flow);
-    supervisor_.check_flow(t, !restarted, v.velocity, stage_.flow_measurement(q, p), estimator_.velocity());
-  } else {
-    monitors_ns += lap();
-    const Vec4 efforts = stage_.efforts(t, out_.tau, restarted);
-    command_.mode = hal::CommandMode::effort;
-    for (int j = 0; j < 4; ++j) command_.value[j] = efforts[j];
-    counters_.actuation.record_ns(lap());
-  }
-  counters_.monitors.record_ns(monitors_ns + lap());
-  counters_.update.record_ns(now_ns - start_ns);
+  step_.estimate(sensors_, transition.changed && (transition.from == safety::Mode::safe_stop ||
+                                                  transition.from == safety::Mode::wait_sensors));
+  if (mode == safety::Mode::track)
+    path_time_ = path_.desired(t, desired_.q, desired_.qd, desired_.qdd);
+  else
+    desired_ = DesiredMotion{held_q_, Vec4::Zero(), Vec4::Zero()};
+  step_.update(t, mode, transition.changed, commanding(transition.from), complete_, sensors_, desired_, command_);
 }
 
 void FirmwareNode::send_stop_frame() {
@@ -286,10 +180,10 @@ void FirmwareNode::publish_cycle(const safety::Transition& transition) {
   const std::int64_t utime = this->utime();
   const auto mode = static_cast<std::int8_t>(machine_.mode());
   telemetry_->publish(telemetry::Channel::command,
-                      command_message(utime, mode, controller_id_, static_cast<std::int8_t>(config_.controller.command_interface),
-                                      command_, stage_, out_));
+                      command_message(utime, mode, step_.controller_id(), static_cast<std::int8_t>(config_.controller.command_interface),
+                                      command_, step_.stage(), step_.output()));
   telemetry_->publish(telemetry::Channel::controller,
-                      controller_message(utime, mode, controller_id_, q_d_, qd_d_, out_, config_.theta_known ? &config_.theta_true : nullptr));
+                      controller_message(utime, mode, step_.controller_id(), desired_.q, desired_.qd, step_.output(), config_.theta_known ? &config_.theta_true : nullptr));
   if (transition.changed) {
     const bool stop = transition.to == safety::Mode::safe_stop;
     char text[sizeof(exlcm::fault_t::text)];
@@ -339,16 +233,13 @@ void FirmwareNode::scan_state(SubnormalScan& scan) const {
   scan.scan("firmware command.value", command_.value);
   scan.scan("firmware command.pilot_a", command_.pilot_a);
   scan.scan("firmware command.pilot_b", command_.pilot_b);
-  estimator_.visit_state(v);
   // The path and the hold.
-  scan.scan("q_desired", q_d_);
-  scan.scan("qd_desired", qd_d_);
-  scan.scan("qdd_desired", qdd_d_);
+  scan.scan("q_desired", desired_.q);
+  scan.scan("qd_desired", desired_.qd);
+  scan.scan("qdd_desired", desired_.qdd);
   scan.scan("held q", held_q_);
   // The law, its output and the stages after it.
-  control::visit_state(out_, v);
-  controller_->visit_state(v);
-  stage_.visit_state(v);
+  step_.visit_state(v);
 }
 
 }  // namespace exc::app

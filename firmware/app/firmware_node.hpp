@@ -5,24 +5,21 @@
 //   end_cycle():   read + validate sensors -> supervisor (operator, machine signals) -> state
 //                  machine -> estimate -> path -> control law -> supervisor's checks -> actuation
 //                  stage (blend and lag lead, or the valve stage) -> write commands -> telemetry
+//                  (estimate to actuation: the control step, control_step.hpp)
 // Time is the cycle count times the period, so a run is deterministic and the plant's time is the
 // firmware's. Nothing here allocates, locks or blocks after construction.
 #include <cmath>
 #include <cstdint>
-#include <memory>
 
+#include "app/control_step.hpp"
 #include "app/loop_counters.hpp"
 #include "app/subnormal_scan.hpp"
 #include "app/tracking_metrics.hpp"
-#include "control/actuation_stage.hpp"
-#include "control/control_types.hpp"
-#include "control/controller_config.hpp"
 #include "control/path_clock.hpp"
 #include "control/perf_counter.hpp"
-#include "control/state_estimator.hpp"
 #include "control/task.hpp"
-#include "hal/can_ports.hpp"
 #include "app/firmware_node_config.hpp"
+#include "hal/can_ports.hpp"
 #include "model/model.hpp"
 #include "safety/supervisor.hpp"
 
@@ -93,12 +90,12 @@ class FirmwareNode {
   double task_time() const { return tracking() ? path_time_ : -1.0; }
   bool stopping_on_path() const { return path_.stopping(); }  // a stop along the path is under way
   // Desired q_a of the last cycle (valid while tracking or holding).
-  const Vec4& q_desired() const { return q_d_; }
+  const Vec4& q_desired() const { return desired_.q; }
   const hal::SensorState& sensors() const { return sensors_; }
   bool has_sensors() const { return have_valid_; }  // a complete, valid sensor set arrived at least once
-  const control::ControlOutput& last_output() const { return out_; }
+  const control::ControlOutput& last_output() const { return step_.output(); }
   // The valve stage's last command (valve interface; zeros otherwise).
-  const control::ValveCommand& last_valve_command() const { return stage_.last_valve_command(); }
+  const control::ValveCommand& last_valve_command() const { return step_.stage().last_valve_command(); }
   bool valve_interface() const { return config_.controller.command_interface == control::CommandInterface::valve; }
   const hal::CommandState& last_command() const { return command_; }
   // The loop's timing counters by stage (loop_counters.hpp); the control computation (estimate, path,
@@ -125,14 +122,11 @@ class FirmwareNode {
   FirmwareNodeConfig config_;
   hal::FirmwareCanPort& port_;
   telemetry::TelemetrySink* telemetry_;
-  std::unique_ptr<control::Controller> controller_;
-  std::int8_t controller_id_;  // the law's number in telemetry (ControllerRegistry::id_of)
-  control::StateEstimator estimator_;
   safety::ControlStateMachine machine_;
   safety::Supervisor supervisor_;
   control::PathClock path_;
-  control::ActuationStage stage_;
   LoopCounters counters_;
+  ControlStep step_;  // estimate, law, the stages after it and their checks
 
   double period_;
   std::uint64_t cycle_ = 0;
@@ -147,10 +141,9 @@ class FirmwareNode {
   bool stop_requested_ = false;
   bool safe_command_sent_ = false;
   Vec4 held_q_ = Vec4::Zero();
-  Vec4 q_d_ = Vec4::Zero(), qd_d_ = Vec4::Zero(), qdd_d_ = Vec4::Zero();
+  DesiredMotion desired_;
   hal::SensorState sensors_;
   hal::CommandState command_;
-  control::ControlOutput out_;
 };
 
 }  // namespace exc::app
