@@ -239,6 +239,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   control::PerfCounter control_first_end, plant_first_end, control_last_begin, plant_last_begin;
   bool first_taken = false, last_taken = false;
   std::int64_t cycles_run = 0;
+  // The stop's judge records the plant's truth from the fault's start (its ring reserved here).
+  std::optional<StopJudge> judge;
+  if (options.fault.kind != FaultSchedule::Kind::none) judge.emplace(scene.machine, options.fault.start, scene.cycle);
   const double cpu_start = thread_cpu_seconds();
   {
     // Counted from the first cycle on: everything before is start-up. The telemetry thread's own
@@ -255,7 +258,11 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       if (k >= cycles) {
         const double now_s = static_cast<double>(k) * scene.cycle;
         if (result.first_safe_stop_time < 0 || now_s >= result.first_safe_stop_time + options.rest_horizon) break;
-        if (!moving_now && now_s - std::max(last_moving, 0.0) >= kRestSettle) break;
+        // At rest for kRestSettle, and a judged stop's drift fit covered (kStopJudgeSpan from the
+        // onset, at the earliest the fault's start or 0.1 s before its detection).
+        const double onset = result.first_safe_stop_time >= 0 ? std::max(fault.start, result.first_fault_detected_time - 0.1) : fault.start;
+        const bool judged = !judge || now_s >= onset + kStopJudgeSpan + scene.cycle;
+        if (!moving_now && now_s - std::max(last_moving, 0.0) >= kRestSettle && judged) break;
       }
       clock.now_ns = k * period_ns;
       const double now = static_cast<double>(k) * scene.cycle;
@@ -293,6 +300,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       moving_now = std::abs(s.qd_a[0]) >= kRestSwingRate;
       for (int j = 1; j < 4; ++j) moving_now = moving_now || std::abs(s.qd_a[j]) >= kRestCylinderRate;
       if (moving_now) last_moving = s.time;
+      if (judge) judge->record(s.time, s.q_a, s.qd_a, hydraulic && s.hydraulics.swing_brake_applied);
       result.peak_soil_force = std::max(result.peak_soil_force, s.soil_force.norm());
       if (hydraulic) {
         result.peak_pressure = std::max(result.peak_pressure, s.hydraulics.max_pressure);
@@ -341,6 +349,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   const app::RunSummaryRecord outcome = fw.finish();
   const app::CycleStatus& last = fw.status();
   result.estop = outcome.emergency_sent;
+  if (judge && result.first_safe_stop_time >= 0) {
+    result.stop = judge->judge(result.first_fault_detected_time, result.first_safe_stop_time, scene.cycle, result.estop);
+    if (!result.stop->judged) result.stop.reset();
+  }
   plant_node.publish_counters();
   if (publisher) {
     publisher->stop();

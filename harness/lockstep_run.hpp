@@ -15,6 +15,7 @@
 #include "app/float_environment.hpp"
 #include "app/settings_blob.hpp"
 #include "harness/scene_source.hpp"
+#include "harness/stop_judge.hpp"
 #include "harness/target_figures.hpp"
 #include "control/controller_config.hpp"
 #include "hal/can_protocol.hpp"
@@ -117,6 +118,9 @@ struct RunRecord {
   // heap_allocations_in_loop are then the image's allocator calls after start-up, and the host's
   // timing figures above are left empty (count 0): the host did not run the firmware.
   std::optional<TargetFigures> target;
+  // A run with a fault whose stop was taken: the stop judged on the plant's truth against R1-R3
+  // (harness/stop_judge.hpp; docs/safety.md, "The stop requirement").
+  std::optional<StopJudgement> stop;
 };
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.

@@ -142,6 +142,29 @@ nlohmann::json target_json(const TargetFigures& t) {
           {"start_up_instructions", t.start_up_instructions}};
 }
 
+nlohmann::json stop_json(const StopJudgement& s) {
+  auto four = [](const std::array<double, 4>& a) { return nlohmann::json{a[0], a[1], a[2], a[3]}; };
+  nlohmann::json exempt = nlohmann::json::array();
+  for (const StopExemption& e : s.exempt)
+    exempt.push_back({{"function", kActiveNames[static_cast<std::size_t>(e.function)]}, {"reason", e.reason}, {"travel", e.travel}});
+  nlohmann::json j = {{"detected_after_s", s.detected_after_s},
+                      {"outputs_after_s", s.outputs_after_s},
+                      {"peak_speed_after_detection", four(s.speed_at_detection)},
+                      {"travel_to_first_stop", four(s.travel)},
+                      {"travel_allowed", four(s.travel_allowed)},
+                      {"first_overshoot", four(s.first_overshoot)},
+                      {"drift_after_1_5_s", four(s.drift)},
+                      {"drift_fit_span_s", s.drift_span},
+                      {"ring_tau_s", four(s.ring_tau)},
+                      {"brake_after_s", s.brake_after_s >= 0 ? nlohmann::json(s.brake_after_s) : nlohmann::json(nullptr)},
+                      {"exempt", exempt},
+                      {"meets_r1", s.meets_r1},
+                      {"meets_r2", s.meets_r2},
+                      {"meets_r3", s.meets_r3}};
+  if (!s.why.empty()) j["why"] = s.why;
+  return j;
+}
+
 nlohmann::json to_json(const Summary& summary) {
   nlohmann::json j;
   j["scene"] = summary.scene;
@@ -184,6 +207,7 @@ nlohmann::json to_json(const Summary& summary) {
     run["task_finished"] = r.task_finished;
     if (r.task_finished) run["task_finish_time"] = r.task_finish_time;
     if (r.target) run["target"] = target_json(*r.target);
+    if (r.stop) run["stop"] = stop_json(*r.stop);
     nlohmann::json cycles = nlohmann::json::array();
     for (const CycleRecord& k : r.cycles) {
       nlohmann::json theta;

@@ -4,6 +4,7 @@
 
 #include "safety/firmware_faults.hpp"
 #include "control/path_stop.hpp"
+#include "report/run_report.hpp"
 
 namespace exc::sim {
 namespace {
@@ -86,6 +87,7 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
   // emergency stop was sent.
   o["machine_at_rest_time"] = r.machine_at_rest_time >= 0 ? nlohmann::json(r.machine_at_rest_time) : nlohmann::json(nullptr);
   o["estop"] = r.estop;
+  if (r.stop) o["stop"] = stop_json(*r.stop);
   std::string why;
   if (r.failure.rfind("plant stopped", 0) == 0) {
     why = r.failure;
@@ -99,7 +101,8 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
     if (late > 1e-9)
       why = "the safe state " + std::to_string(late * 1e3) + " ms later than allowed after detection (the watchdog time" +
             (allowed > watchdog ? " and the deceleration along the path)" : ")");
-    else if (r.machine_at_rest_time < 0) why = "the firmware stopped but the machine still moved at the run's end";
+    else if (r.stop && !r.stop->meets_r3) why = "the stop misses R3: " + r.stop->why;
+    else if (!r.stop && r.machine_at_rest_time < 0) why = "the firmware stopped but the machine still moved at the run's end";
   } else if (r.tracking_samples == 0) {
     why = r.failure;
   } else {
@@ -162,6 +165,30 @@ void count_safety_function(nlohmann::json& table, const nlohmann::json& line, co
     keep_worst(k["worst_time_to_rest"], std::max(0.0, r["machine_at_rest_time"].get<double>() - start));
   else
     k["never_at_rest"] = k["never_at_rest"].get<int>() + 1;
+  // The stop against R1-R3 (docs/safety.md): R1 counted for the spool faults from the stick (the
+  // onset of disagreement is at or after it), R2 and R3 for every stop; exemptions per function.
+  if (!r.contains("stop")) return;
+  const nlohmann::json& s = r["stop"];
+  auto add = [&k](const char* key) { k[key] = k.value(key, 0) + 1; };
+  if (kind == "spool_stuck") add(s["detected_after_s"].get<double>() <= 0.1 + 1e-9 ? "r1_within_100ms_of_stick" : "r1_later_than_100ms_of_stick");
+  add(s["meets_r2"].get<bool>() ? "r2_met" : "r2_missed");
+  add(s["meets_r3"].get<bool>() ? "r3_met" : "r3_missed");
+  if (!s["exempt"].empty()) add("exempt");
+  double drift = 0, ring = 0;
+  for (int f = 0; f < 4; ++f) {
+    bool exempt = false;
+    for (const auto& e : s["exempt"]) exempt = exempt || e["function"] == kActiveNames[static_cast<std::size_t>(f)];
+    if (exempt) continue;
+    drift = std::max(drift, std::abs(s["drift_after_1_5_s"][static_cast<std::size_t>(f)].get<double>()));
+    ring = std::max(ring, s["ring_tau_s"][static_cast<std::size_t>(f)].get<double>());
+  }
+  keep_worst(k["worst_drift"], drift);
+  keep_worst(k["worst_ring_tau"], ring);
+  if (!s["exempt"].empty()) {
+    double travel = 0;
+    for (const auto& e : s["exempt"]) travel = std::max(travel, e["travel"].get<double>());
+    keep_worst(k["worst_exempt_travel"], travel);
+  }
 }
 
 }  // namespace exc::sim

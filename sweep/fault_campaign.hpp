@@ -29,9 +29,11 @@ FaultSchedule fault_schedule(const SweepCase& c, std::uint64_t seed);
 // A run's outcome as the campaign counts it, with the times it was judged by:
 //   tracked     no safe stop, and the true error within controller.tracking_error_limit throughout
 //   safe_state  the firmware took the safe state within controller.watchdog_timeout of detecting the
-//               fault (FirmwareNode::fault_detected_time)
+//               fault (FirmwareNode::fault_detected_time) and the machine's stop met R3 (travel,
+//               drift, ring, swing brake; harness/stop_judge.hpp), or its one miss is a declared
+//               gravity exemption
 //   neither     anything else (the plant stopped, never tracked, beyond the limits without a stop, a
-//               late safe state), with the reason in "why"
+//               late safe state, a stop that misses R3), with the reason in "why"
 nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firmware);
 
 // Counts the run of `controller` in a merged case line (one with a "fault") into `table`, the

@@ -1,15 +1,17 @@
-// Issue 32's stops judged by the machine (docs/safety.md): a main-valve spool stuck on any of the
-// four functions, at openings both ways, under every law that drives the valves, in the dig scene:
-// the velocity plausibility monitor finds it within 100 ms of the stick, the firmware sends the
-// emergency stop (the machine cuts its pilot supply and stops its engine), and the machine is at rest
-// (plant truth: cylinders under 1 mm/s, swing under 1 mrad/s, to the run's end) within 1.5 s. And
-// without a fault the monitor stays inside its band on every shipped hydraulic scene's law: its
+// The safety concept's stops judged by the machine (docs/safety.md): a main-valve spool stuck on any
+// of the four functions, at openings both ways, under every law that drives the valves, in the dig
+// scene, against the stop requirement R1-R3 (the spool monitor or the flow monitor finds it, the
+// firmware sends the emergency stop: the machine's safety solenoids shut the pump line, close the
+// holding valves and dump the swing brake, its pilot supply is cut and its engine stopped). And
+// without a fault the flow monitor stays inside its band on every shipped hydraulic scene's law: its
 // margin is printed. Firmware and plant in lockstep over the in-memory bus (harness/lockstep_run.hpp).
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
+
+#include "harness/stop_judge.hpp"
 
 #include "app/firmware_node.hpp"
 #include "harness/lockstep_run.hpp"
@@ -41,60 +43,91 @@ sim::FaultSchedule stuck_spool(int joint, double opening, double start, double d
 
 }  // namespace
 
-TEST_CASE("firmware/safety: a spool stuck on any function, either way, under every law: found by the velocity monitor, the emergency stop sent, detection and time to rest against issue 32's 100 ms and 1.5 s, printed") {
-  // Issue 32's requirement is detection within 100 ms and the machine at rest within 1.5 s of the
-  // stick. Asserted: every case found by the flow plausibility monitor, within 100 ms under the
-  // laws that command an effort (the flow law asks only a small flow against a stuck swing, so less
-  // oil arrives against its command: 150 ms), the emergency stop sent. The time to rest is printed
-  // per case against 1.5 s: after the engine's run-down the machine's own dynamics (a gravity load
-  // through a stuck spool to its end stop, a boom ringing on its oil column) decide it;
-  // docs/safety.md reports which cases miss it and why.
+TEST_CASE("firmware/safety: a spool stuck on any function, both ways, at openings 0.2-1.0, under every law: found within 100 ms of the disagreement's onset, the emergency stop's outputs in the same cycle, and the machine's stop meets R3 or is a declared gravity exemption, printed") {
+  // The stop requirement (docs/safety.md): R1 a stuck spool found within 100 ms of the onset of
+  // disagreement; R2 the safe state's outputs within one cycle of detection; R3 judged on the plant's
+  // truth by harness/stop_judge.hpp: each function's travel from detection to its first stop within
+  // its peak speed x (closing time + 0.1 s), net drift below 1 mm/s (1 mrad/s) fitted from 1.5 s
+  // after the stick over 2 s, a remaining ring's envelope time constant at most 3.5 s, the swing's
+  // brake within 0.3 s; exempt only a cylinder that gravity drives out through a side without a
+  // holding valve. The onset is taken here apart from the monitor: the first cycle the firmware's
+  // own command, through the valve's lag as this test steps it, leaves the stuck spool by more than
+  // the monitor's limits (a spool stuck where the law commands it shows nothing until then).
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
+  const safety::SpoolMonitorSettings ms = b.firmware.controller.spool_monitor;
+  const double tau = b.firmware.machine.hydraulics.valve_time_constant, dt = b.scene.cycle;
   const double t_stick = 3.0;
-  double worst_detection = 0, worst_rest = 0;
-  int cases = 0, detected_in_time = 0, at_rest_in_time = 0, never_at_rest = 0;
-  std::string worst_detection_case, worst_rest_case;
+  int cases = 0, r1 = 0, r3 = 0, exempt = 0;
+  double worst_detection = 0, worst_drift = 0, worst_tau = 0;
+  std::string worst_detection_case, exemptions;
   for (const std::string law : kLaws) {
     for (int joint = 0; joint < 4; ++joint) {
-      for (const double opening : {-0.8, -0.4, 0.4, 0.8}) {
+      for (const double opening : {-1.0, -0.8, -0.4, -0.2, 0.2, 0.4, 0.8, 1.0}) {
         sim::LockstepOptions o;
         o.controller = law;
-        o.duration = t_stick + 4.0;
+        o.duration = t_stick + sim::kStopJudgeSpan + 0.1;
+        o.rest_horizon = 6.0;  // a late find (a spool stuck where it was commanded) is judged as long after
         o.fault = stuck_spool(joint, opening, t_stick, 1e9);  // to the run's end
+        double lagged = 0, onset = -1;  // the command through the valve's lag, stepped here
+        o.node_observer = [&](std::int64_t k, const app::PlantNode&, const app::FirmwareNode& node) {
+          const double t = static_cast<double>(k) * dt;  // the firmware's clock, which detection is stamped in
+          const double e = lagged;
+          lagged += (1.0 - std::exp(-dt / tau)) * (std::clamp(node.last_command().value[static_cast<std::size_t>(joint)], -1.0, 1.0) - lagged);
+          if (onset >= 0 || t < t_stick) return;
+          const double along = e >= 0 ? opening : -opening;
+          const bool neutral = std::abs(e) < ms.neutral_expected;
+          if (neutral ? std::abs(opening) > ms.band : along - std::abs(e) > ms.excess || -along > ms.band) onset = t;
+        };
         const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
-        const std::string name = law + ", " + kActiveNames[static_cast<std::size_t>(joint)] +
-                                 " stuck at " + std::to_string(opening);
+        const std::string name = law + ", " + kActiveNames[static_cast<std::size_t>(joint)] + " stuck at " + std::to_string(opening);
         INFO(name << ": " << r.failure);
         ++cases;
         REQUIRE(r.first_safe_stop_time >= 0);
-        const bool flow_swing = law == "flow" && joint == 0;
-        CHECK(r.first_fault_code == static_cast<int>(safety::FirmwareFault::velocity_implausible));
-        const double detection = r.first_fault_detected_time - t_stick;
-        CHECK(detection > 0);
-        CHECK(detection <= (flow_swing ? 0.15 : 0.1));
+        REQUIRE(r.stop);
+        const sim::StopJudgement& s = *r.stop;
         CHECK(r.estop);
-        const double rest = r.machine_at_rest_time >= 0 ? r.machine_at_rest_time - t_stick : -1;
-        MESSAGE(name << ": detected after " << detection * 1e3 << " ms, at rest "
-                     << (rest >= 0 ? std::to_string(rest) + " s" : std::string("never (moving at the end)"))
-                     << " after the stick");
-        detected_in_time += detection <= 0.1 ? 1 : 0;
-        at_rest_in_time += rest >= 0 && rest <= 1.5 ? 1 : 0;
-        never_at_rest += rest < 0 ? 1 : 0;
+        // R1: from the onset (or the stick, when the command already disagreed then).
+        REQUIRE(onset >= 0);
+        const double detection = r.first_fault_detected_time - onset;
+        CHECK(detection >= 0);
+        CHECK(detection <= 0.1);
+        r1 += detection <= 0.1 ? 1 : 0;
+        // R2: the outputs in the cycle the fault was detected or the next.
+        CHECK(s.meets_r2);
+        // R3, or a declared exemption.
+        CHECK_MESSAGE(s.meets_r3, s.why);
+        r3 += s.meets_r3 ? 1 : 0;
+        for (const sim::StopExemption& x : s.exempt) {
+          ++exempt;
+          exemptions += "\n  " + name + ": " + x.reason + ", travel " + std::to_string(x.travel * 1e3) + " mm";
+          CHECK(x.function == 3);  // only the bucket lacks a holding valve on the reference machine's sides its load can drain
+        }
+        std::string per;
+        for (int f = 0; f < 4; ++f) {
+          bool ex = false;
+          for (const sim::StopExemption& x : s.exempt) ex = ex || x.function == f;
+          if (!ex) {
+            worst_drift = std::max(worst_drift, std::abs(s.drift[f]));
+            worst_tau = std::max(worst_tau, s.ring_tau[f]);
+          }
+        }
+        MESSAGE(name << ": " << std::string(safety::to_string(static_cast<safety::FirmwareFault>(r.first_fault_code))) << " "
+                     << detection * 1e3 << " ms after the onset (" << (onset - t_stick) * 1e3 << " ms after the stick); travel "
+                     << s.travel[static_cast<std::size_t>(joint)] * 1e3 << " of " << s.travel_allowed[static_cast<std::size_t>(joint)] * 1e3
+                     << " allowed; drift " << s.drift[static_cast<std::size_t>(joint)] * 1e3 << " mm/s; ring tau "
+                     << s.ring_tau[static_cast<std::size_t>(joint)] << " s; brake " << s.brake_after_s << " s"
+                     << (s.why.empty() ? "" : "; " + s.why));
         if (detection > worst_detection) {
           worst_detection = detection;
           worst_detection_case = name;
         }
-        if (rest > worst_rest) {
-          worst_rest = rest;
-          worst_rest_case = name;
-        }
       }
     }
   }
-  MESSAGE("spool stuck, " << cases << " cases (4 laws x 4 functions x 4 openings): detected within 100 ms " << detected_in_time
-                          << ", at rest within 1.5 s " << at_rest_in_time << ", never at rest " << never_at_rest
-                          << "; worst detection " << worst_detection * 1e3 << " ms (" << worst_detection_case
-                          << "), worst time to rest of those at rest " << worst_rest << " s (" << worst_rest_case << ")");
+  MESSAGE("spool stuck, " << cases << " cases (4 laws x 4 functions x 8 openings): R1 met " << r1 << ", R3 met " << r3
+                          << "; worst detection after the onset " << worst_detection * 1e3 << " ms (" << worst_detection_case
+                          << "), worst drift " << worst_drift * 1e3 << " mm/s, worst ring tau " << worst_tau << " s; exempt "
+                          << exempt << exemptions);
 }
 
 TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the frozen-reading test never trip on the shipped hydraulic scenes under every law they run, their margins printed") {
@@ -108,8 +141,10 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       int longest_frozen = 0;  // the frozen-reading test's longest run of counted sets, any function
       sim::LockstepOptions o;
       o.controller = law;
-      o.node_observer = [&worst, &longest_frozen](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+      double worst_spool = 0;  // the spool monitor's largest test value over its limit
+      o.node_observer = [&worst, &longest_frozen, &worst_spool](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
         worst = node.supervisor().plausibility().worst_ratio();
+        worst_spool = node.supervisor().spool_monitor().worst_ratio();
         for (int i = 0; i < 4; ++i) longest_frozen = std::max(longest_frozen, node.supervisor().frozen_position().run(i));
       };
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
@@ -120,11 +155,13 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       INFO(what << ": " << r.failure);
       MESSAGE(what << ": largest test value / floor per function " << worst.transpose() << "; frozen-reading test's longest run "
                    << longest_frozen << " of " << b.firmware.controller.plausibility.frozen_sets
-                   << " sets; largest tracking error / limit " << tracking_share.transpose()
+                   << " sets; spool monitor's largest test value / limit " << worst_spool
+                   << "; largest tracking error / limit " << tracking_share.transpose()
                    << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
       // The monitor's own criterion: outside its floor for its debounce time in a row. A single
       // cycle beyond the floor is no fault (the printed figure is the largest single cycle's).
       CHECK(r.first_fault_code != static_cast<int>(safety::FirmwareFault::velocity_implausible));
+      CHECK(r.first_fault_code != static_cast<int>(safety::FirmwareFault::spool_disagreement));
       CHECK(r.safe_stops == 0);
       CHECK(longest_frozen < b.firmware.controller.plausibility.frozen_sets);
       // The default limit is 5x the worst of 1300 unseen runs: a shipped scene within half of it.
@@ -133,7 +170,7 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
   }
 }
 
-TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x what the machine reaches, stops a boom stuck half open with the velocity monitor off within 0.3 s, where the effort interface's fixed 0.2 m took 1.4 s") {
+TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x what the machine reaches, stops a boom stuck half open with the velocity and spool monitors off within 0.3 s, where the effort interface's fixed 0.2 m took 1.4 s") {
   // Issue 32: with the fixed 0.2 m limit (17x the valve machine's worst error) the tracking error
   // found a stuck boom spool after 1.45 s. The dig scene, the boom's spool stuck at +0.5 from 3 s
   // (extending at about 0.13 m/s against a path that goes the other way), the flow monitor off so
@@ -142,6 +179,7 @@ TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x w
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   b.firmware.controller.plausibility.enabled = false;
   b.firmware.controller.plausibility.frozen_sets = 1000000;
+  b.firmware.controller.spool_monitor.enabled = false;  // it finds the spool at once: the limit's case
   REQUIRE(b.firmware.controller.command_interface == control::CommandInterface::valve);
   CHECK(b.firmware.controller.tracking_error_limit[1] == doctest::Approx(5 * 0.0074));
   double found[2] = {-1, -1};
@@ -210,7 +248,7 @@ SupervisedRun run_supervised(const sim::SceneBundle& b, sim::LockstepOptions o) 
 }  // namespace
 
 TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the machine at rest until a SUPERVISOR acknowledge frame arrives on the bus") {
-  // The arm's spool sticks at 0.4 for 0.5 s from 3 s (then frees): the velocity monitor stops the
+  // The arm's spool sticks at 0.4 for 0.5 s from 3 s (then frees): the spool monitor stops the
   // firmware with the emergency stop. The operator station acknowledges at 7 s; without that frame
   // the same run stays stopped to its end.
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
@@ -224,7 +262,7 @@ TEST_CASE("firmware/supervisor: a stuck spool's emergency stop latches with the 
     const SupervisedRun run = run_supervised(b, o);
     INFO(run.record.failure << " " << run.fault_text);
     REQUIRE(run.first_stop > 3.0);
-    CHECK(run.fault == safety::FirmwareFault::velocity_implausible);
+    CHECK(run.fault == safety::FirmwareFault::spool_disagreement);
     CHECK(run.estop);
     // Stopped from the fault to the acknowledge's cycle, and not a cycle less (a frame sent before
     // the harness's cycle at t is read in the firmware's cycle t + 1 ms).
@@ -363,8 +401,11 @@ TEST_CASE("firmware/standstill: a swing spool stuck just past its dead zone, fou
   // from 5.815 s. The tracking limit stops the firmware (controlled: valves centred), but the spool
   // keeps passing oil and the swing swings on, ringing on its oil spring at 50-180 mrad/s. Its mean
   // speed fell by a third from one 2.5 s window to the next, which the creep test read as braking;
-  // a mean ten times the standstill rate a whole window into the stop is not braking.
-  const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/free_motion.yaml");
+  // a mean ten times the standstill rate a whole window into the stop is not braking. The spool
+  // monitor, which finds this spool itself 20 ms after the stick, is off: the case is the
+  // standstill monitor's.
+  sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/free_motion.yaml");
+  b.firmware.controller.spool_monitor.enabled = false;
   for (const std::string law : {"pid", "adaptive"}) {
     sim::LockstepOptions o;
     o.controller = law;

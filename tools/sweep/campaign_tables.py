@@ -2,7 +2,8 @@
 """The safety campaign's two tables in Markdown, from a merged sweep (docs/safety.md, the README).
 
 usage: campaign_tables.py DIR [--requirements]
-  --requirements  a column with each safety function's reaction-time requirement (docs/safety.md)
+  --requirements  a column with each safety function's reaction-time requirement (docs/safety.md), and a
+                  third table: the stop requirement R1-R4 per safety function
   reads DIR/sweep.json (excavator-sim sweep-merge's "safety_functions" and "campaign") and prints
   per safety function (the fault that took the stop) and per fault kind: runs, worst detection,
   worst time to rest, runs stopped but never at rest, emergency stops; PID and adaptive side by side.
@@ -96,7 +97,42 @@ def main(argv):
         rest = max((r.get("worst_time_to_rest") for r in rows if r.get("worst_time_to_rest") is not None), default=None)
         print("| %s | %d | %s | %s | %s | %s |" % (kind, rows[0].get("runs", 0), cells, seconds(detection), seconds(rest),
                                                 pair(rows, "estop")))
+    if requirements:
+        print_stop_requirement(functions, campaign, laws)
     return 0
+
+
+def mm(x):
+    return "-" if x is None else "%.2f" % (x * 1e3)
+
+
+def print_stop_requirement(functions, campaign, laws):
+    """R1-R4 (docs/safety.md, "The stop requirement"), per safety function and law."""
+    print()
+    print("| safety function | stops %s | R2 met | R3 met | R3 missed | exempt (gravity) | worst drift, mm/s | "
+          "worst ring tau, s | worst exempt travel, mm |" % " / ".join(laws))
+    print("|---|---|---|---|---|---|---|---|---|")
+    for name, label, _ in FUNCTIONS:
+        rows = [functions[law].get(name) for law in laws]
+        if name == "none" or not any(rows):
+            continue
+        stops = [sum((r or {}).get(k, 0) for k in ("r3_met", "r3_missed")) for r in rows]
+        if not any(stops):
+            continue
+        tau = max(((r or {}).get("worst_ring_tau") or 0 for r in rows), default=0)
+        print("| %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (
+            label, " / ".join(map(str, stops)), pair(rows, "r2_met", lambda v: str(v or 0)),
+            pair(rows, "r3_met", lambda v: str(v or 0)), pair(rows, "r3_missed", lambda v: str(v or 0)),
+            pair(rows, "exempt", lambda v: str(v or 0)), pair(rows, "worst_drift", mm), "%.2f" % tau,
+            pair(rows, "worst_exempt_travel", mm)))
+    r1 = [sum((functions[law].get(n) or {}).get("r1_within_100ms_of_stick", 0) for n in functions[law]) for law in laws]
+    r1_late = [sum((functions[law].get(n) or {}).get("r1_later_than_100ms_of_stick", 0) for n in functions[law]) for law in laws]
+    neither = [sum(r.get("neither", 0) for r in campaign[law].values()) for law in laws]
+    runs = [sum(r.get("runs", 0) for r in campaign[law].values()) for law in laws]
+    print()
+    print("R1, stuck spools found within 100 ms of the stick (%s): %s; later: %s. R4, runs that neither track nor meet R3: "
+          "%s of %s." % (" / ".join(laws), " / ".join(map(str, r1)), " / ".join(map(str, r1_late)),
+                         " / ".join(map(str, neither)), " / ".join(map(str, runs))))
 
 
 if __name__ == "__main__":

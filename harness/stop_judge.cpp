@@ -1,0 +1,165 @@
+#include "harness/stop_judge.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace exc::sim {
+namespace {
+
+constexpr double kRestRate = 1e-3;       // m/s, rad/s: "at rest" (docs/safety.md)
+// m/s, rad/s: a ring's peak below "at rest" is no ring to fit (a function creeping or stick-slipping
+// below it is at rest by the safety concept's measure).
+constexpr double kRingFloor = kRestRate;
+constexpr int kRingPeaks = 3;            // peaks the envelope's fit needs
+constexpr int kMaxPeaks = 512;           // half periods fitted at most (a 2.5 Hz ring over 100 s)
+const char* const kFunctions[] = {"swing", "boom", "arm", "bucket"};
+
+std::string format(const char* fmt, double a, double b) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, fmt, a, b);
+  return buf;
+}
+
+}  // namespace
+
+StopJudge::StopJudge(const Machine& machine, double fault_start, double cycle, double span)
+    : hp_(machine.hydraulics), start_(fault_start) {
+  samples_.reserve(static_cast<std::size_t>(std::ceil(span / cycle)) + 2);
+}
+
+void StopJudge::record(double t, const Vec4& q_a, const Vec4& qd_a, bool brake_applied) {
+  if (t < start_ || samples_.size() == samples_.capacity()) return;
+  samples_.push_back(Sample{t, q_a, qd_a, brake_applied});
+}
+
+StopJudgement StopJudge::judge(double detected, double safe_state, double period, bool emergency) const {
+  StopJudgement j;
+  if (detected < 0 || safe_state < 0 || samples_.empty() || detected > samples_.back().t) return j;
+  j.judged = true;
+  j.detected_after_s = detected - start_;
+  j.outputs_after_s = safe_state - detected;
+  j.meets_r1 = j.detected_after_s <= 0.1 + 1e-9;
+  j.meets_r2 = j.outputs_after_s <= period + 1e-9;
+  std::size_t d = 0;
+  while (d + 1 < samples_.size() && samples_[d].t < detected - 1e-9) ++d;
+  const std::size_t n = samples_.size();
+  // The valve that ends a function's motion: on the emergency stop the pump-line shut-off and the
+  // holding valves; on a controlled stop the main spools centring (95 % of their lag).
+  const double closing = emergency ? std::max(hp_.pump_shutoff_time, hp_.holding_valve_close_time) : 3 * hp_.valve_time_constant;
+  // The drift's fit: from 1.5 s after the onset of disagreement to the record's end. The onset is
+  // taken as early as R1 lets it lie: the fault's start, or 0.1 s before a later detection (a spool
+  // stuck where it was commanded disagrees only once the command moves away).
+  const double onset = std::max(start_, detected - 0.1);
+  const double fit_from = onset + kDriftFrom;
+  j.drift_span = samples_.back().t - fit_from;
+  for (int f = 0; f < 4; ++f) {
+    // The first stop after detection: the velocity reverses or falls to "at rest".
+    const double v0 = samples_[d].qd[f];
+    double peak = std::abs(v0);
+    std::size_t s = d;
+    while (s + 1 < n && std::abs(samples_[s].qd[f]) >= kRestRate && samples_[s].qd[f] * v0 > 0) {
+      ++s;
+      peak = std::max(peak, std::abs(samples_[s].qd[f]));
+    }
+    j.speed_at_detection[f] = peak;
+    j.travel[f] = std::abs(samples_[s].q[f] - samples_[d].q[f]);
+    // The first overshoot: how far the function ran on after the closing valve had closed (the
+    // stop frame reaches the machine a cycle after detection), the oil column's compression.
+    const double closed = detected + period + closing;
+    std::size_t c = d;
+    while (c < s && samples_[c].t < closed - 1e-9) ++c;
+    j.first_overshoot[f] = std::abs(samples_[s].q[f] - samples_[c].q[f]);
+    // Speed x (closing + 0.1 s), plus that overshoot; the swing's stop is its brake's (stated).
+    j.travel_allowed[f] = f == 0 ? -1.0 : peak * (closing + kTravelMargin) + j.first_overshoot[f];
+    // Net drift: least-squares slope of position against time.
+    double st = 0, sq = 0, stt = 0, stq = 0;
+    int m = 0;
+    for (const Sample& x : samples_) {
+      if (x.t < fit_from) continue;
+      const double t = x.t - fit_from;
+      st += t;
+      sq += x.q[f];
+      stt += t * t;
+      stq += t * x.q[f];
+      ++m;
+    }
+    const double den = m * stt - st * st;
+    j.drift[f] = m > 1 && den > 0 ? (m * stq - st * sq) / den : 0.0;
+    // The ring's envelope: the velocity's peak in each half period after the first stop, from the
+    // largest on (a ring decays from its crest; the peaks before it are the ring building up),
+    // fitted as A exp(-t / tau). Peaks below "at rest" are no ring.
+    double peak_t[kMaxPeaks], peak_a[kMaxPeaks];
+    int peaks = 0, crest = 0;
+    double half_peak = 0, half_time = 0;
+    for (std::size_t k = s + 1; k < n && peaks < kMaxPeaks; ++k) {
+      const double v = samples_[k].qd[f];
+      if (std::abs(v) > half_peak) {
+        half_peak = std::abs(v);
+        half_time = samples_[k].t;
+      }
+      const bool reversal = k + 1 < n && samples_[k + 1].qd[f] * v < 0;
+      if (reversal || k + 1 == n) {
+        if (reversal && half_peak > kRingFloor) {
+          peak_t[peaks] = half_time;
+          peak_a[peaks] = half_peak;
+          if (half_peak > peak_a[crest]) crest = peaks;
+          ++peaks;
+        }
+        half_peak = 0;
+      }
+    }
+    double pt = 0, pl = 0, ptt = 0, ptl = 0;
+    const int used = peaks - crest;
+    for (int p = crest; p < peaks; ++p) {
+      const double l = std::log(peak_a[p]);
+      pt += peak_t[p];
+      pl += l;
+      ptt += peak_t[p] * peak_t[p];
+      ptl += peak_t[p] * l;
+    }
+    const double pden = used * ptt - pt * pt;
+    const double slope = used >= kRingPeaks && pden > 0 ? (used * ptl - pt * pl) / pden : 0.0;
+    j.ring_tau[f] = used < kRingPeaks ? 0.0 : slope < 0 ? -1.0 / slope : 1e9;
+  }
+  for (std::size_t k = d; k < n; ++k)
+    if (samples_[k].brake) {
+      j.brake_after_s = samples_[k].t - detected;
+      break;
+    }
+  // Exempt: a cylinder still drifting whose outflow side has no holding valve (gravity drives it
+  // there whatever the pumps do): declared with its travel, not judged.
+  bool exempt[4] = {false, false, false, false};
+  for (int f = 1; f < 4; ++f) {
+    if (std::abs(j.drift[f]) <= kDriftLimit) continue;
+    const bool cap_out = j.drift[f] < 0;  // retracting: the cap side drains
+    const bool held = (f == 1 && cap_out && hp_.load_holding_valves) || (f == 2 && !cap_out && hp_.load_holding_valves) ||
+                      (f == 3 && hp_.bucket_holding_valve);
+    if (held) continue;
+    exempt[f] = true;
+    j.exempt.push_back(StopExemption{f, std::string(kFunctions[f]) + ": gravity drives it out through its " +
+                                            (cap_out ? "cap" : "rod") + " side, which has no holding valve",
+                                     std::abs(samples_.back().q[f] - samples_[d].q[f])});
+  }
+  std::string why;
+  if (j.drift_span < kDriftSpan - 2 * period)
+    why = format("the record ends %.2f s after 1.5 s from the fault's start, short of the drift fit's %.1f s", j.drift_span, kDriftSpan);
+  for (int f = 0; f < 4 && why.empty(); ++f) {
+    if (exempt[f]) continue;
+    const std::string name = kFunctions[f];
+    if (std::abs(j.drift[f]) > kDriftLimit)
+      why = name + format(" drifts at %.2f mm/s (limit %.1f)", std::abs(j.drift[f]) * 1e3, kDriftLimit * 1e3);
+    else if (j.ring_tau[f] > kRingTauLimit)
+      why = name + format(" rings with an envelope time constant of %.2f s (limit %.1f)", j.ring_tau[f], kRingTauLimit);
+    else if (f > 0 && j.travel[f] > j.travel_allowed[f] + 1e-6)
+      why = name + format(" travelled %.1f mm after detection before its first stop, allowed %.1f", j.travel[f] * 1e3,
+                          j.travel_allowed[f] * 1e3);
+  }
+  if (why.empty() && emergency && hp_.swing_brake_torque > 0 && (j.brake_after_s < 0 || j.brake_after_s > kBrakeLimit))
+    why = format("the swing brake engaged %.3f s after detection (limit %.1f)", j.brake_after_s, kBrakeLimit);
+  j.meets_r3 = why.empty();
+  j.why = why;
+  return j;
+}
+
+}  // namespace exc::sim

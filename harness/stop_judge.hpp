@@ -1,0 +1,74 @@
+#pragma once
+// A faulted run's stop judged on the machine's truth against the stop requirement (docs/safety.md,
+// "The stop requirement"): R1 detection after the fault's start, R2 the safe state's outputs after
+// detection, R3 per function the travel from detection to its first stop against its speed times the
+// closing valve's time plus 0.1 s plus the first overshoot, the net drift (the slope of a straight line fitted to its
+// position from 1.5 s after the onset over at least 2 s, so a ring's periods average out),
+// the remaining ring's envelope time constant, and the swing brake's engagement. Motion a port
+// without a holding valve lets gravity drive is exempt, declared with its travel. The plant's truth
+// is recorded into a ring sized before the loop, so the lockstep loop allocates nothing.
+#include <array>
+#include <string>
+#include <vector>
+
+#include "model/machine.hpp"
+#include "model/types.hpp"
+
+namespace exc::sim {
+
+// R3's figures (docs/safety.md): drift below 1 mm/s (1 mrad/s swing) from 1.5 s after the onset over
+// at least 2 s, a ring's envelope time constant at most 3.5 s, the swing's brake within 0.3 s.
+inline constexpr double kDriftFrom = 1.5;          // s after the onset (the fault's start, or 0.1 s before a later detection)
+inline constexpr double kDriftSpan = 2.0;          // s, the fit's least span
+inline constexpr double kDriftLimit = 1e-3;        // m/s, rad/s
+inline constexpr double kRingTauLimit = 3.5;       // s
+inline constexpr double kBrakeLimit = 0.3;         // s after detection
+inline constexpr double kTravelMargin = 0.1;       // s beyond the closing valve's time
+inline constexpr double kStopJudgeSpan = kDriftFrom + kDriftSpan;  // s after the fault a judged run lasts at least
+
+struct StopExemption {
+  int function = 0;
+  std::string reason;
+  double travel = 0;  // m (rad) from detection to the record's end
+};
+
+struct StopJudgement {
+  bool judged = false;              // a stop was taken after a fault's start and recorded
+  double detected_after_s = -1;     // R1: from the fault's start
+  double outputs_after_s = -1;      // R2: the safe state's outputs after detection
+  std::array<double, 4> speed_at_detection{};  // m/s (rad/s): the peak from detection to the first stop
+  std::array<double, 4> travel{};              // to the function's first stop after detection
+  std::array<double, 4> first_overshoot{};     // run on after the closing valve closed, to that stop
+  // peak speed x (closing time + 0.1 s) + first overshoot; swing (-1): stated, not bounded
+  std::array<double, 4> travel_allowed{};
+  std::array<double, 4> drift{};               // R3: m/s (rad/s), the fit's slope
+  double drift_span = 0;                       // s the fit covered
+  std::array<double, 4> ring_tau{};            // s, 0: no ring to fit
+  double brake_after_s = -1;                   // swing brake engaged after detection (-1: never)
+  std::vector<StopExemption> exempt;
+  bool meets_r1 = false, meets_r2 = false, meets_r3 = false;
+  std::string why;  // the first of R3's figures missed ("" when R3 is met)
+};
+
+class StopJudge {
+ public:
+  // fault_start: s; cycle: the plant's period; machine: the plant's (its holding valves and closing times).
+  StopJudge(const Machine& machine, double fault_start, double cycle, double span = 12.0);
+  // Every cycle from the fault's start: the plant's truth (no allocation).
+  void record(double t, const Vec4& q_a, const Vec4& qd_a, bool brake_applied);
+  // After the run: detected and safe_state are the firmware's times (s; -1: no stop); emergency: the
+  // stop was the emergency stop (the safety solenoids dropped, the swing brake dumped).
+  StopJudgement judge(double detected, double safe_state, double period, bool emergency) const;
+
+ private:
+  struct Sample {
+    double t;
+    Vec4 q, qd;
+    bool brake;
+  };
+  HydraulicParameters hp_;
+  double start_;
+  std::vector<Sample> samples_;  // reserved for the span: never grows in the loop
+};
+
+}  // namespace exc::sim
