@@ -8,7 +8,7 @@ every FW_EMERGENCY carries EmergencyStop = 1 (no release), every command frame i
 four valves centred (no CMD_PILOT, no CMD_EFFORT), and at least --min-cycles SYNC frames pass (the
 firmware stayed stopped, not just for a moment). After the acknowledge the firmware releases the
 machine (FW_EMERGENCY EmergencyStop = 0, FaultCode 0) within --release-cycles SYNCs. The stops'
-FaultCodes must be --expect-codes in order (e.g. 10,1: velocity implausible, a stuck spool; then
+FaultCodes must be --expect-codes in order (e.g. 16,1: spool disagreement, a stuck spool; then
 sensor timeout). With --controlled the stops are controlled ones (EmergencyStop = 0, FaultCode not 0:
 an operator's stop, a lost operator link): each begins at the first FW_EMERGENCY with a FaultCode
 after the previous acknowledge and holds that code with EmergencyStop = 0.
