@@ -350,7 +350,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   const app::CycleStatus& last = fw.status();
   result.estop = outcome.emergency_sent;
   if (judge && result.first_safe_stop_time >= 0) {
-    result.stop = judge->judge(result.first_fault_detected_time, result.first_safe_stop_time, scene.cycle, result.estop);
+    // The emergency stop's figures (the solenoids' closing, the brake) for a fault that takes it at
+    // once; a controlled stop escalated later is judged as the controlled stop it began as.
+    const bool emergency = safety::stop_of(static_cast<safety::FirmwareFault>(result.first_fault_code)) == safety::StopKind::emergency;
+    result.stop = judge->judge(result.first_fault_detected_time, result.first_safe_stop_time, scene.cycle, emergency);
     if (!result.stop->judged) result.stop.reset();
   }
   plant_node.publish_counters();

@@ -148,7 +148,8 @@ StopJudgement StopJudge::judge(double detected, double safe_state, double period
     if (exempt[f]) continue;
     const std::string name = kFunctions[f];
     if (std::abs(j.drift[f]) > kDriftLimit)
-      why = name + format(" drifts at %.2f mm/s (limit %.1f)", std::abs(j.drift[f]) * 1e3, kDriftLimit * 1e3);
+      why = name + format(f == 0 ? " drifts at %.2f mrad/s (limit %.1f)" : " drifts at %.2f mm/s (limit %.1f)", std::abs(j.drift[f]) * 1e3,
+                          kDriftLimit * 1e3);
     else if (j.ring_tau[f] > kRingTauLimit)
       why = name + format(" rings with an envelope time constant of %.2f s (limit %.1f)", j.ring_tau[f], kRingTauLimit);
     else if (f > 0 && j.travel[f] > j.travel_allowed[f] + 1e-6)
