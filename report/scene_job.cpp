@@ -114,6 +114,13 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
                         : cc.law_given           ? std::vector<std::string>{cc.law}
                                                  : default_controllers(bundle, std::cerr);
   check_controller_names(options.controllers);
+  // A law the scene's command interface cannot carry is refused here, before the log's size is
+  // stated and before anything is written, not when its run builds it.
+  for (const std::string& name : options.controllers)
+    if (const std::string why = control::interface_misfit(control::controller_registry().at(name), cc.command_interface);
+        !why.empty())
+      throw std::invalid_argument("--controller: " + why + " (" + job.scene_path + "'s controller.command_interface is " +
+                                  control::kCommandInterfaces.name_of(cc.command_interface) + ")");
   plan.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   options.lcm_url = job.lcm_url.empty()
                         ? std::string(kFileScheme) + (fs::absolute(plan.out_dir) / "run.lcm").string() + "?mode=w"

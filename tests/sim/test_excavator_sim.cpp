@@ -1137,6 +1137,21 @@ TEST_CASE("tools/excavator-sim refuses a controller named twice (run --controlle
   CHECK(control_run.status == 0);
 }
 
+TEST_CASE("tools/excavator-sim refuses a law its scene's command interface cannot carry before the log's size line, writing nothing") {
+  const Run flow = run_sim("run " + kPaperDig + " --controller flow --duration 0.1 --out out");
+  INFO(flow.err);
+  CHECK(flow.status == 2);
+  CHECK(flow.err.find("--controller: flow commands the valves' flow: it needs command_interface: valve") != std::string::npos);
+  CHECK(flow.err.find("controller.command_interface is effort") != std::string::npos);
+  CHECK(flow.err.find("excavator-sim: log ") == std::string::npos);  // no log-size line
+  CHECK(!fs::exists(flow.dir / "out" / "effective.yaml"));
+  CHECK(!fs::exists(flow.dir / "out" / "run.lcm"));
+  // The control: a law that fits runs and writes both.
+  const Run pid = run_sim("run " + kPaperDig + " --controller pid --duration 0.1 --no-report --out out");
+  CHECK(pid.status == 0);
+  CHECK(fs::exists(pid.dir / "out" / "effective.yaml"));
+}
+
 TEST_CASE("tools/excavator-sim sweep refuses a --shard that is not exactly I/N with 0 <= I < N (trailing text, a third part, overflow, a sign), and runs one that is") {
   const Run first = run_sim("sweep --help");
   REQUIRE(first.status == 0);
