@@ -128,7 +128,9 @@ int main(int argc, char** argv) {
   sweep->add_option("spec", sweep_spec, "sweep spec (YAML)")->required();
   sweep->add_option("--shard", sweep_shard, "I/N: run cases I, I+N, I+2N, ... (default 0/1: every case)");
   sweep->add_option("--out", sweep_out, "the shard's result file (default: out/sweep/shard-I-of-N.jsonl)");
-  sweep->add_flag("--quiet", sweep_quiet, "no progress output");
+  sweep->add_flag("--quiet", sweep_quiet, "no progress line (it is shown only on a terminal: k of N cases, elapsed, time left)");
+  bool sweep_check = false;
+  sweep->add_flag("--check", sweep_check, "read and check the spec, print its number of cases, run none");
   auto* merge = app.add_subcommand("sweep-merge", "merge shard files into sweep.csv, sweep.json and the spec's charts; names missing cases and shard files");
   std::string merge_spec, merge_out = "out/sweep";
   std::vector<std::string> merge_files;
@@ -173,6 +175,10 @@ int main(int argc, char** argv) {
       if (spec.run != exc::sim::SweepRun::closed_loop) {
         std::cerr << "excavator-sim sweep: " << sweep_spec << ": an open-loop sweep runs in excavator-bench (its step map)\n";
         return 2;
+      }
+      if (sweep_check) {
+        std::cout << sweep_spec << ": " << spec.total_cases() << " cases\n";
+        return 0;
       }
       if (sweep_out.empty())
         sweep_out = (fs::path("out/sweep") / ("shard-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl")).string();
