@@ -34,6 +34,10 @@ function(exc_add_doctest target)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 600)
   endif()
+  # The address and thread sanitizers slow the code 2-15x: their builds give each case 3x the time.
+  if(EXC_SANITIZE STREQUAL "address" OR EXC_SANITIZE STREQUAL "thread")
+    math(EXPR ARG_TIMEOUT "${ARG_TIMEOUT} * 3")
+  endif()
   # A case that reports SKIPPED (a peer library absent) shows as skipped in a user's build; in the test
   # build (CI) nothing may skip: without the property the case asserted nothing and the main fails it.
   set(_props TIMEOUT ${ARG_TIMEOUT})

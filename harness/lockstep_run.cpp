@@ -333,6 +333,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       if (options.node_observer) options.node_observer(k, plant_node, *host_node);
       if (plant_node.failed()) break;
       if (options.stop_at_safe_state && st.safe_stops > 0) break;
+      if (options.interrupt != nullptr && options.interrupt->load(std::memory_order_relaxed) != 0) {
+        result.interrupted = true;
+        break;
+      }
       if (options.progress && (k + 1) % progress_every == 0) {
         // On a terminal the line is redrawn in place; in a log, one line per tenth of the run.
         std::fprintf(stderr, interactive ? "\r  %-10s %5.1f / %.1f s simulated" : "  %-10s %5.1f / %.1f s simulated\n",
@@ -417,7 +421,13 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   result.task_finished = outcome.trajectory_finished;
   result.task_finish_time = outcome.finish_time;
   const char* const mode = safety::to_string(static_cast<safety::Mode>(outcome.mode));
-  if (plant_node.failed()) {
+  if (result.interrupted) {
+    result.ok = false;
+    char text[96];
+    std::snprintf(text, sizeof text, "interrupted (SIGINT) at %.3f s of %.3f s", result.simulated_seconds,
+                  static_cast<double>(cycles) * scene.cycle);
+    result.failure = text;
+  } else if (plant_node.failed()) {
     result.ok = false;
     result.failure = std::string("plant stopped: ") + plant.status().text();
   } else if (last.safe_stops > 0) {

@@ -4,6 +4,7 @@
 // same frames as on a real bus. excavator-sim (main job, robustness), excavator-bench (fidelity and
 // controller maps) and the sweeps all call run_lockstep; its RunRecord is what the JSON summary, the
 // report and the charts read. The bus is stamped with simulated time, so a run is deterministic.
+#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -114,6 +115,9 @@ struct RunRecord {
   std::uint64_t pump_limited_cycles = 0;  // firmware cycles whose openings asked more than the pumps give
   bool task_finished = false;         // the task ran to its end (then the machine held its final pose)
   double task_finish_time = 0;        // s
+  // Ended early by LockstepOptions::interrupt (a person's Ctrl-C): not ok, its figures those of the
+  // cycles that ran.
+  bool interrupted = false;
   // A run on an emulated target (LockstepOptions::firmware_target): the image's own figures. Its
   // heap_allocations_in_loop are then the image's allocator calls after start-up, and the host's
   // timing figures above are left empty (count 0): the host did not run the firmware.
@@ -204,6 +208,8 @@ struct LockstepOptions {
   // observers take the in-process node and are refused with a target.
   std::string firmware_target;
   std::string firmware_image;
+  // Non-zero (a signal handler sets it): the run ends at the next cycle boundary, interrupted.
+  const std::atomic<int>* interrupt = nullptr;
 };
 
 // The cycles a run of `scene` lasts: `duration` s, or the scene's own duration when it is 0.

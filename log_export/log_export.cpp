@@ -55,10 +55,17 @@ bool seek_next_sound_event(std::FILE* file, std::uint64_t file_bytes) {
     const auto channel_bytes = static_cast<std::int32_t>(big_endian(header + 16, 4));
     const auto data_bytes = static_cast<std::int32_t>(big_endian(header + 20, 4));
     // LCM's own rule for the channel (1 to 999 bytes); the data must fit in what the file holds.
-    const bool sound = channel_bytes > 0 && channel_bytes < 1000 && data_bytes >= 0 &&
-                       static_cast<std::uint64_t>(sync_at) + kEventHeaderBytes +
-                               static_cast<std::uint64_t>(channel_bytes) + static_cast<std::uint64_t>(data_bytes) <=
-                           file_bytes;
+    const std::uint64_t end = static_cast<std::uint64_t>(sync_at) + kEventHeaderBytes +
+                              static_cast<std::uint64_t>(channel_bytes) + static_cast<std::uint64_t>(data_bytes);
+    bool sound = channel_bytes > 0 && channel_bytes < 1000 && data_bytes >= 0 && end <= file_bytes;
+    // LCM's reader drops an event not followed by a sync word (or the file's end), printing a bare
+    // "Invalid header after log data"; such an event is skipped here instead, its bytes counted
+    // unread and said in our own words.
+    if (sound && end + 4 <= file_bytes) {
+      std::uint8_t next[4];
+      sound = fseeko(file, static_cast<off_t>(end), SEEK_SET) == 0 && std::fread(next, 1, 4, file) == 4 &&
+              big_endian(next, 4) == kSyncWord;
+    }
     if (fseeko(file, sound ? sync_at : sync_at + 1, SEEK_SET) != 0) return false;
     if (sound) return true;
   }
@@ -125,6 +132,8 @@ std::string controller_of(const std::string& channel) {
 template <class OnEvent>
 bool read_log(const std::string& log_path, LogSummary* summary, std::string* error,
               OnEvent&& on_event) {
+  *summary = LogSummary{};
+  summary->bad_input = true;  // until the log has been read
   if (!std::filesystem::exists(log_path)) {
     *error = log_path + ": no such file";
     return false;
@@ -134,7 +143,6 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
     *error = log_path + ": cannot be opened as an LCM log";
     return false;
   }
-  *summary = LogSummary{};
   std::error_code size_error;
   const std::uintmax_t file_bytes = std::filesystem::file_size(log_path, size_error);
   if (size_error) {
@@ -176,6 +184,12 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
             return;
           }
           const bool first = ++reading.decoded == 1;
+          if (!first && prototype.seq > channel.last_seq + 1) {
+            ++channel.seq_gaps;
+            channel.seq_missing += static_cast<std::uint64_t>(prototype.seq - channel.last_seq - 1);
+          }
+          if (first) channel.first_seq = prototype.seq;
+          channel.last_seq = first ? prototype.seq : std::max(channel.last_seq, prototype.seq);
           channel.min_utime = first ? prototype.utime : std::min(channel.min_utime, prototype.utime);
           channel.max_utime = first ? prototype.utime : std::max(channel.max_utime, prototype.utime);
           on_event(*event, prototype);
@@ -194,6 +208,12 @@ bool read_log(const std::string& log_path, LogSummary* summary, std::string* err
     *error = log_path + ": not an LCM log (no event found where LCM's log reader expects one)";
     return false;
   }
+  if (file_bytes == 0) {
+    *error = log_path + ": an empty log (0 bytes): nothing was logged (a run or lcm-logger stopped before its "
+             "first message, or telemetry sent where no logger listened)";
+    return false;
+  }
+  summary->bad_input = false;
   if (file_bytes > event_bytes) summary->unread_bytes = file_bytes - event_bytes;
   return true;
 }

@@ -20,6 +20,11 @@ struct ChannelSummary {
   bool rows_written = false;   // export_log_to_csv wrote one row per message (see ExportOptions)
   bool bucketed = false;       // and/or its bucketed view
   std::string csv_file;        // its file name when exported: csv_file_name, numbered if another took it
+  // The decoded messages' sequence numbers (+1 per message at the publisher): a jump of more than
+  // one is a gap, messages published but not in the log (a receiver that dropped them, lcm-logger
+  // over UDP); seq_missing counts them.
+  std::int64_t first_seq = 0, last_seq = 0;
+  std::uint64_t seq_gaps = 0, seq_missing = 0;
 };
 
 struct LogSummary {
@@ -31,6 +36,8 @@ struct LogSummary {
   // (an event whose header is damaged is skipped to the next sync word). The events read are whole;
   // their payloads are checked only by decoding (LCM's messages carry no checksum).
   std::uint64_t unread_bytes = 0;
+  // The failure was the input's (no such file, not an LCM log, an empty one), not a write's.
+  bool bad_input = false;
   // In doubles: a damaged log's stamps can lie at the ends of int64, where their difference wraps.
   double duration_s() const {
     return events ? (static_cast<double>(last_log_utime) - static_cast<double>(first_log_utime)) * 1e-6 : 0.0;

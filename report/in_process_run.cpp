@@ -72,8 +72,13 @@ Summary run_all(const SceneBundle& bundle, const RunOptions& options) {
     lo.log_every = options.log_every;
     lo.progress = options.progress;
     lo.firmware_target = options.firmware_target;
+    lo.interrupt = options.interrupt;
     summary.runs.push_back(run_lockstep(bundle.scene, bundle.firmware, lo));
     summary.all_ok = summary.all_ok && summary.runs.back().ok;
+    if (summary.runs.back().interrupted) {
+      summary.interrupted = true;
+      break;
+    }
   }
   return summary;
 }

@@ -19,6 +19,7 @@ struct RunOptions {
   std::uint32_t log_every = 1;           // the per-cycle channels every Nth cycle (LockstepOptions::log_every)
   bool progress = true;
   std::string firmware_target;           // "": in this process; "cortex-m7": on the emulated target (LockstepOptions)
+  const std::atomic<int>* interrupt = nullptr;  // LockstepOptions::interrupt; the controllers after it do not run
 };
 
 struct Summary {
@@ -27,6 +28,7 @@ struct Summary {
   std::string setup;
   std::vector<RunRecord> runs;
   bool all_ok = true;
+  bool interrupted = false;  // a run ended by LockstepOptions::interrupt; the controllers after it not run
 };
 
 // The run's setup as a person reads it: actuators (and their lag), the firmware's compensation of

@@ -170,6 +170,7 @@ nlohmann::json to_json(const Summary& summary) {
   j["scene"] = summary.scene;
   j["setup"] = summary.setup;
   j["ok"] = summary.all_ok;
+  if (summary.interrupted) j["interrupted"] = true;
   Timing worst;
   std::uint64_t allocations = 0;
   double simulated = 0;

@@ -17,6 +17,7 @@
 #include "control/controller_registry.hpp"
 #include "harness/log_volume.hpp"
 #include "output_files/output_file.hpp"
+#include "run_interrupt.hpp"
 #include "run_report.hpp"
 #include "settings/section_reader.hpp"
 
@@ -96,6 +97,7 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
   options.progress = job.progress;
   options.log_every = job.log_every;
   options.firmware_target = job.firmware_target;
+  options.interrupt = &run_interrupt();  // zero unless catch_run_interrupt's handler saw a SIGINT
   // A target without its image is refused before anything runs or is written.
   if (!job.firmware_target.empty()) {
     const std::string image = firmware_target_image(job.firmware_target);
@@ -114,6 +116,13 @@ SceneJobPlan plan_scene_job(const SceneJob& job) {
                         : cc.law_given           ? std::vector<std::string>{cc.law}
                                                  : default_controllers(bundle, std::cerr);
   check_controller_names(options.controllers);
+  // A law the scene's command interface cannot carry is refused here, before the log's size is
+  // stated and before anything is written, not when its run builds it.
+  for (const std::string& name : options.controllers)
+    if (const std::string why = control::interface_misfit(control::controller_registry().at(name), cc.command_interface);
+        !why.empty())
+      throw std::invalid_argument("--controller: " + why + " (" + job.scene_path + "'s controller.command_interface is " +
+                                  control::kCommandInterfaces.name_of(cc.command_interface) + ")");
   plan.out_dir = job.out_dir.empty() ? fs::path("out") / bundle.name : job.out_dir;
   options.lcm_url = job.lcm_url.empty()
                         ? std::string(kFileScheme) + (fs::absolute(plan.out_dir) / "run.lcm").string() + "?mode=w"
@@ -198,7 +207,11 @@ SceneJobResult run_scene_job(const SceneJobPlan& plan) {
     json_file << j.dump(2) << "\n";
     output::finish_file(json_file, job.json_path);
   }
-  result.exit_code = result.summary.all_ok ? 0 : 1;
+  result.exit_code = result.summary.interrupted ? kInterruptedExit : result.summary.all_ok ? 0 : 1;
+  if (result.summary.interrupted)
+    std::cerr << "excavator-sim: interrupted: " << summary_path.string() << " says so (ok false, interrupted true); "
+              << (plan.log.empty() ? std::string("no log file") : "the log " + plan.log.string() + " is closed")
+              << "\n";
   if (job.report && !plan.log.empty()) {
     const std::string title = bundle.name + ": " + bundle.scene.description;
     // The report reads the log the telemetry went to: <out>/run.lcm, or the file --lcm named.
@@ -206,7 +219,7 @@ SceneJobResult run_scene_job(const SceneJobPlan& plan) {
     if (rc != 0) {
       std::cerr << "excavator-sim: the report step failed (exit " << rc << "); the log and summary are in "
                 << result.out_dir.string() << "\n";
-      result.exit_code = 1;
+      if (result.exit_code == 0) result.exit_code = 1;
     } else {
       std::cout << "report: " << (result.out_dir / "report" / "report.md").string() << "\n";
     }

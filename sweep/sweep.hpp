@@ -136,8 +136,12 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c);
 RunRecord run_sweep_case(const SweepSpec& spec, const SweepCase& c, const std::string& controller);
 nlohmann::json record_json(const RunRecord& r, const app::FirmwareSettings& firmware);
 
+// The progress line of a shard on a terminal: "sweep shard 0/4: 12 of 250 cases, 1 min 04 s elapsed,
+// ~21 min 10 s left" (the time left from the mean time per case so far).
+std::string sweep_progress_text(int shard, int shards, int done, int count, double elapsed_s);
 // Runs the cases id = shard, shard + shards, ... and writes one JSON line per case to `out` (flushed
-// as each finishes). Returns the number of cases run.
+// as each finishes); with `progress`, on a terminal only, the progress line above, redrawn. Returns
+// the number of cases run.
 int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const std::filesystem::path& out, bool progress,
                     const SweepRunner& runner = run_closed_loop_case);
 

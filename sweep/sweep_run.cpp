@@ -1,5 +1,8 @@
 // A sweep's runs: a case's scene and settings made from its draws and set values, each controller
 // through run_lockstep, one JSON line per case into the shard's file.
+#include <unistd.h>
+
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -86,6 +89,32 @@ nlohmann::json run_closed_loop_case(const SweepSpec& spec, const SweepCase& c) {
   return line;
 }
 
+namespace {
+
+// "1 min 05 s", "42 s".
+std::string duration_text(double seconds) {
+  const long s = std::lround(std::max(0.0, seconds));
+  char text[48];
+  if (s >= 3600)
+    std::snprintf(text, sizeof text, "%ld h %02ld min", s / 3600, s / 60 % 60);
+  else if (s >= 60)
+    std::snprintf(text, sizeof text, "%ld min %02ld s", s / 60, s % 60);
+  else
+    std::snprintf(text, sizeof text, "%ld s", s);
+  return text;
+}
+
+}  // namespace
+
+std::string sweep_progress_text(int shard, int shards, int done, int count, double elapsed_s) {
+  std::string text = "sweep";
+  if (shards > 1) text += " shard " + std::to_string(shard) + "/" + std::to_string(shards);
+  text += ": " + std::to_string(done) + " of " + std::to_string(count) + " cases, " + duration_text(elapsed_s) + " elapsed";
+  if (done > 0 && done < count)
+    text += ", ~" + duration_text(elapsed_s / done * (count - done)) + " left";
+  return text;
+}
+
 int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path& out, bool progress,
                     const SweepRunner& runner) {
   if (!out.parent_path().empty()) fs::create_directories(out.parent_path());
@@ -95,13 +124,25 @@ int run_sweep_shard(const SweepSpec& spec, int shard, int shards, const fs::path
     for (const std::shared_ptr<const SceneSource>& scene : spec.sources) check_faults_fit(spec.faults, scene->nominal);
   int done = 0;
   const int total = spec.total_cases();
+  const int count = shard < total ? (total - shard + shards - 1) / shards : 0;  // this shard's cases
+  // The progress line is for a person at a terminal, redrawn in place; a log or a pipe gets none.
+  const bool show = progress && ::isatty(STDERR_FILENO) == 1;
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
+  Clock::time_point shown = start;
   for (int id = shard; id < total; id += shards) {
     nlohmann::json line = runner(spec, sweep_case(spec, id));
     line["spec"] = spec.digest;
     file << line.dump() << "\n";
     output::flush_file(file, out);  // a shard that dies keeps the cases it finished
     ++done;
-    if (progress && done % 10 == 0) std::fprintf(stderr, "sweep shard %d/%d: %d cases done\n", shard, shards, done);
+    const Clock::time_point now = Clock::now();
+    if (show && (done == count || now - shown >= std::chrono::milliseconds(250))) {
+      shown = now;
+      const std::string text = sweep_progress_text(shard, shards, done, count, std::chrono::duration<double>(now - start).count());
+      std::fprintf(stderr, "\r%s\033[K%s", text.c_str(), done == count ? "\n" : "");
+      std::fflush(stderr);
+    }
   }
   output::finish_file(file, out);
   return done;

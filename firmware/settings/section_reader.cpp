@@ -115,9 +115,16 @@ void SectionReader::declare(const char* key) {
   for (const std::string& d : declared_)
     if (d == key) return;
   declared_.emplace_back(key);
+  // A key the section declares is no misspelling: a missing key whose every lookalike is declared
+  // is plainly missing.
+  for (PendingMissing& p : pending_) {
+    p.lookalikes.erase(std::remove(p.lookalikes.begin(), p.lookalikes.end(), key), p.lookalikes.end());
+    if (p.lookalikes.empty()) fail_at(mark_of(p.key), field(p.key), p.reason);
+  }
 }
 
 void SectionReader::fail_at(const YAML::Mark& mark, const std::string& field, const std::string& reason) const {
+  throw_pending();
   const bool known = !mark.is_null();
   throw SettingsError(file_, known ? mark.line + 1 : 0, known ? mark.column + 1 : 0, field, reason);
 }
@@ -137,14 +144,19 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
   return d[a.size()][b.size()];
 }
 
-// A word close enough to `word` to be its misspelling (at most 2 edits, and fewer than half its
-// letters), the closest of `candidates`; "" when none is.
+// Whether `word` is spelt nearly as `c`: at most 2 edits, and fewer than half its letters.
+bool misspelling(const std::string& word, const std::string& c) {
+  const std::size_t e = edit_distance(word, c);
+  return e > 0 && e <= 2 && 2 * e < std::max(word.size(), c.size());
+}
+
+// A word close enough to `word` to be its misspelling, the closest of `candidates`; "" when none is.
 std::string closest(const std::string& word, const std::vector<std::string>& candidates) {
   std::string best;
   std::size_t best_distance = 3;
   for (const std::string& c : candidates) {
     const std::size_t e = edit_distance(word, c);
-    if (e > 0 && e < best_distance && 2 * e < std::max(word.size(), c.size())) {
+    if (misspelling(word, c) && e < best_distance) {
       best = c;
       best_distance = e;
     }
@@ -156,6 +168,26 @@ std::string closest(const std::string& word, const std::vector<std::string>& can
 
 void SectionReader::fail(const std::string& key, const std::string& reason) const {
   fail_at(mark_of(key), field(key), reason);
+}
+
+void SectionReader::missing(const char* key, const std::string& reason) {
+  PendingMissing p{key, reason, {}};
+  if (present() && in_.IsMap())
+    for (const auto& kv : in_) {
+      const std::string k = kv.first.Scalar();
+      if (std::find(declared_.begin(), declared_.end(), k) == declared_.end() && misspelling(k, key))
+        p.lookalikes.push_back(k);
+    }
+  if (p.lookalikes.empty()) fail(key, reason);
+  pending_.push_back(std::move(p));
+}
+
+void SectionReader::throw_pending() const {
+  if (pending_.empty()) return;
+  const PendingMissing& p = pending_.front();
+  const YAML::Mark mark = mark_of(p.key);
+  const bool known = !mark.is_null();
+  throw SettingsError(file_, known ? mark.line + 1 : 0, known ? mark.column + 1 : 0, field(p.key), p.reason);
 }
 
 void SectionReader::fail(const std::string& key, std::size_t index, const std::string& reason) const {
@@ -232,7 +264,7 @@ void SectionReader::number(const char* key, double& value, Bounds b, const char*
   if (value_given(key)) {
     value = to_number(get(key), field(key), b.lo, b.hi, unit);
   } else if (need == Need::required) {
-    fail(key, std::string("missing: ") + what + "; a number in " + range_text(b.lo, b.hi, unit));
+    missing(key, std::string("missing: ") + what + "; a number in " + range_text(b.lo, b.hi, unit));
   } else if (!std::isfinite(value) || value < b.lo || value > b.hi) {
     fail(key, "is " + with_unit(value, unit) + " (not from the file); allowed range " + range_text(b.lo, b.hi, unit));
   }
@@ -251,7 +283,7 @@ void SectionReader::read_whole(const char* key, double& value, double lo, double
       fail(key, "is " + (n.IsScalar() ? n.Scalar() : std::string("not a scalar")) + "; allowed: " + allowed);
     value = v;
   } else if (need == Need::required) {
-    fail(key, std::string("missing: ") + what + "; " + allowed);
+    missing(key, std::string("missing: ") + what + "; " + allowed);
   } else if (value != std::floor(value) || value < lo || value > hi) {
     fail(key, "is " + format_number(value) + " (not from the file); allowed: " + allowed);
   }
@@ -279,7 +311,7 @@ void SectionReader::text(const char* key, std::string& value, const char* what, 
     if (!n.IsScalar()) fail(key, std::string("must be a string: ") + what);
     value = n.Scalar();
   } else if (need == Need::required) {
-    fail(key, std::string("missing: ") + what + "; a string");
+    missing(key, std::string("missing: ") + what + "; a string");
   }
   out_[key] = value;
 }
@@ -302,7 +334,7 @@ void SectionReader::read_list(const char* key, double* values, int n, const doub
     for (int i = 0; i < n; ++i)
       values[i] = to_number(list[i], index_field(field(key), static_cast<std::size_t>(i)), lo[i * stride], hi[i * stride], unit);
   } else if (need == Need::required) {
-    fail(key, std::string("missing: ") + what + "; " + shape);
+    missing(key, std::string("missing: ") + what + "; " + shape);
   } else {
     for (int i = 0; i < n; ++i)
       if (!std::isfinite(values[i]) || values[i] < lo[i * stride] || values[i] > hi[i * stride])
@@ -322,7 +354,7 @@ std::size_t SectionReader::begin_rows(const char* key, std::size_t min, std::siz
                             std::to_string(columns) + " numbers";
   out_[key] = YAML::Node(YAML::NodeType::Sequence);
   if (!value_given(key)) {
-    if (need == Need::required) fail(key, std::string("missing: ") + what + "; " + shape);
+    if (need == Need::required) missing(key, std::string("missing: ") + what + "; " + shape);
     return kAbsent;
   }
   const YAML::Node list = get(key);
@@ -424,8 +456,18 @@ void SectionReader::finish() const {
     std::string list;
     for (const std::string& d : declared_) list += (list.empty() ? "" : ", ") + d;
     const std::string near = closest(key, declared_);
-    fail_at(kv.first.Mark(), field(key), "unknown key; " + (near.empty() ? std::string() : "did you mean " + near + "? ") + "allowed keys: " + list);
+    bool near_missing = false;
+    for (const PendingMissing& p : pending_) near_missing = near_missing || p.key == near;
+    // Thrown here directly: a required key this one misspells is named with it, not as missing.
+    const YAML::Mark mark = kv.first.Mark();
+    throw SettingsError(file_, mark.line + 1, mark.column + 1, field(key),
+                        "unknown key; " +
+                            (near.empty() ? std::string()
+                                          : "did you mean " + near + "?" +
+                                                (near_missing ? " (" + near + " is required and not given)" : "") + " ") +
+                            "allowed keys: " + list);
   }
+  throw_pending();
 }
 
 void merge_effective(YAML::Node into, const YAML::Node& from) {

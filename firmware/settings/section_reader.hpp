@@ -157,7 +157,8 @@ class SectionReader {
   // Free text kept only for people (a machine file's `frames:`) is declared the same way.
   void others(const std::vector<std::string>& keys);
 
-  // Rejects keys that no read declared, listing the declared ones.
+  // Rejects keys that no read declared, listing the declared ones; one spelt nearly as a declared
+  // key is named with it ("did you mean duration?"), a required key's misspelling included.
   void finish() const;
 
   // An error at the key's value (at the section when the key is absent), at an element of a list,
@@ -203,6 +204,17 @@ class SectionReader {
   YAML::Mark mark_;  // of the section, or of the nearest enclosing one present in the file
   YAML::Node out_;
   std::vector<std::string> declared_;
+  // A required key found missing while the section holds keys not yet declared that are spelt
+  // nearly as it: one of them may be its misspelling, or a field declared later. The error waits
+  // until that is known: finish() names the misspelt key (did you mean ...?); the plain "missing"
+  // follows once every such key is declared, and any other error of this section reports it first.
+  struct PendingMissing {
+    std::string key, reason;
+    std::vector<std::string> lookalikes;
+  };
+  std::vector<PendingMissing> pending_;
+  void missing(const char* key, const std::string& reason);
+  void throw_pending() const;
   const Document* document_ = nullptr;  // the document read (null: a node given without one)
 };
 

@@ -12,6 +12,7 @@
 #include "scenes.hpp"
 #include "settings_error_check.hpp"
 #include "model/machine_reader.hpp"
+#include "settings/section_reader.hpp"
 
 using namespace exc;
 
@@ -126,6 +127,9 @@ TEST_CASE("firmware/settings accept the plant's sections without reading them an
   check_error("name: x\n" + std::string(kTask), "duration", "name: x", "missing: how long the run lasts");
   // An unknown key spelt nearly as a declared one: named with it, as git and cargo do.
   check_error("name: x\nduration: 2\ntask_: {}\n" + std::string(kTask), "task_", "task_", "unknown key; did you mean task? allowed keys:");
+  // A misspelt required key: the misspelling is named with the key it misses, not "duration: missing".
+  check_error("name: x\ndurration: 2\n" + std::string(kTask), "durration", "durration",
+              "unknown key; did you mean duration? (duration is required and not given) allowed keys:");
   check_error("name: x\nduration: 2\nterrain: {height: 50}\n" + std::string(kTask), "terrain.height", "50",
               "is 50 m; allowed range [-20, 20] m");
   check_error("name: x\nduration: 2\ncontroller: {kp: 3}\n" + std::string(kTask), "controller.kp", "3}",
@@ -211,4 +215,31 @@ TEST_CASE("firmware/settings accept a run of a working shift (duration 28800 s) 
   CHECK(read("name: x\nduration: 28800\n" + std::string(kTask)).duration == 28800);
   check_error("name: x\nduration: 28801\n" + std::string(kTask), "duration", "28801",
               "is 28801 s; allowed range [0.001, 28800] s");
+}
+
+TEST_CASE("firmware/settings name a required key's misspelling only once the section's keys are all declared") {
+  double q = 0, qd = 0, w = 0;
+  const auto read_q = [&](const std::string& yaml) {
+    settings::SectionReader r("f.yaml", "", YAML::Load(yaml));
+    r.number("q_a", q, {-10, 10}, "m", "the required one", settings::Need::required);
+    r.number("qd_a", qd, {-10, 10}, "m/s", "an optional one declared later");
+    r.number("w", w, {0, 1}, "", "another optional one");
+    r.finish();
+  };
+  const auto error_of = [&](const std::string& yaml) {
+    try {
+      read_q(yaml);
+    } catch (const SettingsError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // qd_a is spelt nearly as q_a but is a field of its own: q_a is plainly missing.
+  CHECK(error_of("qd_a: 1\n") == "f.yaml:1:1: q_a: missing: the required one; a number in [-10, 10] m");
+  // q_b is no field: it is named, with the required key it misspells.
+  CHECK(error_of("q_b: 1\nqd_a: 1\n") ==
+        "f.yaml:1:1: q_b: unknown key; did you mean q_a? (q_a is required and not given) allowed keys: q_a, qd_a, w");
+  // Another error of the section read after the missing key still reports the missing key first.
+  CHECK(error_of("q_b: 1\nw: 5\n").find("q_a: missing") != std::string::npos);
+  CHECK(error_of("q_a: 1\n") == "no error");
 }

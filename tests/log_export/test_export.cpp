@@ -521,6 +521,53 @@ TEST_CASE("tools/excavator-log reads past a damaged event header, and counts the
   }
 }
 
+TEST_CASE("tools/excavator-log exits 2 for bad input (no such file, not a log, an empty log), explains a damaged sync word in its own words and flags gaps in a channel's sequence numbers") {
+  const fs::path dir = exc::test::scratch_dir(fs::temp_directory_path() / ("exc-input-" + std::to_string(::getpid())));
+  const fs::path text = dir / "notes.txt", empty = dir / "empty.lcm";
+  std::ofstream(text) << "not a log\n";
+  std::ofstream{empty};
+  for (const char* sub : {"info", "export", "report"}) {
+    const std::string tail = std::string(sub) == "info" ? "" : std::string(sub) == "export" ? " --csv csv" : " --out rep";
+    INFO(sub);
+    const ToolRun missing = run_excavator_log(std::string(sub) + " '" + (dir / "none.lcm").string() + "'" + tail, dir);
+    CHECK(missing.status == 2);
+    CHECK(missing.err.find("none.lcm: no such file") != std::string::npos);
+    const ToolRun not_log = run_excavator_log(std::string(sub) + " '" + text.string() + "'" + tail, dir);
+    CHECK(not_log.status == 2);
+    CHECK(not_log.err.find("notes.txt: not an LCM log") != std::string::npos);
+    const ToolRun nothing = run_excavator_log(std::string(sub) + " '" + empty.string() + "'" + tail, dir);
+    INFO(nothing.err);
+    CHECK(nothing.status == 2);
+    CHECK(nothing.err.find("empty.lcm: an empty log (0 bytes): nothing was logged") != std::string::npos);
+    CHECK(nothing.err.find("plot-run") == std::string::npos);
+  }
+  // Ten events with sequence numbers 0..11, 3 and 7 not published into the log: two gaps, two missing.
+  const fs::path gappy = dir / "gappy.lcm";
+  std::vector<Event> events;
+  for (int k = 0; k < 12; ++k)
+    if (k != 3 && k != 7) events.push_back({"EXC_TIMING/pid", timing_message(1000 * k, k), 1700000000000000 + k});
+  write_log(gappy, events);
+  const ToolRun gaps = run_excavator_log("info '" + gappy.string() + "'", dir);
+  INFO(gaps.out);
+  CHECK(gaps.status == 0);
+  CHECK(gaps.out.find("EXC_TIMING/pid: 2 of 12 messages missing (sequence numbers 0 to 11, 2 gaps)") != std::string::npos);
+  // The control: ten events without a gap say nothing of one.
+  const fs::path whole = dir / "whole.lcm";
+  const std::uint64_t event_size = write_ten_timing_events(whole, "EXC_TIMING/pid");
+  const ToolRun whole_run = run_excavator_log("info '" + whole.string() + "'", dir);
+  CHECK(whole_run.out.find("missing") == std::string::npos);
+  // A damaged sync word: LCM's own reader would print a bare "Invalid header after log data"; the
+  // event before it and the damaged one are counted unread, in excavator-log's words.
+  std::string damaged = file_text(whole);
+  for (int i = 0; i < 4; ++i) damaged[4 * event_size + i] = 0;
+  std::ofstream(whole, std::ios::binary | std::ios::trunc) << damaged;
+  const ToolRun sync = run_excavator_log("info '" + whole.string() + "'", dir);
+  INFO(sync.err);
+  CHECK(sync.status == 0);
+  CHECK(sync.err.find("Invalid header") == std::string::npos);
+  CHECK(sync.err.find(std::to_string(2 * event_size) + " bytes are in no complete event") != std::string::npos);
+}
+
 TEST_CASE("telemetry/export keeps a channel's type through an event of another or no type, and leaves that event out") {
   // One channel of timing_t with, in its middle, an event whose fingerprint is damaged and one of
   // another exlcm type (two publishers on one channel): both are counted undecodable; the channel

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <string>
 #include <vector>
+#include <fcntl.h>
 #include <sched.h>
 #include <signal.h>
 #include <spawn.h>
@@ -1153,6 +1154,101 @@ TEST_CASE("tools/excavator-sim refuses a controller named twice (run --controlle
   CHECK(control.status == 0);
   const Run control_run = run_sim("run " + kDig + " --controller pid --duration 0.1 --no-report --out out");
   CHECK(control_run.status == 0);
+}
+
+TEST_CASE("tools/excavator-sim refuses a law its scene's command interface cannot carry before the log's size line, writing nothing") {
+  const Run flow = run_sim("run " + kPaperDig + " --controller flow --duration 0.1 --out out");
+  INFO(flow.err);
+  CHECK(flow.status == 2);
+  CHECK(flow.err.find("--controller: flow commands the valves' flow: it needs command_interface: valve") != std::string::npos);
+  CHECK(flow.err.find("controller.command_interface is effort") != std::string::npos);
+  CHECK(flow.err.find("excavator-sim: log ") == std::string::npos);  // no log-size line
+  CHECK(!fs::exists(flow.dir / "out" / "effective.yaml"));
+  CHECK(!fs::exists(flow.dir / "out" / "run.lcm"));
+  // The control: a law that fits runs and writes both.
+  const Run pid = run_sim("run " + kPaperDig + " --controller pid --duration 0.1 --no-report --out out");
+  CHECK(pid.status == 0);
+  CHECK(fs::exists(pid.dir / "out" / "effective.yaml"));
+}
+
+namespace {
+
+// excavator-sim started in `dir` with `args` (stdout and stderr to files there), not waited for.
+pid_t spawn_sim(const fs::path& dir, const std::vector<std::string>& args) {
+  std::vector<std::string> all = {EXC_SIM_TOOL};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  const std::string out = (dir / "out.txt").string(), err = (dir / "err.txt").string();
+  posix_spawn_file_actions_addopen(&files, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&files, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addchdir_np(&files, dir.c_str());
+  // A process group of its own, as a terminal's job: kill(-pid) reaches its helper programs too.
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+  posix_spawnattr_setpgroup(&attributes, 0);
+  pid_t pid = 0;
+  REQUIRE(posix_spawn(&pid, EXC_SIM_TOOL, &files, &attributes, argv.data(), environ) == 0);
+  posix_spawn_file_actions_destroy(&files);
+  posix_spawnattr_destroy(&attributes);
+  return pid;
+}
+
+// Waits (up to a minute) until `ready` holds.
+bool wait_for(const std::function<bool()>& ready) {
+  for (int i = 0; i < 6000; ++i) {
+    if (ready()) return true;
+    usleep(10000);
+  }
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("tools/excavator-sim: a first Ctrl-C ends the run at a cycle, writes its summary marked interrupted, a closed log and the report, exit 130, and a second aborts") {
+  const fs::path dir = exc::test::scratch_dir(fs::path(EXC_BINARY_DIR) / "tests" / "sim" / ("interrupt_" + std::to_string(getpid())));
+  const fs::path log = dir / "out" / "run.lcm";
+  const pid_t sim = spawn_sim(dir, {"run", kDig, "--controller", "pid,adaptive", "--duration", "600", "--out", "out"});
+  // Running once its log has events in it.
+  REQUIRE(wait_for([&] { std::error_code ec; return fs::file_size(log, ec) > 100000 && !ec; }));
+  kill(sim, SIGINT);
+  int status = 0;
+  waitpid(sim, &status, 0);
+  const std::string err = read_text_file(dir / "err.txt");
+  INFO(err);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(err.find("interrupted: the run ends at the next cycle") != std::string::npos);
+  const nlohmann::json j = nlohmann::json::parse(read_text_file(dir / "out" / "summary.json"));
+  CHECK(j["ok"] == false);
+  CHECK(j["interrupted"] == true);
+  REQUIRE(j.contains("pid"));
+  CHECK(j["pid"]["failure"].get<std::string>().rfind("interrupted (SIGINT) at ", 0) == 0);
+  CHECK(j["pid"]["simulated_seconds"].get<double>() < 600);
+  CHECK(!j.contains("adaptive"));  // the controller after the interrupted one did not run
+  // The log is whole (every event complete) and the report of what ran is written.
+  const std::string info = "'" + std::string(EXC_LOG_TOOL) + "' info '" + log.string() + "' > '" + (dir / "info.txt").string() +
+                           "' 2> '" + (dir / "info_err.txt").string() + "'";
+  CHECK(std::system(info.c_str()) == 0);
+  CHECK(read_text_file(dir / "info_err.txt").find("no complete event") == std::string::npos);
+  CHECK(fs::exists(dir / "out" / "report" / "report.md"));
+
+  // A second Ctrl-C, once the first was taken (the report's helpers then run for seconds): the
+  // program ends by the signal, at once.
+  const fs::path again_dir = exc::test::scratch_dir(dir / "again");
+  const pid_t again = spawn_sim(again_dir, {"run", kDig, "--controller", "pid", "--duration", "600", "--out", "out"});
+  REQUIRE(wait_for([&] { std::error_code ec; return fs::file_size(again_dir / "out" / "run.lcm", ec) > 100000 && !ec; }));
+  kill(again, SIGINT);
+  REQUIRE(wait_for([&] { return read_text_file(again_dir / "err.txt").find("interrupted: the run ends") != std::string::npos; }));
+  kill(-again, SIGINT);  // to the job, as a terminal sends it
+  int again_status = 0;
+  waitpid(again, &again_status, 0);
+  CHECK(WIFSIGNALED(again_status));
+  CHECK(WTERMSIG(again_status) == SIGINT);
 }
 
 TEST_CASE("tools/excavator-sim sweep refuses a --shard that is not exactly I/N with 0 <= I < N (trailing text, a third part, overflow, a sign), and runs one that is") {

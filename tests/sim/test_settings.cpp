@@ -184,3 +184,36 @@ TEST_CASE("tools/excavator-firmware --print-config prints the firmware's section
   CHECK(keys == std::set<std::string>{"name", "description", "terrain", "duration", "controller", "task"});
   for (const std::string& k : keys) CHECK_MESSAGE(exc::settings::emit(f[k]) == exc::settings::emit(s[k]), k);
 }
+
+TEST_CASE("tools/excavator-plant --print-config checks the plant's sections that excavator-firmware --print-config leaves, and says so, and the help texts say what the programs do") {
+  const fs::path dir = fresh_dir("plant_config");
+  const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
+  // A misspelt key in the plant's soil section.
+  std::string misspelt = read_text_file(dig);
+  const auto soil = misspelt.find("soil: {preset: loam}");
+  REQUIRE(soil != std::string::npos);
+  misspelt.replace(soil, 20, "soil: {presett: loam}");
+  std::ofstream(dir / "misspelt.yaml") << misspelt;
+  const Run fw = run(std::string(EXC_FIRMWARE_TOOL) + " --print-config --scene misspelt.yaml", dir);
+  CHECK(fw.status == 0);  // the firmware does not read the plant's sections, and says so
+  CHECK(fw.err.find("the firmware's sections only; the plant's (soil") != std::string::npos);
+  CHECK(fw.err.find("excavator-plant --print-config --scene misspelt.yaml") != std::string::npos);
+  const Run plant = run(std::string(EXC_PLANT_TOOL) + " --print-config --scene misspelt.yaml", dir);
+  INFO(plant.err);
+  CHECK(plant.status == 2);
+  CHECK(plant.err.find("soil.presett: unknown key; did you mean preset?") != std::string::npos);
+  // The control: the shipped scene's plant sections, defaults filled in, as excavator-sim config prints them.
+  const Run good = run(std::string(EXC_PLANT_TOOL) + " --print-config --scene " + dig, dir);
+  REQUIRE_MESSAGE(good.status == 0, good.err);
+  const Run sim = run(std::string(EXC_SIM_TOOL) + " config " + dig, dir);
+  const YAML::Node p = YAML::Load(good.out), s = YAML::Load(sim.out);
+  for (const char* k : {"soil", "actuators", "sensors"}) CHECK_MESSAGE(exc::settings::emit(p[k]) == exc::settings::emit(s[k]), k);
+  // Help: where the vcan set-up is described, the defaults shown; the operator's keep-alive is many frames.
+  const Run plant_help = run(std::string(EXC_PLANT_TOOL) + " --help", dir);
+  CHECK(plant_help.out.find("docs/vcan.md") != std::string::npos);
+  CHECK(plant_help.out.find("see README") == std::string::npos);
+  CHECK(plant_help.out.find("500") != std::string::npos);  // --silence-ms's default
+  const Run operator_help = run(std::string(EXC_OPERATOR_TOOL) + " --help", dir);
+  CHECK(operator_help.out.find("sends one operator command") == std::string::npos);
+  CHECK(operator_help.out.find("one every --period for keep-alive") != std::string::npos);
+}

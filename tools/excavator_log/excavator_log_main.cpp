@@ -55,6 +55,26 @@ void print_summary(const std::string& log_path, const exc::log::LogSummary& summ
   }
 }
 
+// Messages a channel's sequence numbers say were published but are not in the log.
+void print_gaps(const exc::log::LogSummary& summary) {
+  for (const auto& [name, channel] : summary.channels) {
+    if (channel.seq_gaps == 0) continue;
+    const std::int64_t span = channel.last_seq - channel.first_seq + 1;
+    std::printf("%s: %llu of %lld messages missing (sequence numbers %lld to %lld, %llu gap%s): published but not "
+                "recorded, e.g. dropped by a logger over UDP\n",
+                exc::log::printable_channel(name).c_str(), static_cast<unsigned long long>(channel.seq_missing),
+                static_cast<long long>(span), static_cast<long long>(channel.first_seq),
+                static_cast<long long>(channel.last_seq), static_cast<unsigned long long>(channel.seq_gaps),
+                channel.seq_gaps == 1 ? "" : "s");
+  }
+}
+
+// Exit status of a failed read: 2 for bad input (as every program here), 1 for a failed write.
+int failure(const exc::log::LogSummary& summary, const std::string& error) {
+  std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
+  return summary.bad_input ? 2 : 1;
+}
+
 // plot-run: the one built next to this program (build tree), else the one on PATH (installed).
 std::string plot_run_program() {
 #ifdef EXC_PLOT_RUN
@@ -116,20 +136,15 @@ int main(int argc, char** argv) {
   exc::log::LogSummary summary;
   std::string error;
   if (info->parsed()) {
-    if (!exc::log::summarize_log(info_log, &summary, &error)) {
-      std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
-      return 1;
-    }
+    if (!exc::log::summarize_log(info_log, &summary, &error)) return failure(summary, error);
     print_summary(info_log, summary);
+    print_gaps(summary);
     warn_unread(info_log, summary);
     return 0;
   }
   if (reporter->parsed()) {
     const std::string csv = (std::filesystem::path(report_dir) / "csv").string();
-    if (!exc::log::export_log_to_csv(report_log, csv, &summary, &error, options)) {
-      std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
-      return 1;
-    }
+    if (!exc::log::export_log_to_csv(report_log, csv, &summary, &error, options)) return failure(summary, error);
     warn_unread(report_log, summary);
     std::vector<std::string> command = {plot_run_program(), csv, "--out", report_dir, "--title", title};
     if (!summary_json.empty()) command.insert(command.end(), {"--summary", summary_json});
@@ -139,11 +154,9 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
-  if (!exc::log::export_log_to_csv(export_log, csv_dir, &summary, &error, options)) {
-    std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
-    return 1;
-  }
+  if (!exc::log::export_log_to_csv(export_log, csv_dir, &summary, &error, options)) return failure(summary, error);
   print_summary(export_log, summary);
+  print_gaps(summary);
   warn_unread(export_log, summary);
   for (const auto& [name, channel] : summary.channels) {
     if (channel.type_name == "unknown") {

@@ -1,5 +1,5 @@
-// excavator-operator: sends one operator command to the firmware as a SUPERVISOR frame on a SocketCAN
-// interface, as an operator station or a remote e-stop kit would: start (a firmware run with
+// excavator-operator: sends operator commands to the firmware as SUPERVISOR frames on a SocketCAN
+// interface (one frame for start, stop, ack; a stream of them for keep-alive), as an operator station or a remote e-stop kit would: start (a firmware run with
 // --wait-for-start begins its task), stop (a controlled stop that latches like a fault) or ack
 // (acknowledges a latched stop; the firmware holds where the machine is once its condition is gone);
 // or keep-alive: Command none every --period until its --duration ends or a signal, the monitored
@@ -36,8 +36,9 @@ const std::map<std::string, exc::hal::SupervisorCommand> kCommands{
 
 int main(int argc, char** argv) {
   CLI::App app{
-      "excavator-operator: sends one operator command (a SUPERVISOR frame, hal/excavator.dbc) to the firmware on a "
-      "SocketCAN interface.\n  start  a firmware run with --wait-for-start begins its task\n  stop   a controlled "
+      "excavator-operator: an operator station: sends the firmware its commands as SUPERVISOR frames "
+      "(hal/excavator.dbc) on a SocketCAN interface: one frame for start, stop and ack, one every --period for "
+      "keep-alive.\n  start  a firmware run with --wait-for-start begins its task\n  stop   a controlled "
       "stop (valves centred), latched until acknowledged\n  ack    acknowledges a latched stop (also: acknowledge)\n"
       "  keep-alive  Command none every --period until --duration or SIGINT/SIGTERM: a monitored link; once the "
       "firmware has heard one, silence for its controller.supervisor_timeout (0.5 s) stops the machine"};
@@ -49,7 +50,8 @@ int main(int argc, char** argv) {
                  "the frame's rolling counter, 0..15 (default 0: the firmware takes a frame more than 5 ms after "
                  "the previous SUPERVISOR as a new sequence, so each run of this program is heard)")
       ->check(exc::cli::count_in(0, 15));
-  app.add_option("--period", period, "keep-alive: seconds between frames (default 0.1)")
+  app.add_option("--period", period, "keep-alive: seconds between frames")
+      ->capture_default_str()
       ->check(exc::cli::number_in({0.005, 10}, "s"));
   app.add_option("--duration", duration, "keep-alive: seconds to send for (default 0: until SIGINT or SIGTERM)")
       ->check(exc::cli::number_in({0, 1e6}, "s"));

@@ -20,6 +20,7 @@
 #include "output_files/output_file.hpp"
 #include "sim_plant/plant_node.hpp"
 #include "sim_plant/plant.hpp"
+#include "settings/section_reader.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
 namespace {
@@ -32,36 +33,49 @@ int main(int argc, char** argv) {
   // This thread steps the plant (and starts the telemetry thread): subnormals flushed, as in the
   // firmware and the lockstep harness, so the two processes compute what one process computes.
   exc::app::set_loop_float_mode();
-  CLI::App app{"excavator-plant: the simulated excavator on a SocketCAN interface (see README)."};
+  CLI::App app{"excavator-plant: the simulated excavator on a SocketCAN interface, one step per SYNC from "
+               "excavator-firmware; holds when SYNC stops (setting up vcan0 and running the two: docs/vcan.md)."};
   std::string iface, scene_path, lcm_url;
   double duration = 0, silence_ms = 500, startup_s = 120;
-  bool realtime = false;
+  bool realtime = false, print_config = false;
   // A main-valve spool stuck (as the fault campaign's spool_stuck) for the vcan safety tests.
   std::string stuck_function;
   double stuck_opening = 0, stuck_from = 0, stuck_until = 1e9;
-  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0")->required();
-  app.add_option("--scene", scene_path, "scene file")->required();
+  app.add_option("--can", iface, "SocketCAN interface, e.g. vcan0 (required unless --print-config)");
+  app.add_option("--scene", scene_path, "scene file (its machine, soil, actuators, sensors, ... sections)")->required();
   app.add_option("--duration", duration,
                  "exit after this many simulated seconds (default: the scene's, or while SYNC comes on after it: "
                  "a firmware whose task is stretched, by task.efforts.fit_timing or controller.pump_pacing, runs longer)")
       ->check(exc::cli::number_in(exc::kRunDurationBounds, "s"));
   app.add_option("--lcm", lcm_url, "publish the machine state (EXC_STATE) to this LCM URL");
   app.add_option("--silence-ms", silence_ms, "hold after this long without SYNC (wall clock)")
+      ->capture_default_str()
       ->check(exc::cli::number_in({0.01, 600000}, "ms"));
   app.add_option("--startup-timeout", startup_s, "give up if no SYNC arrives within this many seconds")
+      ->capture_default_str()
       ->check(exc::cli::number_in({0.001, 86400}, "s"));
   app.add_flag("--realtime", realtime,
                "the firmware runs --realtime: a full telemetry ring drops and counts messages instead of "
                "delaying the answer to SYNC past the firmware's deadline (default: wait, lose nothing)");
   app.add_option("--stuck-spool", stuck_function, "stick this function's main-valve spool (hydraulic machine)")
       ->check(CLI::IsMember({"swing", "boom", "arm", "bucket"}));
-  app.add_option("--stuck-opening", stuck_opening, "the opening the spool sticks at")->check(exc::cli::number_in({-1, 1}, ""));
-  app.add_option("--stuck-from", stuck_from, "simulated time it sticks")->check(exc::cli::number_in({0, 1e9}, "s"));
+  app.add_option("--stuck-opening", stuck_opening, "the opening the spool sticks at")->capture_default_str()->check(exc::cli::number_in({-1, 1}, ""));
+  app.add_option("--stuck-from", stuck_from, "simulated time it sticks")->capture_default_str()->check(exc::cli::number_in({0, 1e9}, "s"));
   app.add_option("--stuck-until", stuck_until, "simulated time it frees (default: never)")->check(exc::cli::number_in({0, 1e9}, "s"));
+  app.add_flag("--print-config", print_config,
+               "print the plant's sections of the scene as it reads them, every default filled in (YAML), and exit");
   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
+  if (!print_config && iface.empty()) {
+    std::cerr << "excavator-plant: --can is required\n";
+    return 2;
+  }
 
   try {
     exc::plant::Plant plant(exc::plant::load_scene(scene_path));
+    if (print_config) {
+      std::cout << exc::settings::emit(plant.scene().effective);
+      return 0;
+    }
     exc::app::NodeIo io;
     std::string error;
     // The plant steps on SYNC and has no clock of its own, but its answer is part of the firmware's

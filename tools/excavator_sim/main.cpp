@@ -21,6 +21,7 @@
 #include "output_files/output_file.hpp"
 #include "sweep/robustness.hpp"
 #include "report/paper_report.hpp"
+#include "report/run_interrupt.hpp"
 #include "report/run_report.hpp"
 #include "report/scene_job.hpp"
 #include "settings/section_reader.hpp"
@@ -127,7 +128,9 @@ int main(int argc, char** argv) {
   sweep->add_option("spec", sweep_spec, "sweep spec (YAML)")->required();
   sweep->add_option("--shard", sweep_shard, "I/N: run cases I, I+N, I+2N, ... (default 0/1: every case)");
   sweep->add_option("--out", sweep_out, "the shard's result file (default: out/sweep/shard-I-of-N.jsonl)");
-  sweep->add_flag("--quiet", sweep_quiet, "no progress output");
+  sweep->add_flag("--quiet", sweep_quiet, "no progress line (it is shown only on a terminal: k of N cases, elapsed, time left)");
+  bool sweep_check = false;
+  sweep->add_flag("--check", sweep_check, "read and check the spec, print its number of cases, run none");
   auto* merge = app.add_subcommand("sweep-merge", "merge shard files into sweep.csv, sweep.json and the spec's charts; names missing cases and shard files");
   std::string merge_spec, merge_out = "out/sweep";
   std::vector<std::string> merge_files;
@@ -172,6 +175,10 @@ int main(int argc, char** argv) {
       if (spec.run != exc::sim::SweepRun::closed_loop) {
         std::cerr << "excavator-sim sweep: " << sweep_spec << ": an open-loop sweep runs in excavator-bench (its step map)\n";
         return 2;
+      }
+      if (sweep_check) {
+        std::cout << sweep_spec << ": " << spec.total_cases() << " cases\n";
+        return 0;
       }
       if (sweep_out.empty())
         sweep_out = (fs::path("out/sweep") / ("shard-" + std::to_string(shard) + "-of-" + std::to_string(shards) + ".jsonl")).string();
@@ -249,9 +256,14 @@ int main(int argc, char** argv) {
       const exc::sim::SceneJobPlan dig_plan = exc::sim::plan_scene_job(dig_job);
       const exc::sim::SceneJobPlan hydraulic_plan = exc::sim::plan_scene_job(hydraulic_job);
       exc::sim::check_log_room({&free_plan, &dig_plan, &hydraulic_plan});
+      exc::sim::catch_run_interrupt();
+      // Interrupted, the scenes after the one that was running do not run, and there is no paper page.
       const exc::sim::SceneJobResult free_result = exc::sim::run_scene_job(free_plan);
+      if (free_result.summary.interrupted) return free_result.exit_code;
       const exc::sim::SceneJobResult dig_result = exc::sim::run_scene_job(dig_plan);
+      if (dig_result.summary.interrupted) return dig_result.exit_code;
       const exc::sim::SceneJobResult hydraulic_result = exc::sim::run_scene_job(hydraulic_plan);
+      if (hydraulic_result.summary.interrupted) return hydraulic_result.exit_code;
       if (!exc::sim::write_paper_report(out, free_result, dig_result, hydraulic_result)) {
         std::cerr << "excavator-sim: cannot write " << (out / "report.md").string() << "\n";
         return 1;
@@ -276,7 +288,10 @@ int main(int argc, char** argv) {
     job.report = !no_report;
     job.progress = !quiet;
     job.firmware_target = firmware_target;
-    return exc::sim::run_scene_job(job).exit_code;
+    const exc::sim::SceneJobPlan plan = exc::sim::plan_scene_job(job);
+    exc::sim::check_log_room({&plan});
+    exc::sim::catch_run_interrupt();
+    return exc::sim::run_scene_job(plan).exit_code;
   } catch (const std::exception& e) {
     std::cerr << "excavator-sim: " << e.what() << "\n";
     return 2;

@@ -65,9 +65,10 @@ def plot_bands(plt, runs, channel, panels, title, name, out_dir, written, scale=
 
 
 def plot_errors(plt, runs, out_dir, written):
+    # In mm (mrad for the swing), as every table gives it.
     plot_bands(plt, runs, "EXC_CONTROLLER",
-               [("error_%d" % j, "%s error, %s" % (joint, unit)) for j, (joint, unit) in enumerate(JOINTS)],
-               "Tracking error e = q - q_d", "tracking_error.png", out_dir, written)
+               [("error_%d" % j, "%s error [%s]" % (joint, ERROR_UNITS[j])) for j, (joint, _) in enumerate(JOINTS)],
+               "Tracking error e = q - q_d", "tracking_error.png", out_dir, written, scale=1e3)
 
 
 def plot_soil_force(plt, runs, out_dir, written):

@@ -5,7 +5,7 @@ import json
 import math
 
 import long_figures
-from figure_base import JOINTS, THETA, decorate, new_figure, plot_runs, save
+from figure_base import ERROR_UNITS, JOINTS, THETA, decorate, new_figure, plot_runs, save
 from plot_failure import fail
 from run_data import commanded, is_long, seconds
 
@@ -39,8 +39,9 @@ def plot_errors(plt, runs, out_dir, written):
     fig, axes = new_figure(plt, 2, 2, "Tracking error e = q - q_d")
     for j, (joint, unit) in enumerate(JOINTS):
         ax = axes[j // 2][j % 2]
-        plot_runs(ax, runs, "EXC_CONTROLLER", lambda ctrl: ctrl["error_%d" % j])
-        decorate(ax, "time [s]", "error, %s" % unit, title=joint)
+        # In mm (mrad for the swing), as every table gives it.
+        plot_runs(ax, runs, "EXC_CONTROLLER", lambda ctrl: [1e3 * e for e in ctrl["error_%d" % j]])
+        decorate(ax, "time [s]", "error [%s]" % ERROR_UNITS[j], title=joint)
     save(plt, fig, out_dir, "tracking_error.png", written)
 
 
@@ -77,23 +78,38 @@ def plot_soil_estimates(plt, runs, out_dir, written):
     save(plt, fig, out_dir, "soil_estimates.png", written)
 
 
+def last_of_stage(timing, stage):
+    """The row of the stage's last message (it holds the run's statistics), None without one."""
+    rows = [r for r, s in enumerate(timing["stage"]) if s == stage]
+    return rows[-1] if rows else None
+
+
 def plot_timing(plt, runs, out_dir, written):
-    fig, axes = new_figure(plt, 1, 1, "Control loop timing")
+    # Stage 0 of EXC_TIMING, the whole firmware cycle; the summary's "control step" is stage 2 (the
+    # update: estimate, path and law), a part of it: both are named, so that the figures are not
+    # taken for one another.
+    fig, axes = new_figure(plt, 1, 1, "Firmware cycle timing: the whole cycle (read, update, write, telemetry encode)")
     ax = axes[0][0]
     drawn = False
     for label, channels in runs.items():
         timing = channels.get("EXC_TIMING", {})
         if timing and timing.get("stage"):
-            # The last message of the whole-cycle counter holds the run's histogram.
-            rows = [r for r, s in enumerate(timing["stage"]) if s == 0]
-            if rows:
-                r = rows[-1]
+            r = last_of_stage(timing, 0)
+            if r is not None:
                 width = timing["bin_width_us"][r]
                 bins = [timing["bins_%d" % b][r] for b in range(64)]
                 edges = [b * width for b in range(64)]
-                ax.bar(edges, bins, width=width, align="edge", alpha=0.5,
-                       label="%s: p99 %.1f us, max %.1f us" % (label, timing["p99_us"][r],
-                                                               timing["max_us"][r]))
+                text = "%s: whole cycle p99 %.1f us, max %.1f us" % (label, timing["p99_us"][r], timing["max_us"][r])
+                u = last_of_stage(timing, 2)
+                if u is not None:
+                    text += "; control step (update) p99 %.1f us" % timing["p99_us"][u]
+                bars = ax.bar(edges, bins, width=width, align="edge", alpha=0.5, label=text)
+                # The last bin also holds every longer cycle: said at its bar.
+                if bins[-1] > 0:
+                    last = bars[-1]
+                    ax.annotate("%s: %d at >= %g us" % (label, bins[-1], edges[-1]),
+                                (last.get_x() + last.get_width() / 2, last.get_height()),
+                                ha="right", va="bottom", fontsize=7, rotation=90)
                 drawn = True
                 continue
         state = channels.get("EXC_STATE", {})
@@ -109,6 +125,7 @@ def plot_timing(plt, runs, out_dir, written):
 
 
 def plot_robustness(plt, path, out_dir):
+    import matplotlib.ticker as ticker
     """robustness.png from `excavator-sim robustness --json`: RMS error per variant, one panel per
     joint, one bar per controller (log scale: the variants span two decades)."""
     try:
@@ -138,6 +155,11 @@ def plot_robustness(plt, path, out_dir):
                     ax.annotate("stopped", (bar.get_x() + bar.get_width() / 2, bar.get_height()),
                                 ha="center", va="bottom", fontsize=7, rotation=90)
         ax.set_yscale("log")
+        # Labels at 1, 2 and 5 of each decade, as plain numbers: a panel spanning less than a
+        # decade still carries several readable values.
+        ax.yaxis.set_major_locator(ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: "%g" % v))
+        ax.yaxis.set_minor_formatter(ticker.NullFormatter())
         ax.set_title(joint)
         ax.set_ylabel("RMS error [mm]")
         ax.set_xticks(range(len(rows)))
