@@ -52,6 +52,7 @@ class ActuatorModel {
   void set_pilot_supply(bool on) { circuit_.set_pilot_supply(on); }
   void set_engine_running(bool on) { circuit_.set_engine_running(on); }
   void set_safety_solenoids(bool energised) { circuit_.set_safety_solenoids(energised); }
+  void set_swing_lock(bool on) { circuit_.set_swing_lock(on); }
   const Vec4& spool() const { return circuit_.spool(); }
   const Vec4& pressure_a() const { return circuit_.pressure_a(); }  // cylinder bore side; swing: port A
   const Vec4& pressure_b() const { return circuit_.pressure_b(); }

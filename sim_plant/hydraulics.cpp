@@ -52,6 +52,7 @@ void HydraulicCircuit::reset(const Vec4& q_a, const Vec4& hold) {
   spool_.setZero();
   stuck_ = -1;
   pilot_on_ = engine_on_ = solenoids_on_ = true;
+  swing_lock_ = false;
   pilot_ = engine_ = shutoff_ = 1;
   solenoid_off_time_ = -1;
   const double low = 2.0 * hp_.tank_pressure;

@@ -113,6 +113,9 @@ class HydraulicCircuit {
   void set_pilot_supply(bool on) { pilot_on_ = on; }
   void set_engine_running(bool on) { engine_on_ = on; }
   void set_safety_solenoids(bool energised) { solenoids_on_ = energised; }
+  // The swing lock: the swing's parking brake applied on any latched stop (a controlled one too),
+  // as a machine's safety controller drops its swing-lock solenoid once the machine is stopped.
+  void set_swing_lock(bool on) { swing_lock_ = on; }
   double pilot_supply() const { return pilot_; }   // 0..1 of the pilot pressure
   double engine_flow() const { return engine_; }   // 0..1 of the pumps' rated flow
   double pump_line_open() const { return shutoff_; }  // 0..1: the pump-line shut-off's opening
@@ -122,7 +125,7 @@ class HydraulicCircuit {
   bool bucket_holding_valve_closed() const {
     return hp_.bucket_holding_valve && solenoid_off_time_ >= hp_.holding_valve_close_time;
   }
-  bool swing_brake_applied() const { return hp_.swing_brake_torque > 0 && (pilot_ < 0.5 || !solenoids_on_); }
+  bool swing_brake_applied() const { return hp_.swing_brake_torque > 0 && (pilot_ < 0.5 || !solenoids_on_ || swing_lock_); }
 
   // Advance spools, pumps and chambers over dt; q_a is the position at the end, qd_a the velocity
   // over the substep (the piston sweeps A qd_a dt).
@@ -161,7 +164,7 @@ class HydraulicCircuit {
   Vec4 relief_setting_ = Vec4::Zero();
   double k_relief_ = 0, k_makeup_ = 0;
   double pump_flow_scale_ = 1;
-  bool pilot_on_ = true, engine_on_ = true, solenoids_on_ = true;
+  bool pilot_on_ = true, engine_on_ = true, solenoids_on_ = true, swing_lock_ = false;
   double pilot_ = 1, engine_ = 1, shutoff_ = 1;
   double solenoid_off_time_ = -1;  // s since the safety solenoids dropped; negative while energised
   Vec4 target_ = Vec4::Zero(), spool_ = Vec4::Zero(), p_a_ = Vec4::Zero(), p_b_ = Vec4::Zero();

@@ -68,6 +68,7 @@ class Plant {
   void set_pilot_supply(bool on) { actuators_.set_pilot_supply(on); }
   void set_engine_running(bool on) { actuators_.set_engine_running(on); }
   void set_safety_solenoids(bool energised) { actuators_.set_safety_solenoids(energised); }
+  void set_swing_lock(bool on) { actuators_.set_swing_lock(on); }
   // Back to the scene's initial state (time 0, soil untouched, sensors reseeded).
   void reset();
   // Advance one control cycle (scene.cycle, 1 ms by default) with this command held.

@@ -148,6 +148,10 @@ void PlantNode::step(std::uint64_t cycle, bool answer) {
     plant_.set_pilot_supply(!pilot_cut);
     plant_.set_engine_running(!command_.emergency_stop);
     plant_.set_safety_solenoids(!command_.emergency_stop);
+    // Any stop the firmware latched (a FW_EMERGENCY with a FaultCode, controlled or emergency) locks
+    // the swing: with its valves centred and no brake, the upper structure rang on its motor's
+    // leaking oil spring for seconds (docs/safety.md, the stop requirement's swing drift).
+    plant_.set_swing_lock(command_.fault_code != 0);
   }
 
   // Any other command goes to the plant as the kind it is: a kind the actuators cannot use (efforts

@@ -17,7 +17,8 @@ LAWS = ("pid", "adaptive")
 # The hazard each safety function serves (docs/safety.md), in the concept's order.
 # With --requirements, each function's reaction-time requirement (docs/safety.md's hazard table).
 FUNCTIONS = (
-    ("velocity implausible", "H1 flow plausibility", "100 ms / 1.5 s (H1)"),
+    ("spool disagreement", "H1 spool monitor", "100 ms of the onset (R1)"),
+    ("velocity implausible", "H1 flow plausibility", "100 ms of the onset (R1)"),
     ("tracking error", "H2 tracking-error limit", "one cycle past the limit (H2)"),
     ("sensor timeout", "H3 sensor watchdog", "20 ms watchdog (H3)"),
     ("pressure implausible", "H4 pressure plausibility", "3 sets range/step, 500 moving sets frozen (H4)"),
