@@ -251,7 +251,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
 
   const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
   TrackingMetrics metrics;
-  PhaseAccumulator hold_acc, stop_acc;
+  PhaseAccumulator settle_acc, hold_acc, stop_acc;
+  double hold_start = -1;  // s the current hold began (-1: not holding)
   bool commanded = false;  // the firmware held or tracked a pose (the stop phase counts from then on)
   const auto wall_start = std::chrono::steady_clock::now();
   const std::int64_t progress_every = std::max<std::int64_t>(1, cycles / 10);
@@ -335,9 +336,12 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       }
       const auto mode = static_cast<safety::Mode>(st.mode);
       if (mode == safety::Mode::hold) {
-        hold_acc.add(s.time, scene.cycle, s.q_a, q_desired);
+        if (hold_start < 0) hold_start = s.time;
+        (s.time - hold_start < kHoldSettle ? settle_acc : hold_acc).add(s.time, scene.cycle, s.q_a, q_desired);
         commanded = true;
       } else {
+        hold_start = -1;
+        settle_acc.leave();
         hold_acc.leave();
       }
       // The safe state: the centred valves' creep from the pose last asked for (none before any).
@@ -406,6 +410,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
     result.measured_rms_error[j] = outcome.measured_rms[j];
     result.measured_max_error[j] = outcome.measured_max[j];
   }
+  result.settle = settle_acc.result();
   result.hold = hold_acc.result();
   result.stop = stop_acc.result();
   const Vec6 truth = theta_of(scene.soil);
@@ -468,9 +473,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
         result.ok = false;
         char text[240];
         std::snprintf(text, sizeof text,
-                      "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s; %llu excursion(s))",
+                      "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s from %.0f s into a hold; %llu excursion(s))",
                       kActiveNames[j], result.hold.max_error[j] * 1e3, j == 0 ? "mrad" : "mm", result.hold.worst_time[j],
-                      kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm",
+                      kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm", kHoldSettle,
                       static_cast<unsigned long long>(result.hold.excursions[j]));
         result.failure = text;
       }

@@ -89,7 +89,7 @@ void print_summary(const Summary& summary, std::ostream& out) {
   }
   bool any_hold = false, any_stop = false;
   for (const RunResult& r : summary.runs) {
-    any_hold = any_hold || r.hold.samples > 0;
+    any_hold = any_hold || r.hold.samples > 0 || r.settle.samples > 0;
     any_stop = any_stop || r.stop.samples > 0;
   }
   // The other phases: the hold (after the task, after a stop, at start-up) against the holding
@@ -109,8 +109,8 @@ void print_summary(const Summary& summary, std::ostream& out) {
     }
   };
   if (any_hold) {
-    phase_rows(format("\nhold error (holding a pose; tolerance %.1f mm, %.1f mrad swing)", kHoldingTolerance[1] * 1e3,
-                      kHoldingTolerance[0] * 1e3).c_str(), &RunResult::hold);
+    phase_rows(format("\nhold error (holding a pose, from %.0f s into each hold; tolerance %.1f mm, %.1f mrad swing)",
+                      kHoldSettle, kHoldingTolerance[1] * 1e3, kHoldingTolerance[0] * 1e3).c_str(), &RunResult::hold);
     out << "  excursions past it (boom/arm/bucket)";
     for (const RunResult& r : summary.runs)
       out << format("| %-25s", format("%llu / %llu / %llu", static_cast<unsigned long long>(r.hold.excursions[1]),
@@ -118,6 +118,7 @@ void print_summary(const Summary& summary, std::ostream& out) {
                                        static_cast<unsigned long long>(r.hold.excursions[3])).c_str());
     out << "\n";
   }
+  if (any_hold) phase_rows(format("\nsettle error (the first %.0f s of each hold)", kHoldSettle).c_str(), &RunResult::settle);
   if (any_stop) phase_rows("\nstop error (the safe state: valves centred)", &RunResult::stop);
   print_cycles(summary, out);
   out << "\nsoil estimates at the end (true value)\n";
@@ -204,9 +205,11 @@ nlohmann::json to_json(const Summary& summary) {
     // tolerance the verdict holds the hold to.
     run["phases"] = {{"tracking", {{"samples", r.tracking_samples}, {"rms_error", tracked_per_joint(r, r.rms_error)},
                                    {"max_error", tracked_per_joint(r, r.max_error)}}},
+                     {"settle", phase_json(r.settle)},
                      {"hold", phase_json(r.hold)},
                      {"stop", phase_json(r.stop)}};
     run["holding_tolerance"] = per_joint(kHoldingTolerance);
+    run["hold_settle_seconds"] = kHoldSettle;
     nlohmann::json theta_hat, theta_true;
     for (int i = 0; i < 6; ++i) {
       theta_hat[kTheta[i]] = r.theta_hat[i];
