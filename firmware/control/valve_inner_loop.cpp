@@ -56,7 +56,7 @@ void ValveInnerLoop::set_holding(bool holding, const Vec4& error) {
     const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
     const double e = std::abs(hold_error_[i]);
     if (e < settings_.hold_window[i]) in_position_ |= bit;
-    else if (e > 2 * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
+    else if (e > kHoldReentry * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
   }
 }
 

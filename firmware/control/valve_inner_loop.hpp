@@ -24,8 +24,8 @@
 //                dead band in the loop, so the band stays small).
 //   in position  while the machine holds a pose (mode hold), a function whose error is inside
 //                hold_window is left with its valve centred, the load held by the closed valve as an
-//                operator's machine holds it; it is corrected again once the error exceeds twice the
-//                window. Without it the dead-zone inverse and the spool's lag make a valve hunt
+//                operator's machine holds it; it is corrected again once the error exceeds
+//                kHoldReentry times the window. Without it the dead-zone inverse and the spool's lag make a valve hunt
 //                around the pose (docs/control.md: a growing limit cycle of the flow law). The error
 //                both judgements read is low-passed over hold_filter_time, longer than the oil
 //                columns' period (2-3 Hz): a load ringing on its closed valve (after a correction, or
@@ -87,6 +87,13 @@ void visit_fields(Visitor& v, ValveLoopSettings& s) {
   v("hold_filter_time", s.hold_filter_time);
 }
 
+// Holding, a centred function is corrected again past this many hold windows. 1.5: the leakage's
+// creep is corrected from 1.5 mm, and what a correction throws the other functions by (the links
+// couple them; about 0.6 mm on the arm when the boom corrects in the dig's pose) stays inside the
+// 2.5 mm holding tolerance (docs/control.md, "Holding still"; at 2 the PID's arm reached 2.65 mm
+// in an hour's hold).
+inline constexpr double kHoldReentry = 1.5;
+
 // What the valve stage sends and what it found.
 struct ValveCommand {
   Vec4 velocity = Vec4::Zero();   // u: commanded flow per piston area (m/s; swing rad/s)
@@ -109,7 +116,7 @@ class ValveInnerLoop {
   // Spool model and lead restart from the centred spool.
   void reset();
   // Each cycle before the update: holding a pose (true, with the error e = q - q_d) or moving (false).
-  // Holding, a function inside its window is centred until its error exceeds twice the window (both
+  // Holding, a function inside its window is centred until its error exceeds kHoldReentry windows (both
   // on the error low-passed over hold_filter_time, which follows e while moving).
   void set_holding(bool holding, const Vec4& error);
   std::uint8_t in_position() const { return in_position_; }
