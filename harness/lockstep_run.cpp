@@ -253,6 +253,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   TrackingMetrics metrics;
   PhaseAccumulator settle_acc, hold_acc, stop_acc;
   double hold_start = -1;  // s the current hold began (-1: not holding)
+  bool settling = false;   // the current hold has not yet had every function inside the tolerance
   bool commanded = false;  // the firmware held or tracked a pose (the stop phase counts from then on)
   const auto wall_start = std::chrono::steady_clock::now();
   const std::int64_t progress_every = std::max<std::int64_t>(1, cycles / 10);
@@ -336,8 +337,16 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       }
       const auto mode = static_cast<safety::Mode>(st.mode);
       if (mode == safety::Mode::hold) {
-        if (hold_start < 0) hold_start = s.time;
-        (s.time - hold_start < kHoldSettle ? settle_acc : hold_acc).add(s.time, scene.cycle, s.q_a, q_desired);
+        if (hold_start < 0) {
+          hold_start = s.time;
+          settling = true;
+        }
+        if (settling) {
+          bool inside = true;
+          for (int j = 0; j < 4; ++j) inside = inside && std::abs(s.q_a[j] - q_desired[j]) <= kHoldingTolerance[j];
+          settling = !inside && s.time - hold_start < kHoldSettleLimit;
+        }
+        (settling ? settle_acc : hold_acc).add(s.time, scene.cycle, s.q_a, q_desired);
         commanded = true;
       } else {
         hold_start = -1;
@@ -473,9 +482,9 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
         result.ok = false;
         char text[240];
         std::snprintf(text, sizeof text,
-                      "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s from %.0f s into a hold; %llu excursion(s))",
+                      "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s once settled; %llu excursion(s))",
                       kActiveNames[j], result.hold.max_error[j] * 1e3, j == 0 ? "mrad" : "mm", result.hold.worst_time[j],
-                      kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm", kHoldSettle,
+                      kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm",
                       static_cast<unsigned long long>(result.hold.excursions[j]));
         result.failure = text;
       }
