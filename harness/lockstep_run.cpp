@@ -343,7 +343,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
         }
         if (settling) {
           bool inside = true;
-          for (int j = 0; j < 4; ++j) inside = inside && std::abs(s.q_a[j] - q_desired[j]) <= kHoldingTolerance[j];
+          for (int j = 0; j < 4; ++j) inside = inside && std::abs(s.q_a[j] - q_desired[j]) <= 0.5 * kHoldingTolerance[j];
           settling = !inside && s.time - hold_start < kHoldSettleLimit;
         }
         (settling ? settle_acc : hold_acc).add(s.time, scene.cycle, s.q_a, q_desired);

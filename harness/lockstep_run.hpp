@@ -60,8 +60,8 @@ struct CycleRecord {
 
 // The errors of one phase of a run, true q_a against the pose the firmware asks for; rad (swing), m.
 // Phases: tracking (the path running, its stop along the path included), settle (each hold's start,
-// the path's last error dying out: until every function is inside the holding tolerance, at most
-// kHoldSettleLimit s), hold (the firmware holding a pose from then on: after the task, after a stop,
+// the path's last error dying out: until every function is inside half the holding tolerance, at
+// most kHoldSettleLimit s), hold (the firmware holding a pose from then on: after the task, after a stop,
 // at start-up) and stop (the safe state after a fault:
 // the centred valves' creep from the pose last asked for).
 struct PhaseErrors {
@@ -76,7 +76,8 @@ struct PhaseErrors {
 };
 // The holding tolerance the run's verdict holds every hold to (docs/control.md, "Holding still"):
 // |q_a - q_d| of each cylinder within 2.5 mm, the swing within 2.5 mrad, once the hold has settled
-// (every function inside it once).
+// (every function inside half of it once: a hold that merely entered the tolerance on its way in
+// is still settling).
 inline constexpr double kHoldingTolerance[4] = {2.5e-3, 2.5e-3, 2.5e-3, 2.5e-3};
 // s from the start of a hold to the start of its judgement at the latest: the hold's pose is the
 // path's last point, and the error the path ended with (up to 14 mm under PID on the clay slope)

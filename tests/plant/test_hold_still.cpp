@@ -48,11 +48,11 @@ HoldCount count_hold(const std::string& law, double duration) {
     if (node.mode() != safety::Mode::hold || !node.trajectory_finished()) return;
     const double t = plant.state().time;
     if (hold_start < 0) hold_start = t;
-    // The path's last error dying out: the hold is judged once every function was inside the tolerance.
+    // The path's last error dying out: the hold is judged once every function was inside half the tolerance.
     if (!settled) {
       bool inside = true;
       for (int j = 0; j < 4; ++j)
-        inside = inside && std::abs(plant.state().q_a[j] - node.q_desired()[j]) <= sim::kHoldingTolerance[j];
+        inside = inside && std::abs(plant.state().q_a[j] - node.q_desired()[j]) <= 0.5 * sim::kHoldingTolerance[j];
       settled = inside || t - hold_start >= sim::kHoldSettleLimit;
       if (!settled) return;
     }
@@ -92,7 +92,7 @@ TEST_CASE("firmware/holding still: 400 s of the dig's hold under every law on de
     int corrections = 0;
     for (int j = 1; j < 4; ++j) {
       const FunctionHold& f = h.f[j];
-      MESSAGE(law << " " << kActiveNames[j] << ": " << f.corrections << " corrections, worst " << f.worst * 1e3
+      MESSAGE(law << " " << std::string(kActiveNames[j]) << ": " << f.corrections << " corrections, worst " << f.worst * 1e3
                   << " mm (after a correction " << f.worst_after_correction * 1e3 << " mm), " << f.excursions
                   << " excursions; run's hold max " << h.run.hold.max_error[j] * 1e3 << " mm");
       corrections += f.corrections;
