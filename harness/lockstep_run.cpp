@@ -254,6 +254,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   PhaseAccumulator settle_acc, hold_acc, stop_acc;
   double hold_start = -1;  // s the current hold began (-1: not holding)
   bool settling = false;   // the current hold has not yet had every function inside the tolerance
+  double inside_since = -1;  // s since every function has been inside half of it (-1: not now)
   bool commanded = false;  // the firmware held or tracked a pose (the stop phase counts from then on)
   const auto wall_start = std::chrono::steady_clock::now();
   const std::int64_t progress_every = std::max<std::int64_t>(1, cycles / 10);
@@ -339,12 +340,15 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       if (mode == safety::Mode::hold) {
         if (hold_start < 0) {
           hold_start = s.time;
+          inside_since = -1;
           settling = true;
         }
         if (settling) {
           bool inside = true;
           for (int j = 0; j < 4; ++j) inside = inside && std::abs(s.q_a[j] - q_desired[j]) <= 0.5 * kHoldingTolerance[j];
-          settling = !inside && s.time - hold_start < kHoldSettleLimit;
+          if (!inside) inside_since = -1;
+          else if (inside_since < 0) inside_since = s.time;
+          settling = !(inside && s.time - inside_since >= kHoldSettleDwell) && s.time - hold_start < kHoldSettleLimit;
         }
         (settling ? settle_acc : hold_acc).add(s.time, scene.cycle, s.q_a, q_desired);
         commanded = true;

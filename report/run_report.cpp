@@ -119,8 +119,8 @@ void print_summary(const Summary& summary, std::ostream& out) {
     out << "\n";
   }
   if (any_hold) {
-    phase_rows(format("\nsettle error (a hold's start: until every function is inside half the tolerance, at most %.0f s)",
-                      kHoldSettleLimit).c_str(), &RunResult::settle);
+    phase_rows(format("\nsettle error (a hold's start: until every function stayed inside half the tolerance for %.1f s, at most %.0f s)",
+                      kHoldSettleDwell, kHoldSettleLimit).c_str(), &RunResult::settle);
     out << "  settling time (s)                  ";
     for (const RunResult& r : summary.runs) out << format("| %-25.2f", r.settle.seconds);
     out << "\n";

@@ -44,16 +44,20 @@ HoldCount count_hold(const std::string& law, double duration) {
   o.duration = duration;
   double hold_start = -1;
   bool settled = false;
+  double inside_since = -1;
   o.observer = [&](std::int64_t, const plant::Plant& plant, const app::FirmwareNode& node) {
     if (node.mode() != safety::Mode::hold || !node.trajectory_finished()) return;
     const double t = plant.state().time;
     if (hold_start < 0) hold_start = t;
-    // The path's last error dying out: the hold is judged once every function was inside half the tolerance.
+    // The path's last error dying out: the hold is judged once every function stayed inside half the
+    // tolerance for the dwell (the run's rule, harness/lockstep_run.hpp).
     if (!settled) {
       bool inside = true;
       for (int j = 0; j < 4; ++j)
         inside = inside && std::abs(plant.state().q_a[j] - node.q_desired()[j]) <= 0.5 * sim::kHoldingTolerance[j];
-      settled = inside || t - hold_start >= sim::kHoldSettleLimit;
+      if (!inside) inside_since = -1;
+      else if (inside_since < 0) inside_since = t;
+      settled = (inside && t - inside_since >= sim::kHoldSettleDwell) || t - hold_start >= sim::kHoldSettleLimit;
       if (!settled) return;
     }
     h.hold_seconds += b.scene.cycle;
