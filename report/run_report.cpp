@@ -88,9 +88,10 @@ void print_summary(const Summary& summary, std::ostream& out) {
     out << "\n";
   }
   bool any_hold = false, any_stop = false;
+  // Only after a task began: a run that never tracked held no pose it was given (its figures are n/a).
   for (const RunResult& r : summary.runs) {
-    any_hold = any_hold || r.hold.samples > 0 || r.settle.samples > 0;
-    any_stop = any_stop || r.stop.samples > 0;
+    any_hold = any_hold || (r.tracking_samples > 0 && (r.hold.samples > 0 || r.settle.samples > 0));
+    any_stop = any_stop || (r.tracking_samples > 0 && r.stop.samples > 0);
   }
   // The other phases: the hold (after the task, after a stop, at start-up) against the holding
   // tolerance the verdict applies, and the safe state's creep.
@@ -102,7 +103,7 @@ void print_summary(const Summary& summary, std::ostream& out) {
       out << format("  %-7s (%-3s)                     ", kJoints[j], kUnits[j]);
       for (const RunResult& r : summary.runs) {
         const PhaseErrors& p = r.*phase;
-        out << (p.samples > 0 ? format("| %10.3e %10.3e    ", p.rms_error[j], p.max_error[j])
+        out << (p.samples > 0 && r.tracking_samples > 0 ? format("| %10.3e %10.3e    ", p.rms_error[j], p.max_error[j])
                               : format("| %10s %10s    ", "n/a", "n/a"));
       }
       out << "\n";
