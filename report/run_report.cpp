@@ -39,6 +39,16 @@ nlohmann::json timing_json(const Timing& t) {
   return {{"median", t.median_us}, {"p99", t.p99_us}, {"max", t.max_us}, {"count", t.count}};
 }
 
+// One phase's figures (null when the run never was in it).
+nlohmann::json phase_json(const PhaseErrors& p) {
+  if (p.samples == 0) return nullptr;
+  nlohmann::json excursions;
+  for (int i = 0; i < 4; ++i) excursions[kJoints[i]] = p.excursions[i];
+  return {{"seconds", p.seconds}, {"samples", p.samples}, {"rms_error", per_joint(p.rms_error)},
+          {"max_error", per_joint(p.max_error)}, {"worst_time", per_joint(p.worst_time)},
+          {"excursions", excursions}};
+}
+
 }  // namespace
 
 nlohmann::json tracked_per_joint(const RunResult& r, const double (&v)[4]) {
@@ -77,6 +87,46 @@ void print_summary(const Summary& summary, std::ostream& out) {
                                      : format("| %10s %10s    ", "n/a", "n/a"));
     out << "\n";
   }
+  bool any_hold = false, any_stop = false;
+  // Only after a task began: a run that never tracked held no pose it was given (its figures are n/a).
+  for (const RunResult& r : summary.runs) {
+    any_hold = any_hold || (r.tracking_samples > 0 && (r.hold.samples > 0 || r.settle.samples > 0));
+    any_stop = any_stop || (r.tracking_samples > 0 && r.stop.samples > 0);
+  }
+  // The other phases: the hold (after the task, after a stop, at start-up) against the holding
+  // tolerance the verdict applies, and the safe state's creep.
+  auto phase_rows = [&](const char* title, PhaseErrors RunResult::*phase) {
+    out << title;
+    for (const RunResult& r : summary.runs) out << format("| %-10s RMS      max     ", r.controller.c_str());
+    out << "\n";
+    for (int j = 0; j < 4; ++j) {
+      out << format("  %-7s (%-3s)                     ", kJoints[j], kUnits[j]);
+      for (const RunResult& r : summary.runs) {
+        const PhaseErrors& p = r.*phase;
+        out << (p.samples > 0 && r.tracking_samples > 0 ? format("| %10.3e %10.3e    ", p.rms_error[j], p.max_error[j])
+                              : format("| %10s %10s    ", "n/a", "n/a"));
+      }
+      out << "\n";
+    }
+  };
+  if (any_hold) {
+    phase_rows(format("\nhold error (holding a pose once settled; tolerance %.1f mm, %.1f mrad swing)",
+                      kHoldingTolerance[1] * 1e3, kHoldingTolerance[0] * 1e3).c_str(), &RunResult::hold);
+    out << "  excursions past it (boom/arm/bucket)";
+    for (const RunResult& r : summary.runs)
+      out << format("| %-25s", format("%llu / %llu / %llu", static_cast<unsigned long long>(r.hold.excursions[1]),
+                                       static_cast<unsigned long long>(r.hold.excursions[2]),
+                                       static_cast<unsigned long long>(r.hold.excursions[3])).c_str());
+    out << "\n";
+  }
+  if (any_hold) {
+    phase_rows(format("\nsettle error (a hold's start: until every function stayed inside half the tolerance for %.1f s, at most %.0f s)",
+                      kHoldSettleDwell, kHoldSettleLimit).c_str(), &RunResult::settle);
+    out << "  settling time (s)                  ";
+    for (const RunResult& r : summary.runs) out << format("| %-25.2f", r.settle.seconds);
+    out << "\n";
+  }
+  if (any_stop) phase_rows("\nstop error (the safe state: valves centred)", &RunResult::stop);
   print_cycles(summary, out);
   out << "\nsoil estimates at the end (true value)\n";
   for (int i = 0; i < 6; ++i) {
@@ -182,6 +232,15 @@ nlohmann::json to_json(const Summary& summary) {
     run["max_error"] = tracked_per_joint(r, r.max_error);
     run["tracking"] = {{"rms_error", tracked_per_joint(r, r.measured_rms_error)}, {"max_error", tracked_per_joint(r, r.measured_max_error)}};
     run["tracking_samples"] = r.tracking_samples;
+    // Every phase (the figures above are the tracking phase's): tracking, hold, stop; and the
+    // tolerance the verdict holds the hold to.
+    run["phases"] = {{"tracking", {{"samples", r.tracking_samples}, {"rms_error", tracked_per_joint(r, r.rms_error)},
+                                   {"max_error", tracked_per_joint(r, r.max_error)}}},
+                     {"settle", phase_json(r.settle)},
+                     {"hold", phase_json(r.hold)},
+                     {"stop", phase_json(r.stop)}};
+    run["holding_tolerance"] = per_joint(kHoldingTolerance);
+    run["hold_settle_limit_seconds"] = kHoldSettleLimit;
     nlohmann::json theta_hat, theta_true;
     for (int i = 0; i < 6; ++i) {
       theta_hat[kTheta[i]] = r.theta_hat[i];

@@ -48,8 +48,15 @@ class ActuationStage {
   // delivered-effort model of the last command (efforts_sent: the efforts the bus carried, none when
   // nothing was commanded yet or the valves were centred).
   AppliedEffort applied(const ChamberPressures& p, const Vec4& velocity, const Vec4* efforts_sent, std::uint8_t law_saturated) const;
-  // What the stage could not deliver last cycle (a clamped lead, a fully open valve), bit j.
-  std::uint8_t limited() const { return valves_interface_ ? valve_stage_.last().limited : lag_.clamped(); }
+  // What the stage did not deliver last cycle (a clamped lead, a fully open valve, a valve centred in
+  // position while the machine holds), bit j: the laws' integrators and updates hold there. Without
+  // the last, a PID integral winds up against the closed valve and the cylinder's dry friction while
+  // the load sits inside the hold window and throws the load past the pose when the valve reopens
+  // (stick-slip hunting: docs/control.md, "Holding still").
+  std::uint8_t limited() const {
+    return valves_interface_ ? static_cast<std::uint8_t>(valve_stage_.last().limited | valve_stage_.in_position())
+                             : lag_.clamped();
+  }
   // What the flow plausibility monitor measures: positions, the oil columns' compression F / K_h
   // (none without pressures or valves) and the functions at a relief.
   safety::FlowMeasurement flow_measurement(const Vec4& q, const ChamberPressures& p) const;

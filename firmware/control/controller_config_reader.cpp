@@ -77,6 +77,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
             "flow feedforward qd_d - position_gain e: the valve stage's own position correction (default: 1 / (5 T_f))");
   v.numbers("hold_window", c.valves.hold_window, {0, 0.1}, "",
             "holding a pose: |e| (rad swing, m) inside which a function's valve stays centred");
+  v.number("hold_filter_time", c.valves.hold_filter_time, {0, 10}, "s",
+           "holding a pose: the low-pass on the error the in-position judgement reads (0: none; docs/control.md)");
   v.finish();
   SectionReader pl = r.section("plausibility", "commanded against measured velocity per function, valve interface (docs/safety.md)");
   pl.flag("enabled", c.plausibility.enabled, "the monitor runs (a fault, emergency stop, when a function moves unlike its command)");

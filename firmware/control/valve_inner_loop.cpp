@@ -32,12 +32,14 @@ ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSetti
       settings_(settings),
       spool_lead_(settings.spool_lag_target > 0 ? model.hydraulics.valve_time_constant : 0.0,
                   settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()),
+      hold_alpha_(settings.hold_filter_time > 0 ? 1.0 - std::exp(-period / settings.hold_filter_time) : 1.0),
       period_(period),
       level_alpha_(1.0 - std::exp(-period / (5 * settings.force_time_constant))) {}
 
 void ValveInnerLoop::reset() {
   spool_lead_.reset(Vec4::Zero());
   in_position_ = 0;
+  hold_error_.setZero();
   force_integral_.setZero();
   level_primed_ = false;
   command_ = ValveCommand{};
@@ -46,13 +48,15 @@ void ValveInnerLoop::reset() {
 void ValveInnerLoop::set_holding(bool holding, const Vec4& error) {
   if (!holding) {
     in_position_ = 0;
+    hold_error_ = error;
     return;
   }
+  hold_error_ += hold_alpha_ * (error - hold_error_);
   for (int i = 0; i < kNumActive; ++i) {
     const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
-    const double e = std::abs(error[i]);
+    const double e = std::abs(hold_error_[i]);
     if (e < settings_.hold_window[i]) in_position_ |= bit;
-    else if (e > 2 * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
+    else if (e > kHoldReentry * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
   }
 }
 
