@@ -420,8 +420,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
     // The emergency stop's figures (the solenoids' closing, the brake) for a fault that takes it at
     // once; a controlled stop escalated later is judged as the controlled stop it began as.
     const bool emergency = safety::stop_of(static_cast<safety::FirmwareFault>(result.first_fault_code)) == safety::StopKind::emergency;
-    result.stop = judge->judge(result.first_fault_detected_time, result.first_safe_stop_time, scene.cycle, emergency);
-    if (!result.stop->judged) result.stop.reset();
+    result.stop_judgement = judge->judge(result.first_fault_detected_time, result.first_safe_stop_time, scene.cycle, emergency);
+    if (!result.stop_judgement->judged) result.stop_judgement.reset();
   }
   plant_node.publish_counters();
   if (publisher) {

@@ -154,7 +154,7 @@ struct RunRecord {
   std::optional<TargetFigures> target;
   // A run with a fault whose stop was taken: the stop judged on the plant's truth against R1-R3
   // (harness/stop_judge.hpp; docs/safety.md, "The stop requirement").
-  std::optional<StopJudgement> stop;
+  std::optional<StopJudgement> stop_judgement;
 };
 
 // One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.

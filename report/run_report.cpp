@@ -267,7 +267,7 @@ nlohmann::json to_json(const Summary& summary) {
     run["task_finished"] = r.task_finished;
     if (r.task_finished) run["task_finish_time"] = r.task_finish_time;
     if (r.target) run["target"] = target_json(*r.target);
-    if (r.stop) run["stop"] = stop_json(*r.stop);
+    if (r.stop_judgement) run["stop"] = stop_json(*r.stop_judgement);
     nlohmann::json cycles = nlohmann::json::array();
     for (const CycleRecord& k : r.cycles) {
       nlohmann::json theta;

@@ -87,7 +87,7 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
   // emergency stop was sent.
   o["machine_at_rest_time"] = r.machine_at_rest_time >= 0 ? nlohmann::json(r.machine_at_rest_time) : nlohmann::json(nullptr);
   o["estop"] = r.estop;
-  if (r.stop) o["stop"] = stop_json(*r.stop);
+  if (r.stop_judgement) o["stop"] = stop_json(*r.stop_judgement);
   std::string why;
   if (r.failure.rfind("plant stopped", 0) == 0) {
     why = r.failure;
@@ -101,8 +101,8 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
     if (late > 1e-9)
       why = "the safe state " + std::to_string(late * 1e3) + " ms later than allowed after detection (the watchdog time" +
             (allowed > watchdog ? " and the deceleration along the path)" : ")");
-    else if (r.stop && !r.stop->meets_r3) why = "the stop misses R3: " + r.stop->why;
-    else if (!r.stop && r.machine_at_rest_time < 0) why = "the firmware stopped but the machine still moved at the run's end";
+    else if (r.stop_judgement && !r.stop_judgement->meets_r3) why = "the stop misses R3: " + r.stop_judgement->why;
+    else if (!r.stop_judgement && r.machine_at_rest_time < 0) why = "the firmware stopped but the machine still moved at the run's end";
   } else if (r.tracking_samples == 0) {
     why = r.failure;
   } else {

@@ -41,6 +41,17 @@ int cycle(SpoolMonitor& m, const Vec4& measured, const Vec4& command) {
   return found;
 }
 
+// Settled on `command` through a healthy valve, then the spool read at `stuck` while the command
+// stays: the cycles until the monitor names a function (-1: not within 100).
+int cycles_to_find(SpoolMonitor& m, const Vec4& command, const Vec4& stuck) {
+  HealthyValve v;
+  for (int k = 0; k < 300; ++k)
+    if (cycle(m, v.step(command), command) >= 0) return -2;  // a healthy valve never disagrees
+  for (int k = 0; k < 100; ++k)
+    if (cycle(m, stuck, command) >= 0) return k;
+  return -1;
+}
+
 // A healthy valve on the bus: the set of cycle k shows the spool after the command of cycle k - 1.
 int healthy_cycle(SpoolMonitor& m, HealthyValve& v, Vec4& last_command, const Vec4& command) {
   const int found = cycle(m, v.step(last_command), command);
@@ -99,33 +110,18 @@ TEST_CASE("firmware/spool monitor: a spool stuck open as its command goes to neu
   }
   SUBCASE("runaway: the spool opens fully against a command of 0.3") {
     SpoolMonitor m(s, kTau, kPeriod);
-    HealthyValve v;
-    const Vec4 c(0, 0, 0.3, 0);
-    for (int k = 0; k < 300; ++k) REQUIRE(cycle(m, v.step(c), c) < 0);
-    int found_at = -1;
-    for (int k = 0; k < 100 && found_at < 0; ++k)
-      if (cycle(m, Vec4(0, 0, 1.0, 0), c) >= 0) found_at = k;
-    CHECK(found_at == s.debounce - 1);
+    CHECK(cycles_to_find(m, Vec4(0, 0, 0.3, 0), Vec4(0, 0, 1.0, 0)) == s.debounce - 1);
     CHECK(m.failed_function() == 2);
     CHECK(m.failed_test() == SpoolTest::further);
   }
   SUBCASE("reversed: the spool at -0.2 while commanded +0.6") {
     SpoolMonitor m(s, kTau, kPeriod);
-    HealthyValve v;
-    const Vec4 c(0.6, 0, 0, 0);
-    for (int k = 0; k < 300; ++k) REQUIRE(cycle(m, v.step(c), c) < 0);
-    int found_at = -1;
-    for (int k = 0; k < 100 && found_at < 0; ++k)
-      if (cycle(m, Vec4(-0.2, 0, 0, 0), c) >= 0) found_at = k;
-    CHECK(found_at == s.debounce - 1);
+    CHECK(cycles_to_find(m, Vec4(0.6, 0, 0, 0), Vec4(-0.2, 0, 0, 0)) == s.debounce - 1);
     CHECK(m.failed_test() == SpoolTest::against);
   }
   SUBCASE("off neutral with neutral commanded: a spool at 0.08 of its stroke") {
     SpoolMonitor m(s, kTau, kPeriod);
-    int found_at = -1;
-    for (int k = 0; k < 100 && found_at < 0; ++k)
-      if (cycle(m, Vec4(0, 0, 0, 0.08), Vec4::Zero()) >= 0) found_at = k;
-    CHECK(found_at == s.debounce - 1);
+    CHECK(cycles_to_find(m, Vec4::Zero(), Vec4(0, 0, 0, 0.08)) == s.debounce - 1);
     CHECK(m.failed_test() == SpoolTest::neutral);
   }
   SUBCASE("one clean set breaks the debounce; a missing set does not") {

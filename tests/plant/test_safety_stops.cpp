@@ -83,8 +83,8 @@ TEST_CASE("firmware/safety: a spool stuck on any function, both ways, at opening
         INFO(name << ": " << r.failure);
         ++cases;
         REQUIRE(r.first_safe_stop_time >= 0);
-        REQUIRE(r.stop);
-        const sim::StopJudgement& s = *r.stop;
+        REQUIRE(r.stop_judgement);
+        const sim::StopJudgement& s = *r.stop_judgement;
         CHECK(r.estop);
         // R1: from the onset (or the stick, when the command already disagreed then).
         REQUIRE(onset >= 0);
