@@ -62,7 +62,7 @@ StopJudgement StopJudge::judge(double detected, double safe_state, double period
       ++s;
       peak = std::max(peak, std::abs(samples_[s].qd[f]));
     }
-    j.speed_at_detection[f] = peak;
+    j.peak_speed[f] = peak;
     j.travel[f] = std::abs(samples_[s].q[f] - samples_[d].q[f]);
     // The first overshoot: how far the function ran on after the closing valve had closed (the
     // stop frame reaches the machine a cycle after detection), the oil column's compression.

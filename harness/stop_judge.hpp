@@ -36,7 +36,7 @@ struct StopJudgement {
   bool judged = false;              // a stop was taken after a fault's start and recorded
   double detected_after_s = -1;     // R1: from the fault's start
   double outputs_after_s = -1;      // R2: the safe state's outputs after detection
-  std::array<double, 4> speed_at_detection{};  // m/s (rad/s): the peak from detection to the first stop
+  std::array<double, 4> peak_speed{};  // m/s (rad/s), from detection to the first stop
   std::array<double, 4> travel{};              // to the function's first stop after detection
   std::array<double, 4> first_overshoot{};     // run on after the closing valve closed, to that stop
   // peak speed x (closing time + 0.1 s) + first overshoot; swing (-1): stated, not bounded

@@ -199,7 +199,7 @@ nlohmann::json stop_json(const StopJudgement& s) {
     exempt.push_back({{"function", kActiveNames[static_cast<std::size_t>(e.function)]}, {"reason", e.reason}, {"travel", e.travel}});
   nlohmann::json j = {{"detected_after_s", s.detected_after_s},
                       {"outputs_after_s", s.outputs_after_s},
-                      {"peak_speed_after_detection", four(s.speed_at_detection)},
+                      {"peak_speed_after_detection", four(s.peak_speed)},
                       {"travel_to_first_stop", four(s.travel)},
                       {"travel_allowed", four(s.travel_allowed)},
                       {"first_overshoot", four(s.first_overshoot)},
