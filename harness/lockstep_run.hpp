@@ -89,7 +89,7 @@ inline constexpr double kHoldSettleLimit = 10.0;
 // half the swing's 0.4 Hz ringing period, so a ring through zero is not taken for a settled hold.
 inline constexpr double kHoldSettleDwell = 1.5;
 
-// "At rest" (issue 32, docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
+// "At rest" (docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
 inline constexpr double kRestCylinderRate = 1e-3;  // m/s
 inline constexpr double kRestSwingRate = 1e-3;     // rad/s
 inline constexpr double kRestSettle = 1.0;          // s at rest that ends a run past its scene (rest_horizon)

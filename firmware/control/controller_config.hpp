@@ -226,7 +226,7 @@ inline constexpr double kFrozenSpeedShare = 0.02;
 inline constexpr double kValveMachineReach[4] = {0.0078, 0.0074, 0.0191, 0.0104};
 // The default tracking-error limit on the valve interface, in multiples of that reach: well clear of
 // every fault-free run (the worst is a fifth of it by construction), and far closer than the fixed
-// 0.1 rad / 0.2 m (10-27x the reach) that let a stuck spool run 1.45 s (issue 32).
+// 0.1 rad / 0.2 m (10-27x the reach) that let a stuck spool run 1.45 s.
 inline constexpr double kTrackingLimitMultiple = 5;
 // The default tracking-error limit for a command interface (ControllerConfig::tracking_error_limit).
 Vec4 default_tracking_error_limit(CommandInterface interface);

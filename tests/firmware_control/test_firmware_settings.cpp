@@ -151,7 +151,7 @@ TEST_CASE("firmware/settings name the file when it is missing or not YAML") {
 
 namespace {
 
-// Issue 16's scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
+// A saturating scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
 std::string fast_swing_scene(const std::string& efforts, const std::string& duration = "3") {
   std::string task = exc::control::sim::kFastSwingTask;
   const std::string type = "  type: joint_waypoints\n";
