@@ -31,21 +31,28 @@ std::string format(const char* fmt, double a, double b) {
 // dry friction holds at a turning point, for a cycle or more at nearly every reversal once slow; or a
 // creep too slow to count) belongs to neither side and ends no half period. Its peak is the largest
 // |velocity| in it. A ring ends once the function has been below the floor for kRingRest: motion after
-// that is a new ring (excited afresh, e.g. by a draining bucket reaching its end stop), fitted apart.
-// Each ring is fitted as A exp(-t / tau) from its largest peak on (a ring decays from its crest; the
-// peaks before it are the ring building up).
+// that is a new ring (excited afresh, e.g. by a draining bucket reaching its end stop), judged apart.
+// A ring is judged from its crest (its largest peak; the peaks before it are the ring building up).
+// One that has ended decayed from its crest A_c at t_c to the floor by its last sample above it, t_e:
+// its envelope's time constant is (t_e - t_c) / ln(A_c / floor), the exponential that takes as long
+// (a ring shaken up again before it rested, or cut short by an end stop, is not one exponential, and a
+// fit of one to its peaks can find no decay in motion that has died out). One still ringing at the
+// record's end: A exp(-t / tau) fitted by least squares to its peaks from the crest on.
 template <class Samples>
 double ring_envelope_tau(const Samples& samples, std::size_t from, int f) {
   double peak_t[kMaxPeaks], peak_a[kMaxPeaks];
   int peaks = 0;
   double worst = 0;
-  // The ring of peaks [0, peaks): its tau from the crest on, folded into the worst.
-  const auto fit = [&] {
+  // The ring of peaks [0, peaks), its last sample above the floor at `last`: its envelope's tau,
+  // folded into the worst.
+  const auto judge_ring = [&](bool ended, double last) {
     int crest = 0;
     for (int p = 1; p < peaks; ++p)
       if (peak_a[p] > peak_a[crest]) crest = p;
     const int used = peaks - crest;
-    if (used >= kRingPeaks) {
+    if (used >= kRingPeaks && ended) {
+      worst = std::max(worst, (last - peak_t[crest]) / std::log(peak_a[crest] / kRingFloor));
+    } else if (used >= kRingPeaks) {
       double pt = 0, pl = 0, ptt = 0, ptl = 0;
       for (int p = crest; p < peaks; ++p) {
         const double l = std::log(peak_a[p]);
@@ -74,7 +81,7 @@ double ring_envelope_tau(const Samples& samples, std::size_t from, int f) {
       peak_a[peaks] = half_peak;
       ++peaks;
     }
-    if (new_ring) fit();
+    if (new_ring) judge_ring(true, last_above);
     if (sign != side || new_ring) {
       side = sign;
       half_peak = 0;
@@ -86,13 +93,15 @@ double ring_envelope_tau(const Samples& samples, std::size_t from, int f) {
     last_above = t;
   }
   // The last half period counts once the velocity has come back to the floor before the record's end
-  // (a half period cut by the record's end may not have reached its peak).
-  if (side != 0 && n > 0 && std::abs(samples[n - 1].qd[f]) <= kRingFloor && peaks < kMaxPeaks) {
+  // (a half period cut by the record's end may not have reached its peak); the last ring has ended
+  // when the record ends kRingRest after its last sample above the floor.
+  const bool back = n > 0 && std::abs(samples[n - 1].qd[f]) <= kRingFloor;
+  if (side != 0 && back && peaks < kMaxPeaks) {
     peak_t[peaks] = half_time;
     peak_a[peaks] = half_peak;
     ++peaks;
   }
-  fit();
+  judge_ring(back && samples[n - 1].t - last_above >= kRingRest, last_above);
   return worst;
 }
 

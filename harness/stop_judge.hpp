@@ -6,7 +6,8 @@
 // position from 1.5 s after the onset over at least 2 s, so a ring's periods average out),
 // the envelope time constant of each remaining ring (half periods told by the velocity's side of
 // zero above the rest floor, so a function its friction holds for a cycle at a turning point still
-// reverses; a ring ends after 1 s at rest), and the swing brake's engagement. Motion a port
+// reverses; a ring ends after 1 s at rest; one that has ended is judged from its crest to its rest, one
+// still ringing by a fit to its peaks), and the swing brake's engagement. Motion a port
 // without a holding valve lets gravity drive is exempt, declared with its travel. The plant's truth
 // is recorded into a ring sized before the loop, so the lockstep loop allocates nothing.
 #include <array>
