@@ -12,6 +12,10 @@ constexpr double kRestRate = 1e-3;       // m/s, rad/s: "at rest" (docs/safety.m
 // below it is at rest by the safety concept's measure).
 constexpr double kRingFloor = kRestRate;
 constexpr int kRingPeaks = 3;            // peaks the envelope's fit needs
+// s below the floor that end a ring: "at rest" for as long as a stopped run must be at rest before it
+// ends (harness/lockstep_run.hpp's kRestSettle), longer than any half period of the machine's rings
+// (1.3-5 Hz) and than the stick at a turning point.
+constexpr double kRingRest = 1.0;
 constexpr int kMaxPeaks = 512;           // half periods fitted at most (a 2.5 Hz ring over 100 s)
 const char* const kFunctions[] = {"swing", "boom", "arm", "bucket"};
 
@@ -19,6 +23,86 @@ std::string format(const char* fmt, double a, double b) {
   char buf[200];
   std::snprintf(buf, sizeof buf, fmt, a, b);
   return buf;
+}
+
+// The slowest envelope time constant of the rings in samples [from, end) of function f (0: no ring
+// with kRingPeaks peaks above the floor; 1e9: one that does not decay). A half period is the velocity
+// on one side of zero, judged by its samples above the floor: a sample at or below it (a function its
+// dry friction holds at a turning point, for a cycle or more at nearly every reversal once slow; or a
+// creep too slow to count) belongs to neither side and ends no half period. Its peak is the largest
+// |velocity| in it. A ring ends once the function has been below the floor for kRingRest: motion after
+// that is a new ring (excited afresh, e.g. by a draining bucket reaching its end stop), judged apart.
+// A ring is judged from its crest (its largest peak; the peaks before it are the ring building up).
+// One that has ended decayed from its crest A_c at t_c to the floor by its last sample above it, t_e:
+// its envelope's time constant is (t_e - t_c) / ln(A_c / floor), the exponential that takes as long
+// (a ring shaken up again before it rested, or cut short by an end stop, is not one exponential, and a
+// fit of one to its peaks can find no decay in motion that has died out). One still ringing at the
+// record's end: A exp(-t / tau) fitted by least squares to its peaks from the crest on.
+template <class Samples>
+double ring_envelope_tau(const Samples& samples, std::size_t from, int f) {
+  double peak_t[kMaxPeaks], peak_a[kMaxPeaks];
+  int peaks = 0;
+  double worst = 0;
+  // The ring of peaks [0, peaks), its last sample above the floor at `last`: its envelope's tau,
+  // folded into the worst.
+  const auto judge_ring = [&](bool ended, double last) {
+    int crest = 0;
+    for (int p = 1; p < peaks; ++p)
+      if (peak_a[p] > peak_a[crest]) crest = p;
+    const int used = peaks - crest;
+    if (used >= kRingPeaks && ended) {
+      worst = std::max(worst, (last - peak_t[crest]) / std::log(peak_a[crest] / kRingFloor));
+    } else if (used >= kRingPeaks) {
+      double pt = 0, pl = 0, ptt = 0, ptl = 0;
+      for (int p = crest; p < peaks; ++p) {
+        const double l = std::log(peak_a[p]);
+        pt += peak_t[p];
+        pl += l;
+        ptt += peak_t[p] * peak_t[p];
+        ptl += peak_t[p] * l;
+      }
+      const double den = used * ptt - pt * pt;
+      const double slope = den > 0 ? (used * ptl - pt * pl) / den : 0.0;
+      worst = std::max(worst, slope < 0 ? -1.0 / slope : 1e9);
+    }
+    peaks = 0;
+  };
+  int side = 0;  // the open half period's sign (0: none open)
+  double half_peak = 0, half_time = 0, last_above = -1e300;
+  const std::size_t n = samples.size();
+  for (std::size_t k = from; k < n; ++k) {
+    const double v = samples[k].qd[f];
+    const double t = samples[k].t;
+    if (std::abs(v) <= kRingFloor) continue;
+    const int sign = v > 0 ? 1 : -1;
+    const bool new_ring = t - last_above > kRingRest;
+    if (side != 0 && (sign != side || new_ring) && peaks < kMaxPeaks) {
+      peak_t[peaks] = half_time;  // the half period closed: the velocity came back through the floor
+      peak_a[peaks] = half_peak;
+      ++peaks;
+    }
+    if (new_ring) judge_ring(true, last_above);
+    if (sign != side || new_ring) {
+      side = sign;
+      half_peak = 0;
+    }
+    if (std::abs(v) > half_peak) {
+      half_peak = std::abs(v);
+      half_time = t;
+    }
+    last_above = t;
+  }
+  // The last half period counts once the velocity has come back to the floor before the record's end
+  // (a half period cut by the record's end may not have reached its peak); the last ring has ended
+  // when the record ends kRingRest after its last sample above the floor.
+  const bool back = n > 0 && std::abs(samples[n - 1].qd[f]) <= kRingFloor;
+  if (side != 0 && back && peaks < kMaxPeaks) {
+    peak_t[peaks] = half_time;
+    peak_a[peaks] = half_peak;
+    ++peaks;
+  }
+  judge_ring(back && samples[n - 1].t - last_above >= kRingRest, last_above);
+  return worst;
 }
 
 }  // namespace
@@ -86,41 +170,7 @@ StopJudgement StopJudge::judge(double detected, double safe_state, double period
     }
     const double den = m * stt - st * st;
     j.drift[f] = m > 1 && den > 0 ? (m * stq - st * sq) / den : 0.0;
-    // The ring's envelope: the velocity's peak in each half period after the first stop, from the
-    // largest on (a ring decays from its crest; the peaks before it are the ring building up),
-    // fitted as A exp(-t / tau). Peaks below "at rest" are no ring.
-    double peak_t[kMaxPeaks], peak_a[kMaxPeaks];
-    int peaks = 0, crest = 0;
-    double half_peak = 0, half_time = 0;
-    for (std::size_t k = s + 1; k < n && peaks < kMaxPeaks; ++k) {
-      const double v = samples_[k].qd[f];
-      if (std::abs(v) > half_peak) {
-        half_peak = std::abs(v);
-        half_time = samples_[k].t;
-      }
-      const bool reversal = k + 1 < n && samples_[k + 1].qd[f] * v < 0;
-      if (reversal || k + 1 == n) {
-        if (reversal && half_peak > kRingFloor) {
-          peak_t[peaks] = half_time;
-          peak_a[peaks] = half_peak;
-          if (half_peak > peak_a[crest]) crest = peaks;
-          ++peaks;
-        }
-        half_peak = 0;
-      }
-    }
-    double pt = 0, pl = 0, ptt = 0, ptl = 0;
-    const int used = peaks - crest;
-    for (int p = crest; p < peaks; ++p) {
-      const double l = std::log(peak_a[p]);
-      pt += peak_t[p];
-      pl += l;
-      ptt += peak_t[p] * peak_t[p];
-      ptl += peak_t[p] * l;
-    }
-    const double pden = used * ptt - pt * pt;
-    const double slope = used >= kRingPeaks && pden > 0 ? (used * ptl - pt * pl) / pden : 0.0;
-    j.ring_tau[f] = used < kRingPeaks ? 0.0 : slope < 0 ? -1.0 / slope : 1e9;
+    j.ring_tau[f] = ring_envelope_tau(samples_, s + 1, f);
   }
   for (std::size_t k = d; k < n; ++k)
     if (samples_[k].brake) {

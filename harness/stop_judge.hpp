@@ -4,7 +4,10 @@
 // detection, R3 per function the travel from detection to its first stop against its speed times the
 // closing valve's time plus 0.1 s plus the first overshoot, the net drift (the slope of a straight line fitted to its
 // position from 1.5 s after the onset over at least 2 s, so a ring's periods average out),
-// the remaining ring's envelope time constant, and the swing brake's engagement. Motion a port
+// the envelope time constant of each remaining ring (half periods told by the velocity's side of
+// zero above the rest floor, so a function its friction holds for a cycle at a turning point still
+// reverses; a ring ends after 1 s at rest; one that has ended is judged from its crest to its rest, one
+// still ringing by a fit to its peaks), and the swing brake's engagement. Motion a port
 // without a holding valve lets gravity drive is exempt, declared with its travel. The plant's truth
 // is recorded into a ring sized before the loop, so the lockstep loop allocates nothing.
 #include <array>
@@ -43,7 +46,7 @@ struct StopJudgement {
   std::array<double, 4> travel_allowed{};
   std::array<double, 4> drift{};               // R3: m/s (rad/s), the fit's slope
   double drift_span = 0;                       // s the fit covered
-  std::array<double, 4> ring_tau{};            // s, 0: no ring to fit
+  std::array<double, 4> ring_tau{};            // s, the slowest ring's (0: no ring to fit; 1e9: not decaying)
   double brake_after_s = -1;                   // swing brake engaged after detection (-1: never)
   std::vector<StopExemption> exempt;
   bool meets_r1 = false, meets_r2 = false, meets_r3 = false;
