@@ -20,6 +20,7 @@
 #include <iostream>
 #include <vector>
 
+#include "app/control_step.hpp"
 #include "app/firmware_node.hpp"
 #include "app/firmware_runner.hpp"
 #include "app/firmware_settings.hpp"
@@ -112,6 +113,15 @@ int main(int argc, char** argv) {
         return 2;
       }
       fc.controller.law = controller;
+    }
+    // The law built once before anything is written or the bus is opened: a law the scene's command
+    // interface cannot carry (--controller flow on an effort-actuated scene), or gains the law refuses,
+    // are bad input, named as the scene's errors are, whether or not the interface exists.
+    try {
+      exc::app::check_control_law(model, fc.controller);
+    } catch (const std::exception& e) {
+      std::cerr << "excavator-firmware: " << e.what() << " (" << scene_path << ")\n";
+      return 2;
     }
     fc.site_map = settings.terrain;
     fc.wait_for_start = wait_for_start;
