@@ -248,6 +248,9 @@ TEST_CASE("tools/excavator-firmware and excavator-plant check the scene before t
       // A law the scene's command interface cannot carry (paper_dig actuates efforts).
       {std::string(EXC_FIRMWARE_TOOL) + bus + " --scene " + scenes + "paper_dig.yaml --controller flow",
        "flow commands the valves' flow: it needs command_interface: valve"},
+      // A stuck spool on a machine without valves (paper_dig's actuators are force actuators).
+      {std::string(EXC_PLANT_TOOL) + bus + " --scene " + scenes + "paper_dig.yaml --stuck-spool boom",
+       "--stuck-spool needs the hydraulic machine"},
   };
   for (const Case& c : cases) {
     const Run r = run(c.command, dir);
