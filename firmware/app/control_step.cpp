@@ -28,6 +28,8 @@ std::unique_ptr<control::Controller> checked_controller(const Model& model, cons
 
 }  // namespace
 
+void check_control_law(const Model& model, const control::ControllerConfig& config) { checked_controller(model, config); }
+
 ControlStep::ControlStep(const Model& model, const FirmwareNodeConfig& config, safety::Supervisor& supervisor, LoopCounters& counters)
     : config_(config),
       supervisor_(supervisor),

@@ -25,6 +25,10 @@ struct DesiredMotion {
   Vec4 q = Vec4::Zero(), qd = Vec4::Zero(), qdd = Vec4::Zero();
 };
 
+// Builds the law as ControlStep does and drops it: a law the command interface cannot carry, or gains
+// the law refuses, are named before a program opens its bus (start-up code: allocates, throws).
+void check_control_law(const Model& model, const control::ControllerConfig& config);
+
 class ControlStep {
  public:
   // Builds the law (refused with std::invalid_argument when the command interface cannot carry it).

@@ -8,6 +8,7 @@
 #include "control/pump_pacing.hpp"
 #include "model/actuator_friction.hpp"
 #include "model/model.hpp"
+#include "model/plant_scene_keys.hpp"
 #include "model/scene_common_reader.hpp"
 #include "control/controller_config_reader.hpp"
 #include "control/controller_registry.hpp"
@@ -113,6 +114,9 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene, const S
   s.task = control::read_task(task, s.machine);
   top.others(kPlantSceneSections);
   top.finish();
+  // The plant's sections: their values are the plant's to read, their keys named here too, so a
+  // misspelt one is refused by the firmware as by the plant.
+  check_plant_scene_keys(scene);
   try {
     check_laws_build(s);
     check_task_efforts(s);

@@ -2,9 +2,9 @@
 // The firmware's own reading of a scene file: the sections a controller on a real machine is given
 // (its nominal machine, `controller:`, `task:`, the site's terrain height and the run's duration).
 // The simulated machine's sections (soil, actuators, integrator, sensors, initial state, checks)
-// belong to the plant, which reads them with its own loader; the firmware only checks that every
-// top-level key is a known section, so a typo is an error on both sides. Nothing here links plant
-// code. Start-up code: allocates, throws SettingsError naming file, line, column, field and range.
+// belong to the plant, which reads them with its own loader; the firmware checks that every
+// top-level key is a known section and every key of the plant's sections a known key
+// (model/plant_scene_keys.hpp), so a typo is an error on both sides. Nothing here links plant code. Start-up code: allocates, throws SettingsError naming file, line, column, field and range.
 #include <string>
 
 #include <yaml-cpp/yaml.h>

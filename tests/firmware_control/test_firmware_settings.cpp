@@ -144,6 +144,22 @@ TEST_CASE("firmware/settings derive the defaults a scene leaves out from the mac
               "controller.external_force.cutoff_hz", "15", "15 Hz must be below filters.acceleration_cutoff_hz = 15 Hz");
 }
 
+TEST_CASE("firmware/settings name a misspelt key in the plant's sections at its line, with the key it nearly spells, without reading their values") {
+  const std::string top = "name: x\nduration: 2\n";
+  check_error(top + "soil: {presett: loam}\n" + kTask, "soil.presett", "presett",
+              "unknown key; did you mean preset? allowed keys: preset, stiffness, damping, mass");
+  check_error(top + "integrator:\n  method: rk4\n  stepp: 0.0005\n" + kTask, "integrator.stepp", "stepp",
+              "unknown key; did you mean step?");
+  check_error(top + "sensors: {sead: 3}\n" + kTask, "sensors.sead", "sead", "unknown key; did you mean seed?");
+  check_error(top + "checks: {energy_tolerence: 1}\n" + kTask, "checks.energy_tolerence", "energy_tolerence",
+              "unknown key; did you mean energy_tolerance?");
+  check_error(top + "initial_state: {qa: [0, 2.4, 2.5, 1.9]}\n" + kTask, "initial_state.qa", "qa",
+              "unknown key; did you mean q_a?");
+  check_error(top + "actuators: hydraulic\n" + kTask, "actuators", "hydraulic", "must be a mapping");
+  // Their values are the plant's to check: a value out of the plant's range passes here.
+  CHECK_NOTHROW(read(top + "soil: {preset: no_such_soil}\nintegrator: {step: -1}\n" + kTask));
+}
+
 TEST_CASE("firmware/settings accept the plant's sections without reading them and refuse unknown ones") {
   const std::string plant_sections =
       "name: x\nduration: 2\nsoil: {preset: loam}\nactuators: {fidelity: limited, lag: 0.02}\n"

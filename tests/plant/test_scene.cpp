@@ -2,8 +2,12 @@
 // load.
 #include <doctest/doctest.h>
 
+#include <map>
+#include <set>
 #include <string>
 
+#include "model/plant_scene_keys.hpp"
+#include "model/scene_common.hpp"
 #include "plant_scenes.hpp"
 #include "settings_error_check.hpp"
 
@@ -111,6 +115,28 @@ TEST_CASE("plant/scene leaves the firmware's controller and task sections to the
   CHECK_FALSE(s.effective["controller"].IsDefined());
   CHECK_FALSE(s.effective["task"].IsDefined());
   CHECK(s.effective["integrator"]["method"].as<std::string>() == "semi_implicit_euler");
+}
+
+TEST_CASE("plant/the plant's scene reader declares exactly the shared list of its keys, by which the firmware names a misspelt one") {
+  // Every key the reader declares, section by section: the effective tree holds each key read (a
+  // default filled in when absent); soil's two branches (a preset or explicit K, B, M) read apart.
+  const std::string explicit_soil = "soil: {stiffness: [1, 1], damping: [1, 1], mass: [1, 1]}\n";
+  std::map<std::string, std::set<std::string>> read;
+  for (const std::string& yaml : {kBase, kBase + explicit_soil}) {
+    const Scene s = read_scene(settings::Document::parse(yaml, "ok.yaml"));
+    for (const std::string& section : kPlantSceneSections) {
+      REQUIRE_MESSAGE(s.effective[section].IsMap(), section);
+      for (const auto& kv : s.effective[section]) read[section].insert(kv.first.Scalar());
+    }
+  }
+  REQUIRE(plant_scene_keys().size() == kPlantSceneSections.size());
+  for (std::size_t i = 0; i < kPlantSceneSections.size(); ++i) {
+    const SceneSectionKeys& listed = plant_scene_keys()[i];
+    CAPTURE(listed.section);
+    CHECK(listed.section == kPlantSceneSections[i]);
+    CHECK(std::set<std::string>(listed.keys.begin(), listed.keys.end()) == read[listed.section]);
+    CHECK(listed.keys.size() == read[listed.section].size());  // none listed twice
+  }
 }
 
 TEST_CASE("plant/scene shipped scenes load and their initial states assemble") {

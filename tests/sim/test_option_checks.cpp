@@ -7,6 +7,7 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -135,6 +136,63 @@ TEST_CASE("tools/every program exits 2 with the reason on a bad command line: an
     INFO(e.err);
     CHECK(e.status == 2);
     CHECK(e.err.find(c.message) != std::string::npos);
+  }
+}
+
+TEST_CASE("tools/every program's --help names it and says in a sentence what it does, exit 0, and shows no code of its own") {
+  const std::string src = EXC_SOURCE_DIR, python = "/usr/bin/python3 ";
+  struct Case {
+    std::string command, name;
+  };
+  std::vector<Case> cases = {
+      {EXC_SIM_TOOL, "excavator-sim"},
+      {EXC_FIRMWARE_TOOL, "excavator-firmware"},
+      {EXC_PLANT_TOOL, "excavator-plant"},
+      {EXC_OPERATOR_TOOL, "excavator-operator"},
+      {EXC_LOG_TOOL, "excavator-log"},
+      {EXC_MODEL_TOOL, "excavator-model"},
+      {EXC_BENCH_TOOL, "excavator-bench"},
+      {EXC_LOOP_BENCH_TOOL, "excavator-loop-bench"},
+      {EXC_PLANT_BENCH_TOOL, "excavator-plant-bench"},
+      {EXC_PLANT_REPLAY_TOOL, "excavator-plant-replay"},
+      {std::string(EXC_PLOT_RUN_DIR) + "/plot-run", "plot-run"},
+      {src + "/tools/sweep/parallel-sweep", "parallel-sweep"},
+      {src + "/tools/sweep/sweep-scaling", "sweep-scaling"},
+      {python + src + "/tools/sweep/plot_sweep.py", "plot_sweep.py"},
+      {python + src + "/tools/sweep/plot_generalisation.py", "plot_generalisation.py"},
+      {python + src + "/tools/sweep/campaign_tables.py", "campaign_tables.py"},
+      {python + src + "/tools/excavator_bench/plot_bench.py", "plot_bench.py"},
+      {src + "/tools/report_memory_bench/report-memory-bench", "report-memory-bench"},
+      {src + "/tools/vcan_vm/vcan-vm", "vcan-vm"},
+      {src + "/tools/sanitizer-tests", "sanitizer-tests"},
+      {src + "/tools/install-deps", "install-deps"},
+  };
+#ifdef EXC_MODEL_BENCH_TOOL
+  cases.push_back({EXC_MODEL_BENCH_TOOL, "model-bench"});
+#endif
+  for (const Case& c : cases) {
+    INFO(c.command);
+    const Exit e = run(c.command + " --help", "help.txt");
+    CHECK(e.status == 0);
+    const std::string help = exc::test::read_text_file(fs::path(EXC_BINARY_DIR) / "tests" / "sim" /
+                                                       ("option_checks_" + std::to_string(getpid())) / "help.txt");
+    INFO(help);
+    CHECK(help.find(c.name) != std::string::npos);
+    // A sentence: a line of at least eight words that is no option's line and no usage line.
+    bool sentence = false;
+    std::istringstream lines(help);
+    for (std::string line; std::getline(lines, line);) {
+      const auto first = line.find_first_not_of(" #");
+      if (first == std::string::npos || line[first] == '-' || line.compare(first, 5, "usage") == 0 ||
+          line.compare(first, 5, "Usage") == 0)
+        continue;
+      std::istringstream words(line);
+      int n = 0;
+      for (std::string w; words >> w;) ++n;
+      sentence = sentence || n >= 8;
+    }
+    CHECK_MESSAGE(sentence, "no sentence saying what it does");
+    CHECK(help.find("set -") == std::string::npos);  // a script's help cut from its own lines, one too many
   }
 }
 

@@ -185,7 +185,7 @@ TEST_CASE("tools/excavator-firmware --print-config prints the firmware's section
   for (const std::string& k : keys) CHECK_MESSAGE(exc::settings::emit(f[k]) == exc::settings::emit(s[k]), k);
 }
 
-TEST_CASE("tools/excavator-plant --print-config checks the plant's sections that excavator-firmware --print-config leaves, and says so, and the help texts say what the programs do") {
+TEST_CASE("tools/excavator-firmware and excavator-plant --print-config name a misspelt key of the plant's sections with its file, line and the key it nearly spells (the firmware leaves their values to the plant and says so), and the help texts say what the programs do") {
   const fs::path dir = fresh_dir("plant_config");
   const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
   // A misspelt key in the plant's soil section.
@@ -194,17 +194,28 @@ TEST_CASE("tools/excavator-plant --print-config checks the plant's sections that
   REQUIRE(soil != std::string::npos);
   misspelt.replace(soil, 20, "soil: {presett: loam}");
   std::ofstream(dir / "misspelt.yaml") << misspelt;
-  const Run fw = run(std::string(EXC_FIRMWARE_TOOL) + " --print-config --scene misspelt.yaml", dir);
-  CHECK(fw.status == 0);  // the firmware does not read the plant's sections, and says so
-  CHECK(fw.err.find("the firmware's sections only; the plant's (soil") != std::string::npos);
-  CHECK(fw.err.find("excavator-plant --print-config --scene misspelt.yaml") != std::string::npos);
-  const Run plant = run(std::string(EXC_PLANT_TOOL) + " --print-config --scene misspelt.yaml", dir);
-  INFO(plant.err);
-  CHECK(plant.status == 2);
-  CHECK(plant.err.find("soil.presett: unknown key; did you mean preset?") != std::string::npos);
+  // Where it is, counted in the file's text.
+  const auto typo = misspelt.find("presett");
+  const std::string line = std::to_string(1 + std::count(misspelt.begin(), misspelt.begin() + static_cast<long>(typo), '\n'));
+  const std::string column = std::to_string(typo - misspelt.rfind('\n', typo));
+  const std::string expected = "misspelt.yaml:" + line + ":" + column + ": soil.presett: unknown key; did you mean preset?";
+  for (const char* tool : {EXC_FIRMWARE_TOOL, EXC_PLANT_TOOL}) {
+    const Run r = run(std::string(tool) + " --print-config --scene misspelt.yaml", dir);
+    INFO(tool, ": ", r.err);
+    CHECK(r.status == 2);
+    CHECK(r.out.empty());
+    CHECK(r.err.find(expected) != std::string::npos);
+  }
+  // The shipped scene: the firmware prints its sections and says the plant's values are the plant's to check.
+  const Run fw = run(std::string(EXC_FIRMWARE_TOOL) + " --print-config --scene " + dig, dir);
+  CHECK(fw.status == 0);
+  CHECK(fw.err.find("the plant's (soil") != std::string::npos);
+  CHECK(fw.err.find("checked for unknown keys only") != std::string::npos);
+  CHECK(fw.err.find("excavator-plant --print-config --scene " + dig) != std::string::npos);
   // The control: the shipped scene's plant sections, defaults filled in, as excavator-sim config prints them.
   const Run good = run(std::string(EXC_PLANT_TOOL) + " --print-config --scene " + dig, dir);
   REQUIRE_MESSAGE(good.status == 0, good.err);
+  CHECK(good.err.empty());
   const Run sim = run(std::string(EXC_SIM_TOOL) + " config " + dig, dir);
   const YAML::Node p = YAML::Load(good.out), s = YAML::Load(sim.out);
   for (const char* k : {"soil", "actuators", "sensors"}) CHECK_MESSAGE(exc::settings::emit(p[k]) == exc::settings::emit(s[k]), k);
@@ -216,4 +227,44 @@ TEST_CASE("tools/excavator-plant --print-config checks the plant's sections that
   const Run operator_help = run(std::string(EXC_OPERATOR_TOOL) + " --help", dir);
   CHECK(operator_help.out.find("sends one operator command") == std::string::npos);
   CHECK(operator_help.out.find("one every --period for keep-alive") != std::string::npos);
+}
+
+TEST_CASE("tools/excavator-firmware and excavator-plant check the scene before the bus: a bad scene on a CAN interface that cannot be opened is the scene's error, exit 2") {
+  const fs::path dir = fresh_dir("scene_before_bus");
+  const std::string scenes = std::string(EXC_SOURCE_DIR) + "/scenes/";
+  std::string misspelt = read_text_file(scenes + "dig.yaml");
+  const auto soil = misspelt.find("soil: {preset: loam}");
+  REQUIRE(soil != std::string::npos);
+  misspelt.replace(soil, 20, "soil: {presett: loam}");
+  std::ofstream(dir / "misspelt.yaml") << misspelt;
+  // No interface of this name exists (and on a kernel without CAN none can be opened at all).
+  const std::string bus = " --can exc-no-such-bus0 --startup-timeout 1";
+  struct Case {
+    std::string command, error;
+  };
+  const Case cases[] = {
+      {std::string(EXC_FIRMWARE_TOOL) + bus + " --scene misspelt.yaml", "soil.presett: unknown key; did you mean preset?"},
+      {std::string(EXC_PLANT_TOOL) + bus + " --scene misspelt.yaml", "soil.presett: unknown key; did you mean preset?"},
+      // A law the scene's command interface cannot carry (paper_dig actuates efforts).
+      {std::string(EXC_FIRMWARE_TOOL) + bus + " --scene " + scenes + "paper_dig.yaml --controller flow",
+       "flow commands the valves' flow: it needs command_interface: valve"},
+      // A stuck spool on a machine without valves (paper_dig's actuators are force actuators).
+      {std::string(EXC_PLANT_TOOL) + bus + " --scene " + scenes + "paper_dig.yaml --stuck-spool boom",
+       "--stuck-spool needs the hydraulic machine"},
+  };
+  for (const Case& c : cases) {
+    const Run r = run(c.command, dir);
+    INFO(c.command, "\n", r.err);
+    CHECK(r.status == 2);
+    CHECK(r.err.find(c.error) != std::string::npos);
+    CHECK(r.err.find("exc-no-such-bus0") == std::string::npos);
+  }
+  // The control: a good scene gets as far as the bus, and is refused there, naming it.
+  for (const char* tool : {EXC_FIRMWARE_TOOL, EXC_PLANT_TOOL}) {
+    const Run r = run(std::string(tool) + bus + " --scene " + scenes + "dig.yaml", dir);
+    INFO(tool, ": ", r.err);
+    CHECK(r.status != 0);
+    CHECK(r.status != 2);
+    CHECK(r.err.find("exc-no-such-bus0") != std::string::npos);
+  }
 }

@@ -20,6 +20,7 @@
 #include <iostream>
 #include <vector>
 
+#include "app/control_step.hpp"
 #include "app/firmware_node.hpp"
 #include "app/firmware_runner.hpp"
 #include "app/firmware_settings.hpp"
@@ -80,7 +81,8 @@ int main(int argc, char** argv) {
       ->check(exc::cli::number_in({0, 1}, ""));
   app.add_flag("--wait-for-start", wait_for_start, "hold until an operator's start (SUPERVISOR frame, excavator-operator start)");
   app.add_flag("--print-config", print_config,
-               "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit");
+               "print the firmware's sections of the scene as it reads them, every default filled in (YAML), and exit "
+               "(of the plant's sections only the keys are checked: a misspelt one is named)");
   app.add_option("--write-settings-blob", blob_path,
                  "write the settings blob the firmware's image runs the scene from (its nominal machine, controller, "
                  "task and run length, with --controller, --duration and --wait-for-start; docs/programs.md) to this "
@@ -95,11 +97,11 @@ int main(int argc, char** argv) {
     const exc::app::FirmwareSettings settings = exc::app::load_firmware_settings(scene_path);
     if (print_config) {
       std::cout << exc::settings::emit(settings.effective);
-      // The firmware links no plant code, so it reads none of the plant's sections: said, so that
-      // exit 0 is not taken for a check of the whole scene.
-      std::cerr << "excavator-firmware: the firmware's sections only; the plant's (" << plant_sections_in(scene_path)
-                << ") are read and checked by excavator-plant --print-config --scene " << scene_path
-                << " (or excavator-sim config " << scene_path << ")\n";
+      // The firmware links no plant code: of the plant's sections it checks the keys, not the values.
+      // Said, so that exit 0 is not taken for a check of the whole scene.
+      std::cerr << "excavator-firmware: the firmware's sections printed; the plant's (" << plant_sections_in(scene_path)
+                << ") checked for unknown keys only, their values read and checked by excavator-plant --print-config --scene "
+                << scene_path << " (or excavator-sim config " << scene_path << ")\n";
       return 0;
     }
     const exc::Model model = exc::build_model(settings.machine);
@@ -112,6 +114,15 @@ int main(int argc, char** argv) {
         return 2;
       }
       fc.controller.law = controller;
+    }
+    // The law built once before anything is written or the bus is opened: a law the scene's command
+    // interface cannot carry (--controller flow on an effort-actuated scene), or gains the law refuses,
+    // are bad input, named as the scene's errors are, whether or not the interface exists.
+    try {
+      exc::app::check_control_law(model, fc.controller);
+    } catch (const std::exception& e) {
+      std::cerr << "excavator-firmware: " << e.what() << " (" << scene_path << ")\n";
+      return 2;
     }
     fc.site_map = settings.terrain;
     fc.wait_for_start = wait_for_start;

@@ -76,6 +76,9 @@ int main(int argc, char** argv) {
       std::cout << exc::settings::emit(plant.scene().effective);
       return 0;
     }
+    // Bad input is named before the bus is opened, as the scene's errors are.
+    if (!stuck_function.empty() && !plant.fidelity().has(exc::plant::kHydraulicCircuit))
+      throw std::invalid_argument("--stuck-spool needs the hydraulic machine; the scene's actuators are not");
     exc::app::NodeIo io;
     std::string error;
     // The plant steps on SYNC and has no clock of its own, but its answer is part of the firmware's
@@ -93,8 +96,6 @@ int main(int argc, char** argv) {
     exc::app::PlantNode node(plant, port, publisher.get());
     exc::app::InjectedFault stuck;
     if (!stuck_function.empty()) {
-      if (!plant.fidelity().has(exc::plant::kHydraulicCircuit))
-        throw std::invalid_argument("--stuck-spool needs the hydraulic machine; the scene's actuators are not");
       stuck.kind = exc::app::InjectedFault::Kind::valve_stuck;
       stuck.joint = stuck_function == "swing" ? 0 : stuck_function == "boom" ? 1 : stuck_function == "arm" ? 2 : 3;
       stuck.magnitude = stuck_opening;

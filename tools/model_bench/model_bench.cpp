@@ -9,6 +9,8 @@
 #include "app/float_environment.hpp"
 
 #include <array>
+#include <cstdio>
+#include <string_view>
 #include <random>
 #include <vector>
 
@@ -154,6 +156,13 @@ BENCHMARK_CAPTURE(BM_ForwardDynamicsAugmented, general, exc::ClosedChainPath::ge
 // Google Benchmark's main, but an argument it does not know exits 2 (bad input), as every program's does.
 int main(int argc, char** argv) {
   exc::app::set_loop_float_mode();
+  // Google Benchmark's --help lists its own flags only: what this program times comes first.
+  for (int i = 1; i < argc; ++i)
+    if (std::string_view(argv[i]) == "--help")
+      std::printf("model-bench: timings of the closed-chain model (inverse and forward dynamics, the augmented form, the\n"
+                  "mass matrix, the closed-chain update; planar and general paths) over random\n"
+                  "valid states of the reference machine; medians of 10 repetitions:\n"
+                  "  model-bench --benchmark_repetitions=10 --benchmark_report_aggregates_only=true\n\n");
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
   benchmark::RunSpecifiedBenchmarks();
