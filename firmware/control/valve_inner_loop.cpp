@@ -52,11 +52,24 @@ void ValveInnerLoop::set_holding(bool holding, const Vec4& error) {
     return;
   }
   hold_error_ += hold_alpha_ * (error - hold_error_);
+  std::uint8_t inside = 0;
+  bool reentered = false;
   for (int i = 0; i < kNumActive; ++i) {
     const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
     const double e = std::abs(hold_error_[i]);
-    if (e < settings_.hold_window[i]) in_position_ |= bit;
-    else if (e > kHoldReentry * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
+    if (e < settings_.hold_window[i]) inside |= bit;
+    else if (e > kHoldReentry * settings_.hold_window[i] && (in_position_ & bit)) reentered = true;
+  }
+  // A function is corrected again past kHoldReentry windows; and then so is every other function
+  // outside its window (in the band up to kHoldReentry): a correction's reaction throws its
+  // neighbours (the links couple them), and one held on its closed valve with its error already in
+  // the band was thrown past the tolerance before its own correction began. Each is centred again
+  // once inside its own window.
+  if (reentered) in_position_ &= inside;
+  for (int i = 0; i < kNumActive; ++i) {
+    const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
+    if (inside & bit) in_position_ |= bit;
+    else if (std::abs(hold_error_[i]) > kHoldReentry * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
   }
 }
 

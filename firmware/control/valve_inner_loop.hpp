@@ -25,7 +25,8 @@
 //   in position  while the machine holds a pose (mode hold), a function whose error is inside
 //                hold_window is left with its valve centred, the load held by the closed valve as an
 //                operator's machine holds it; it is corrected again once the error exceeds
-//                kHoldReentry times the window. Without it the dead-zone inverse and the spool's lag make a valve hunt
+//                kHoldReentry times the window, and then every other function outside its own window
+//                is corrected with it (a correction's reaction throws the neighbours). Without it the dead-zone inverse and the spool's lag make a valve hunt
 //                around the pose (docs/control.md: a growing limit cycle of the flow law). The error
 //                both judgements read is low-passed over hold_filter_time, longer than the oil
 //                columns' period (2-3 Hz): a load ringing on its closed valve (after a correction, or
@@ -91,7 +92,7 @@ void visit_fields(Visitor& v, ValveLoopSettings& s) {
 // creep is corrected from 1.5 mm, and what a correction throws the other functions by (the links
 // couple them; about 0.6 mm on the arm when the boom corrects in the dig's pose) stays inside the
 // 2.5 mm holding tolerance (docs/control.md, "Holding still"; at 2 the PID's arm reached 2.65 mm
-// in an hour's hold).
+// in an hour's hold). A function corrected again takes with it every function outside its window.
 inline constexpr double kHoldReentry = 1.5;
 
 // What the valve stage sends and what it found.
