@@ -345,3 +345,34 @@ TEST_CASE("firmware/valve stage allocates nothing over 100000 cycles") {
   CHECK(counter.count() == 0);
   CHECK(std::isfinite(sink));
 }
+
+// Holding: a function corrected again (past kHoldReentry windows) takes with it every function outside
+// its own window, whose valves are then under control while the correction's reaction throws them;
+// those inside their window stay centred. The old band corrected the function alone.
+TEST_CASE("firmware/valve stage: in a hold a correction takes with it the functions outside their window, and leaves those inside centred") {
+  const ValveLoopModel m = simple_model();
+  ValveLoopSettings s = no_lead();
+  s.hold_filter_time = 0;  // the judgement reads the error itself
+  ValveInnerLoop loop(m, s, kPeriod);
+  const double w = s.hold_window[1];
+  loop.set_holding(true, Vec4::Constant(0.5 * w));
+  REQUIRE(loop.in_position() == 0x0F);
+  // Every function creeps into the band: still centred (the band keeps them until kHoldReentry).
+  loop.set_holding(true, Vec4(0.5 * w, 1.2 * w, 1.2 * w, 0.5 * w));
+  REQUIRE(loop.in_position() == 0x0F);
+  // The boom passes kHoldReentry: the boom is corrected, and the arm, in the band, with it; the swing
+  // and the bucket, inside their windows, stay centred.
+  loop.set_holding(true, Vec4(0.5 * w, (kHoldReentry + 0.1) * w, 1.2 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x09);
+  // Each is centred again once inside its own window.
+  loop.set_holding(true, Vec4(0.5 * w, 1.2 * w, 0.5 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0D);
+  loop.set_holding(true, Vec4(0.5 * w, 0.5 * w, 0.5 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0F);
+  // A function that leaves its window while another corrects is not re-engaged until it passes
+  // kHoldReentry itself or another function is corrected again.
+  loop.set_holding(true, Vec4(0.5 * w, (kHoldReentry + 0.1) * w, 0.5 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0D);
+  loop.set_holding(true, Vec4(0.5 * w, (kHoldReentry + 0.1) * w, 1.2 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0D);
+}
