@@ -28,39 +28,6 @@
 namespace exc::sim {
 namespace {
 
-// One phase's errors accumulated in the loop (no allocation): RMS, max and its time, excursions.
-class PhaseAccumulator {
- public:
-  void add(double t, double dt, const Vec4& q, const Vec4& q_desired) {
-    ++errors_.samples;
-    errors_.seconds += dt;
-    for (int j = 0; j < 4; ++j) {
-      const double e = std::abs(q[j] - q_desired[j]);
-      sum_sq_[j] += e * e;
-      if (e > errors_.max_error[j]) {
-        errors_.max_error[j] = e;
-        errors_.worst_time[j] = t;
-      }
-      const bool over = e > kHoldingTolerance[j];
-      if (over && !over_[j]) ++errors_.excursions[j];
-      over_[j] = over;
-    }
-  }
-  // A phase left: an excursion that continues into the next visit is a new one.
-  void leave() { over_ = {}; }
-  PhaseErrors result() const {
-    PhaseErrors r = errors_;
-    for (int j = 0; j < 4; ++j) r.rms_error[j] = r.samples ? std::sqrt(sum_sq_[j] / static_cast<double>(r.samples)) : 0;
-    return r;
-  }
-
- private:
-  PhaseErrors errors_;
-  std::array<double, 4> sum_sq_{};
-  std::array<bool, 4> over_{};
-};
-
-
 // The bus is stamped with simulated time, so the codec's timing rules never see wall-clock jitter.
 struct SimClock {
   std::int64_t now_ns = 0;
@@ -251,11 +218,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
 
   const auto period_ns = static_cast<std::int64_t>(std::llround(scene.cycle * 1e9));
   TrackingMetrics metrics;
-  PhaseAccumulator settle_acc, hold_acc, stop_acc;
-  double hold_start = -1;  // s the current hold began (-1: not holding)
-  bool settling = false;   // the current hold has not yet had every function inside the tolerance
-  double inside_since = -1;  // s since every function has been inside half of it (-1: not now)
-  bool commanded = false;  // the firmware held or tracked a pose (the stop phase counts from then on)
+  app::RunPhases phases;  // tracking, settle, hold, stop: on the plant's truth
   const auto wall_start = std::chrono::steady_clock::now();
   const std::int64_t progress_every = std::max<std::int64_t>(1, cycles / 10);
   const bool interactive = isatty(STDERR_FILENO) != 0;
@@ -345,31 +308,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
         result.min_pressure = std::min(result.min_pressure, s.hydraulics.min_pressure);
       }
       const auto mode = static_cast<safety::Mode>(st.mode);
-      if (mode == safety::Mode::hold) {
-        if (hold_start < 0) {
-          hold_start = s.time;
-          inside_since = -1;
-          settling = true;
-        }
-        if (settling) {
-          bool inside = true;
-          for (int j = 0; j < 4; ++j) inside = inside && std::abs(s.q_a[j] - q_desired[j]) <= 0.5 * kHoldingTolerance[j];
-          if (!inside) inside_since = -1;
-          else if (inside_since < 0) inside_since = s.time;
-          settling = !(inside && s.time - inside_since >= kHoldSettleDwell) && s.time - hold_start < kHoldSettleLimit;
-        }
-        (settling ? settle_acc : hold_acc).add(s.time, scene.cycle, s.q_a, q_desired);
-        commanded = true;
-      } else {
-        hold_start = -1;
-        settle_acc.leave();
-        hold_acc.leave();
-      }
-      // The safe state: the centred valves' creep from the pose last asked for (none before any).
-      if (mode == safety::Mode::safe_stop && commanded) stop_acc.add(s.time, scene.cycle, s.q_a, q_desired);
-      else stop_acc.leave();
+      phases.add(s.time, scene.cycle, mode, st.tracking, s.q_a, q_desired);
       if (st.tracking) {
-        commanded = true;
         metrics.add(s.q_a, q_desired);
         const double tt = st.task_time;
         const std::size_t c = starts.empty() ? 0
@@ -442,9 +382,10 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
     result.measured_rms_error[j] = outcome.measured_rms[j];
     result.measured_max_error[j] = outcome.measured_max[j];
   }
-  result.settle = settle_acc.result();
-  result.hold = hold_acc.result();
-  result.stop = stop_acc.result();
+  result.tracking = phases.tracking();
+  result.settle = phases.settle();
+  result.hold = phases.hold();
+  result.stop = phases.stop();
   const Vec6 truth = theta_of(scene.soil);
   for (int i = 0; i < 6; ++i) {
     result.theta_hat[i] = last.theta_hat[i];
@@ -506,17 +447,8 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   } else {
     // The hold is part of the task: a machine told to hold still that moves past the holding
     // tolerance failed it, however well it tracked.
-    for (int j = 0; j < 4 && result.ok; ++j)
-      if (result.hold.max_error[j] > kHoldingTolerance[j]) {
-        result.ok = false;
-        char text[240];
-        std::snprintf(text, sizeof text,
-                      "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s once settled; %llu excursion(s))",
-                      kActiveNames[j], result.hold.max_error[j] * 1e3, j == 0 ? "mrad" : "mm", result.hold.worst_time[j],
-                      kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm",
-                      static_cast<unsigned long long>(result.hold.excursions[j]));
-        result.failure = text;
-      }
+    result.failure = app::hold_failure(result.hold);
+    result.ok = result.failure.empty();
   }
   return result;
 }

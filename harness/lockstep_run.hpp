@@ -14,6 +14,7 @@
 
 #include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
+#include "app/run_phases.hpp"
 #include "app/settings_blob.hpp"
 #include "harness/scene_source.hpp"
 #include "harness/stop_judge.hpp"
@@ -60,34 +61,13 @@ struct CycleRecord {
   double theta_hat[6] = {0, 0, 0, 0, 0, 0};  // the soil estimates at the cycle's end
 };
 
-// The errors of one phase of a run, true q_a against the pose the firmware asks for; rad (swing), m.
-// Phases: tracking (the path running, its stop along the path included), settle (each hold's start,
-// the path's last error dying out: until every function has stayed inside half the holding
-// tolerance for kHoldSettleDwell s, at most kHoldSettleLimit s), hold (the firmware holding a pose from then on: after the task, after a stop,
-// at start-up) and stop (the safe state after a fault:
-// the centred valves' creep from the pose last asked for).
-struct PhaseErrors {
-  std::uint64_t samples = 0;
-  double seconds = 0;                   // s spent in the phase
-  double rms_error[4] = {0, 0, 0, 0};
-  double max_error[4] = {0, 0, 0, 0};
-  double worst_time[4] = {-1, -1, -1, -1};  // s of the run at each joint's max (-1: no sample)
-  // Per joint: how often the error rose past the holding tolerance (an excursion: a hunt's
-  // overshoot or a correction that came too late), counted on the hold.
-  std::uint64_t excursions[4] = {0, 0, 0, 0};
-};
-// The holding tolerance the run's verdict holds every hold to (docs/control.md, "Holding still"):
-// |q_a - q_d| of each cylinder within 2.5 mm, the swing within 2.5 mrad, once the hold has settled
-// (every function inside half of it for kHoldSettleDwell: a hold that merely entered the tolerance
-// on its way in, or a swing ringing through it on its soft oil column, is still settling).
-inline constexpr double kHoldingTolerance[4] = {2.5e-3, 2.5e-3, 2.5e-3, 2.5e-3};
-// s from the start of a hold to the start of its judgement at the latest: the hold's pose is the
-// path's last point, and the error the path ended with (up to 14 mm under PID on the clay slope)
-// is corrected first; a hold still outside the tolerance this long after it began is judged anyway.
-inline constexpr double kHoldSettleLimit = 10.0;
-// s every function must stay inside half the tolerance for the hold to count as settled: longer than
-// half the swing's 0.4 Hz ringing period, so a ring through zero is not taken for a settled hold.
-inline constexpr double kHoldSettleDwell = 1.5;
+// The errors of one phase of a run (tracking, settle, hold, stop) and the holding tolerance the
+// verdict holds a hold to: the one phase split of every summary (app/run_phases.hpp); here from the
+// plant's truth.
+using app::PhaseErrors;
+using app::kHoldingTolerance;
+using app::kHoldSettleLimit;
+using app::kHoldSettleDwell;
 
 // "At rest" (docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
 inline constexpr double kRestCylinderRate = 1e-3;  // m/s
@@ -109,7 +89,9 @@ struct RunRecord {
   // reports in a two-process run, and equal to it bit for bit (SYNC lockstep).
   double measured_rms_error[4] = {0, 0, 0, 0};
   double measured_max_error[4] = {0, 0, 0, 0};
-  PhaseErrors settle, hold, stop;     // the other phases (tracking: the figures above)
+  // Every phase (app/run_phases.hpp) on the plant's truth: tracking (the figures above, with each
+  // max's time and the excursions), settle, hold, stop.
+  PhaseErrors tracking, settle, hold, stop;
   double theta_hat[6] = {0, 0, 0, 0, 0, 0};
   double theta_true[6] = {0, 0, 0, 0, 0, 0};
   double peak_soil_force = 0;         // N, |F_soil| maximum

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "app/run_summary.hpp"
 #include "output_files/helper_program.hpp"
 
 namespace exc::sim {
@@ -37,16 +38,6 @@ std::string format(const char* fmt, ...) {
 
 nlohmann::json timing_json(const Timing& t) {
   return {{"median", t.median_us}, {"p99", t.p99_us}, {"max", t.max_us}, {"count", t.count}};
-}
-
-// One phase's figures (null when the run never was in it).
-nlohmann::json phase_json(const PhaseErrors& p) {
-  if (p.samples == 0) return nullptr;
-  nlohmann::json excursions;
-  for (int i = 0; i < 4; ++i) excursions[kJoints[i]] = p.excursions[i];
-  return {{"seconds", p.seconds}, {"samples", p.samples}, {"rms_error", per_joint(p.rms_error)},
-          {"max_error", per_joint(p.max_error)}, {"worst_time", per_joint(p.worst_time)},
-          {"excursions", excursions}};
 }
 
 }  // namespace
@@ -234,12 +225,9 @@ nlohmann::json to_json(const Summary& summary) {
     run["tracking_samples"] = r.tracking_samples;
     // Every phase (the figures above are the tracking phase's): tracking, hold, stop; and the
     // tolerance the verdict holds the hold to.
-    run["phases"] = {{"tracking", {{"samples", r.tracking_samples}, {"rms_error", tracked_per_joint(r, r.rms_error)},
-                                   {"max_error", tracked_per_joint(r, r.max_error)}}},
-                     {"settle", phase_json(r.settle)},
-                     {"hold", phase_json(r.hold)},
-                     {"stop", phase_json(r.stop)}};
-    run["holding_tolerance"] = per_joint(kHoldingTolerance);
+    run["phases"] = app::phases_json(r.tracking, r.settle, r.hold, r.stop);
+    run["holding_tolerance"] = app::holding_tolerance_json();
+    run["hold_ok"] = app::hold_failure(r.hold).empty();
     run["hold_settle_limit_seconds"] = kHoldSettleLimit;
     nlohmann::json theta_hat, theta_true;
     for (int i = 0; i < 6; ++i) {

@@ -36,6 +36,7 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
   bool grid_started = false;
   std::int64_t request_cycle = -1;  // cycle of the stop request
   std::int64_t still_cycle = -1;    // first cycle after it with the path at rest: the hold's time counts from here
+  RunPhases phases;  // after each cycle, outside the node's cycle and its timing
   for (std::int64_t k = 0; k < options.cycles && stop_requests.load() < 2; ++k) {
     if (stop_requests.load() == 1 && request_cycle < 0) {
       outcome.stop_requested = true;
@@ -71,6 +72,9 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
       bus.wait_readable(left);
     }
     node.end_cycle();
+    const std::array<double, 4>& sensed = node.sensors().position;
+    phases.add(node.time(), period_s, node.mode(), node.tracking(), Vec4(sensed[0], sensed[1], sensed[2], sensed[3]),
+               node.q_desired());
     if (options.realtime && !grid_started && node.has_sensors()) {
       // The deadline grid starts once the plant has answered: start-up is not a missed deadline.
       grid_started = true;
@@ -88,6 +92,10 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
   node.publish_counters(true);
 
   outcome.cycles = node.cycle();
+  outcome.tracking = phases.tracking();
+  outcome.settle = phases.settle();
+  outcome.hold = phases.hold();
+  outcome.stop = phases.stop();
   outcome.overruns = sleeper.overruns();
   outcome.skipped_periods = sleeper.skipped_periods();
   // Missed deadlines come first when they are there: a loop that cannot hold its period starves
@@ -105,6 +113,8 @@ RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOpt
     add(std::string("the firmware never tracked (mode ") + safety::to_string(node.mode()) + ")");
   else if (node.supervisor().safe_stops() > 0)
     add(std::string("safe state: ") + node.supervisor().last_fault_text());
+  else if (const std::string held = hold_failure(outcome.hold); !held.empty())
+    add(held);
   outcome.ok = outcome.failure.empty();
   return outcome;
 }

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "app/firmware_node.hpp"
+#include "app/run_phases.hpp"
 #include "hal/can_bus.hpp"
 
 namespace exc::app {
@@ -36,12 +37,17 @@ struct RunnerOutcome {
   bool stop_requested = false;  // a first stop request came (signal, caller)
   bool ok = false;
   std::string failure;  // why not ok, the first cause first
+  // The run's errors per phase on the firmware's sensed positions (app/run_phases.hpp, the split
+  // excavator-sim's summary makes on the plant's truth); a hold that left its pose by more than the
+  // holding tolerance once settled fails the run.
+  PhaseErrors tracking, settle, hold, stop;
 };
 
 // Runs the cycle until options.cycles are done or stop_requests says so: at 1 a tracking machine
 // decelerates along its path, holds for stop_hold_s and the run ends (any other mode ends at once), at 2 the run
 // ends now. Mode changes are written to progress (may be null). Returns the verdict: a run that
-// never tracked, went to its safe state or (real time) missed more deadlines than allowed failed.
+// never tracked, went to its safe state, left a held pose by more than the holding tolerance or
+// (real time) missed more deadlines than allowed failed.
 RunnerOutcome run_firmware(FirmwareNode& node, hal::CanBus& bus, const RunnerOptions& options,
                            const std::atomic<int>& stop_requests, std::FILE* progress);
 

@@ -34,11 +34,17 @@ ValveInnerLoop::ValveInnerLoop(const ValveLoopModel& model, const ValveLoopSetti
                   settings.spool_lag_target > 0 ? settings.spool_lag_target : 1.0, period, spool_limits()),
       hold_alpha_(settings.hold_filter_time > 0 ? 1.0 - std::exp(-period / settings.hold_filter_time) : 1.0),
       period_(period),
+      hold_speed_(settings.hold_filter_time > 0 ? Vec4(settings.hold_window / settings.hold_filter_time) : Vec4::Zero()),
       level_alpha_(1.0 - std::exp(-period / (5 * settings.force_time_constant))) {}
 
 void ValveInnerLoop::reset() {
   spool_lead_.reset(Vec4::Zero());
   in_position_ = 0;
+  settled_ = 0;
+  holding_ = false;
+  correction_time_.setZero();
+  correction_start_.setZero();
+  raw_error_.setZero();
   hold_error_.setZero();
   force_integral_.setZero();
   level_primed_ = false;
@@ -46,18 +52,35 @@ void ValveInnerLoop::reset() {
 }
 
 void ValveInnerLoop::set_holding(bool holding, const Vec4& error) {
+  holding_ = holding;
+  raw_error_ = error;
   if (!holding) {
     in_position_ = 0;
+    settled_ = 0;
     hold_error_ = error;
     return;
   }
   hold_error_ += hold_alpha_ * (error - hold_error_);
+  std::uint8_t inside = 0;
+  bool reentered = false;
   for (int i = 0; i < kNumActive; ++i) {
     const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
     const double e = std::abs(hold_error_[i]);
-    if (e < settings_.hold_window[i]) in_position_ |= bit;
-    else if (e > kHoldReentry * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
+    if (e < settings_.hold_window[i]) inside |= bit;
+    else if (e > kHoldReentry * settings_.hold_window[i] && (in_position_ & bit)) reentered = true;
   }
+  // A function is corrected again past kHoldReentry windows; and then so is every other function
+  // outside its window (in the band up to kHoldReentry): a correction's reaction throws its
+  // neighbours (the links couple them), and one held on its closed valve with its error already in
+  // the band was thrown past the tolerance before its own correction began. Each is centred again
+  // once inside its own window.
+  if (reentered) in_position_ &= inside;
+  for (int i = 0; i < kNumActive; ++i) {
+    const std::uint8_t bit = static_cast<std::uint8_t>(1u << i);
+    if (inside & bit) in_position_ |= bit;
+    else if (std::abs(hold_error_[i]) > kHoldReentry * settings_.hold_window[i]) in_position_ &= static_cast<std::uint8_t>(~bit);
+  }
+  settled_ |= in_position_;
 }
 
 Vec4 ValveInnerLoop::measured_force(const Vec4& p_a, const Vec4& p_b) const {
@@ -210,6 +233,30 @@ void ValveInnerLoop::finish(const Vec4& q, const Vec4& p_a, const Vec4& p_b) {
   const double band = settings_.opening_band;
   for (int i = 0; i < kNumActive; ++i) {
     if ((in_position_ >> i) & 1u) c.velocity[i] = 0;
+    // A correction in a hold (a function back under control after it was in position) starts no
+    // faster than the judgement's filter follows: at hold_window / hold_filter_time the filtered error
+    // lags the true one by at most a window, so the function is centred again with its true error
+    // between the pose and the window, not past the pose. Asked for faster, the force loop's step on
+    // resuming (the law's force against the one the leakage left) lurched the boom at 20-30 mm/s and
+    // its reaction threw the arm, centred with its bore side at tank, by 2-5 mm (docs/control.md).
+    // A correction that has not moved its function back towards the pose (its error, read unfiltered
+    // so that the motion is seen at once, a quarter window below where the correction began) within
+    // hold_filter_time is released from the limit: a small flow that the leakage absorbs before the
+    // pressure reaches breakaway (the swing on a slope) would otherwise never move it; a cylinder's
+    // pressure reaches breakaway in about a tenth of that. Flagged as limited: the laws' integrators
+    // hold while the stage passes less than they ask.
+    const bool correcting = holding_ && (((settled_ & ~in_position_) >> i) & 1u) && hold_speed_[i] > 0;
+    if (!correcting) {
+      correction_time_[i] = 0;
+      correction_start_[i] = hold_error_[i];
+    } else {
+      if (std::abs(raw_error_[i]) > std::abs(correction_start_[i]) - 0.25 * settings_.hold_window[i])
+        correction_time_[i] += period_;
+      if (correction_time_[i] <= settings_.hold_filter_time && std::abs(c.velocity[i]) > hold_speed_[i]) {
+        c.velocity[i] = std::copysign(hold_speed_[i], c.velocity[i]);
+        c.limited |= static_cast<std::uint8_t>(1u << i);
+      }
+    }
     double a = std::isfinite(c.velocity[i]) ? opening_for(i, c.velocity[i], q[i], p_a[i], p_b[i], level_a_[i], level_b_[i]) : 0.0;
     if (std::abs(a) >= 1) {
       a = a > 0 ? 1.0 : -1.0;

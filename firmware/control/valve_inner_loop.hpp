@@ -25,13 +25,18 @@
 //   in position  while the machine holds a pose (mode hold), a function whose error is inside
 //                hold_window is left with its valve centred, the load held by the closed valve as an
 //                operator's machine holds it; it is corrected again once the error exceeds
-//                kHoldReentry times the window. Without it the dead-zone inverse and the spool's lag make a valve hunt
+//                kHoldReentry times the window, and then every other function outside its own window
+//                is corrected with it (a correction's reaction throws the neighbours). Without it the dead-zone inverse and the spool's lag make a valve hunt
 //                around the pose (docs/control.md: a growing limit cycle of the flow law). The error
 //                both judgements read is low-passed over hold_filter_time, longer than the oil
 //                columns' period (2-3 Hz): a load ringing on its closed valve (after a correction, or
 //                when another function moves) does not reopen it and a correction passing through the
 //                window does not centre it mid-way, while the slow creep of leakage is seen as it is.
 //                The laws hold their integrators and updates on a centred function (limited()).
+//                A correction (a function back under control after it was in position in this hold)
+//                moves at most at hold_window / hold_filter_time, flagged as limited (its step on
+//                resuming otherwise lurched a loaded boom and threw its neighbours), unless it has not
+//                moved the function back within hold_filter_time (a flow the leakage absorbs).
 //   spool lead   the pilot-operated spool's first-order lag T_s made to look like the shorter T_t
 //                (ActuatorLagCompensator on the spool position, limits -1..1).
 //   pilots       p_pilot_A = max(s, 0) p_full, p_pilot_B = max(-s, 0) p_full.
@@ -91,7 +96,7 @@ void visit_fields(Visitor& v, ValveLoopSettings& s) {
 // creep is corrected from 1.5 mm, and what a correction throws the other functions by (the links
 // couple them; about 0.6 mm on the arm when the boom corrects in the dig's pose) stays inside the
 // 2.5 mm holding tolerance (docs/control.md, "Holding still"; at 2 the PID's arm reached 2.65 mm
-// in an hour's hold).
+// in an hour's hold). A function corrected again takes with it every function outside its window.
 inline constexpr double kHoldReentry = 1.5;
 
 // What the valve stage sends and what it found.
@@ -160,9 +165,15 @@ class ValveInnerLoop {
   ValveLoopSettings settings_;
   ActuatorLagCompensator spool_lead_;
   std::uint8_t in_position_ = 0;  // bit i: function i centred, in position
+  std::uint8_t settled_ = 0;      // bit i: function i has been in position in this hold (then corrected at hold_speed_)
+  bool holding_ = false;          // the machine holds a pose (set_holding)
   Vec4 hold_error_ = Vec4::Zero();  // the low-passed error the in-position judgement reads
   double hold_alpha_ = 1.0;         // its filter gain per call, 1 - exp(-period / hold_filter_time)
   double period_ = 1e-3;
+  Vec4 hold_speed_ = Vec4::Zero();  // a correction's speed limit in a hold, hold_window / hold_filter_time (0: none)
+  Vec4 correction_time_ = Vec4::Zero();   // s each function's correction has gone without moving it back
+  Vec4 correction_start_ = Vec4::Zero();  // the filtered error where each function's correction began
+  Vec4 raw_error_ = Vec4::Zero();         // this cycle's error as set_holding received it
   Vec4 force_integral_ = Vec4::Zero();  // the force loop's integral, as a flow per piston area
   double level_alpha_ = 1.0;  // the slow force's filter gain per call, 1 - exp(-period / (5 T_f))
   Vec4 level_a_ = Vec4::Zero(), level_b_ = Vec4::Zero();  // Pa, the chambers' levels (update_levels)

@@ -13,6 +13,7 @@
 #include "app/allocation_counter.hpp"
 #include "app/firmware_node.hpp"
 #include "app/firmware_runner.hpp"
+#include "app/run_summary.hpp"
 #include "closed_loop.hpp"
 #include "dbc_reader.hpp"
 #include "hal/can_bus_load.hpp"
@@ -111,6 +112,8 @@ struct AnsweringBus final : hal::CanBus {
   std::uint64_t stop_at_cycle = 0, stall_at_cycle = 0;  // 0: never
   std::int64_t stall_ns = 0;
   std::uint64_t hold_from = 0;  // the first cycle after stop_at_cycle the node was seen in hold (0: never)
+  std::uint64_t throw_at_cycle = 0;  // the machine's pose jumps by `thrown` here (0: never)
+  Vec4 thrown = Vec4::Zero();
   explicit AnsweringBus(Loop& l) : loop(l) {}
   bool send(const hal::CanFrame& frame) override { return loop.fw_bus->send(frame); }
   bool receive(hal::CanFrame& frame) override { return loop.fw_bus->receive(frame); }
@@ -123,6 +126,7 @@ struct AnsweringBus final : hal::CanBus {
       while (hal::monotonic_now_ns() < until) {
       }
     }
+    if (throw_at_cycle > 0 && k == throw_at_cycle) loop.plant.reset(loop.plant.q() + thrown, Vec4::Zero());
     loop.plant_answer();
     return loop.fw_bus->pending() > 0;
   }
@@ -754,6 +758,56 @@ TEST_CASE("firmware/runner: a lockstep run does its cycles, tracks, and leaves t
   for (int j = 0; j < 4; ++j) CHECK(loop.command.value[j] == 0.0);
   CHECK(loop.command.fault_code == static_cast<std::uint16_t>(safety::FirmwareFault::exited));
   CHECK_FALSE(loop.command.emergency_stop);
+}
+
+// excavator-firmware's summary splits the run into phases as excavator-sim's does (app/run_phases):
+// on the old summary only the tracking phase was counted and a hold thrown off its pose passed.
+TEST_CASE("firmware/run summary: the errors per phase, and a hold thrown past the holding tolerance fails the run") {
+  const Model model = build_model(reference_machine());
+  app::FirmwareNodeConfig cfg;
+  cfg.controller.law = "pid";
+  for (const double throw_mm : {0.0, 6.0}) {
+    CAPTURE(throw_mm);
+    Loop loop(model, sim::kFreeMotionTask, cfg);
+    AnsweringBus bus(loop);
+    const double end = loop.task.end_time();  // 8 s; the hold settles within kHoldSettleLimit
+    const auto thrown_at = static_cast<std::uint64_t>((end + app::kHoldSettleLimit + 1) / 1e-3);
+    if (throw_mm > 0) {
+      bus.throw_at_cycle = thrown_at;
+      bus.thrown = Vec4(0, 0, throw_mm * 1e-3, 0);  // the arm
+    }
+    app::RunnerOptions run;
+    run.cycles = static_cast<std::int64_t>(thrown_at + 2000);
+    const std::atomic<int> no_stop{0};
+    const app::RunnerOutcome out = app::run_firmware(loop.node, bus, run, no_stop, nullptr);
+    INFO(out.failure);
+    // The phases: the tracking phase is the firmware's measured tracking, the hold follows the task.
+    REQUIRE(out.tracking.samples == static_cast<std::uint64_t>(loop.node.measured_tracking().samples()));
+    for (int j = 0; j < 4; ++j) CHECK(out.tracking.max_error[j] == doctest::Approx(loop.node.measured_tracking().max_abs(j)));
+    REQUIRE(out.hold.samples > 0);
+    CHECK(out.settle.seconds <= app::kHoldSettleLimit + 1e-9);
+    CHECK(out.stop.samples == 0);
+    const app::RunContext context{loop.node, out, "pid", false, 1e-3, 0, nullptr, telemetry::OverflowPolicy::block};
+    const nlohmann::json j = app::run_summary_json(context);
+    REQUIRE(j.contains("phases"));
+    CHECK(j["phases"]["stop"].is_null());
+    CHECK(j["phases"]["hold"]["max_error"]["arm"].get<double>() == doctest::Approx(out.hold.max_error[2]));
+    CHECK(j["phases"]["tracking"]["samples"].get<std::uint64_t>() == out.tracking.samples);
+    CHECK(j["holding_tolerance"]["arm"].get<double>() == app::kHoldingTolerance[2]);
+    if (throw_mm > 0) {
+      // The arm's error in the hold is at least the throw less what one cycle corrects.
+      CHECK(out.hold.max_error[2] > 0.9 * throw_mm * 1e-3);
+      CHECK(out.hold.excursions[2] >= 1);
+      CHECK_FALSE(out.ok);
+      CHECK(out.failure.find("the arm left its held pose") != std::string::npos);
+      CHECK_FALSE(j["hold_ok"].get<bool>());
+      CHECK_FALSE(j["ok"].get<bool>());
+    } else {
+      for (int k = 0; k < 4; ++k) CHECK(out.hold.max_error[k] < app::kHoldingTolerance[k]);
+      CHECK(out.ok);
+      CHECK(j["hold_ok"].get<bool>());
+    }
+  }
 }
 
 TEST_CASE("firmware/runner: a stop request decelerates a tracking machine along its path, holds it for the hold time, then ends, and before tracking ends at once") {

@@ -345,3 +345,90 @@ TEST_CASE("firmware/valve stage allocates nothing over 100000 cycles") {
   CHECK(counter.count() == 0);
   CHECK(std::isfinite(sink));
 }
+
+// Holding: a function corrected again (past kHoldReentry windows) takes with it every function outside
+// its own window, whose valves are then under control while the correction's reaction throws them;
+// those inside their window stay centred. The old band corrected the function alone.
+TEST_CASE("firmware/valve stage: in a hold a correction takes with it the functions outside their window, and leaves those inside centred") {
+  const ValveLoopModel m = simple_model();
+  ValveLoopSettings s = no_lead();
+  s.hold_filter_time = 0;  // the judgement reads the error itself
+  ValveInnerLoop loop(m, s, kPeriod);
+  const double w = s.hold_window[1];
+  loop.set_holding(true, Vec4::Constant(0.5 * w));
+  REQUIRE(loop.in_position() == 0x0F);
+  // Every function creeps into the band: still centred (the band keeps them until kHoldReentry).
+  loop.set_holding(true, Vec4(0.5 * w, 1.2 * w, 1.2 * w, 0.5 * w));
+  REQUIRE(loop.in_position() == 0x0F);
+  // The boom passes kHoldReentry: the boom is corrected, and the arm, in the band, with it; the swing
+  // and the bucket, inside their windows, stay centred.
+  loop.set_holding(true, Vec4(0.5 * w, (kHoldReentry + 0.1) * w, 1.2 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x09);
+  // Each is centred again once inside its own window.
+  loop.set_holding(true, Vec4(0.5 * w, 1.2 * w, 0.5 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0D);
+  loop.set_holding(true, Vec4(0.5 * w, 0.5 * w, 0.5 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0F);
+  // A function that leaves its window while another corrects is not re-engaged until it passes
+  // kHoldReentry itself or another function is corrected again.
+  loop.set_holding(true, Vec4(0.5 * w, (kHoldReentry + 0.1) * w, 0.5 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0D);
+  loop.set_holding(true, Vec4(0.5 * w, (kHoldReentry + 0.1) * w, 1.2 * w, 0.5 * w));
+  CHECK(loop.in_position() == 0x0D);
+}
+
+// Holding: a correction (a function back under control after it was in position in this hold) moves
+// no faster than hold_window / hold_filter_time, flagged as limited for the laws' anti-windup, until
+// it has gone hold_filter_time without moving the function back; the approach to the pose at a
+// hold's start and a moving machine are not limited. Without it a law's
+// force step on resuming lurched the worn machine's boom and threw its arm past the tolerance.
+TEST_CASE("firmware/valve stage: in a hold a correction moves no faster than the window over the error filter's time, flagged as limited, unless it stalls that long") {
+  const ValveLoopModel m = simple_model();
+  const ValveLoopSettings s = no_lead();
+  REQUIRE(s.hold_filter_time > 0);
+  const Vec4 limit = s.hold_window / s.hold_filter_time;
+  const Vec4 fast(0.05, 0.05, -0.05, 0.05);  // rad/s, m/s: far above the limit
+  REQUIRE((fast.cwiseAbs() - 2 * limit).minCoeff() > 0);
+  ValveInnerLoop loop(m, s, kPeriod);
+  // Moving (the path's error outside the windows; the filter follows it): not limited.
+  const Vec4 outside = 3 * s.hold_window;
+  loop.set_holding(false, outside);
+  CHECK(loop.from_velocity(fast, kMid, kSteadyP, kSteadyP).velocity.isApprox(fast));
+  // A hold's start, the functions still outside their windows: not limited.
+  loop.set_holding(true, outside);
+  CHECK(loop.in_position() == 0);
+  CHECK(loop.from_velocity(fast, kMid, kSteadyP, kSteadyP).velocity.isApprox(fast));
+  CHECK(loop.last().limited == 0);
+  // In position (the filtered error settles inside the window): centred.
+  for (int k = 0; k < 5000; ++k) loop.set_holding(true, Vec4::Zero());
+  REQUIRE(loop.in_position() == 0x0F);
+  CHECK(loop.from_velocity(fast, kMid, kSteadyP, kSteadyP).velocity.isZero());
+  // The leakage takes the boom past kHoldReentry windows: its correction is limited, in the direction
+  // asked for; the others stay centred.
+  Vec4 crept = Vec4::Zero();
+  crept[1] = (kHoldReentry + 0.5) * s.hold_window[1];
+  for (int k = 0; k < 5000 && loop.in_position() == 0x0F; ++k) loop.set_holding(true, crept);
+  REQUIRE(loop.in_position() == 0x0D);
+  const ValveCommand& c = loop.from_velocity(fast, kMid, kSteadyP, kSteadyP);
+  CHECK(c.velocity[1] == doctest::Approx(limit[1]));
+  CHECK(c.velocity[0] == 0.0);
+  CHECK(c.velocity[2] == 0.0);
+  CHECK(c.limited == 0x02);
+  CHECK(loop.from_velocity(-fast, kMid, kSteadyP, kSteadyP).velocity[1] == doctest::Approx(-limit[1]));
+  // Asked for less than the limit: passed as asked, not flagged.
+  const Vec4 slow = 0.5 * limit;
+  CHECK(loop.from_velocity(slow, kMid, kSteadyP, kSteadyP).velocity[1] == doctest::Approx(slow[1]));
+  CHECK(loop.last().limited == 0);
+  // A correction that has not moved the boom back within hold_filter_time (a flow the leakage
+  // absorbs before the pressure reaches breakaway) is released from the limit.
+  const int stalled_cycles = static_cast<int>(1.2 * s.hold_filter_time / kPeriod);
+  for (int k = 0; k < stalled_cycles; ++k) {
+    loop.set_holding(true, crept);
+    loop.from_velocity(fast, kMid, kSteadyP, kSteadyP);
+  }
+  REQUIRE(loop.in_position() == 0x0D);
+  CHECK(loop.last().velocity[1] == doctest::Approx(fast[1]));
+  // The hold ends (the machine tracks again): no limit.
+  loop.set_holding(false, crept);
+  CHECK(loop.from_velocity(fast, kMid, kSteadyP, kSteadyP).velocity.isApprox(fast));
+}

@@ -371,7 +371,7 @@ TEST_CASE("tools/excavator-sim: the report reads the log --lcm named, and withou
   CHECK(fs::exists(log));
   CHECK(!fs::exists(r.dir / "out" / "run.lcm"));
   const std::string report = read_text_file(r.dir / "out" / "report" / "report.md");
-  CHECK(report.find("| RMS error arm (mm) |") != std::string::npos);
+  CHECK(report.find("| tracking: RMS error arm (mm) |") != std::string::npos);  // the summary table's row
   CHECK(r.out.find("report: out/report/report.md") != std::string::npos);
   // A provider that writes no file (here LCM's in-process queue, as udpm:// would be) leaves nothing
   // to report from: said on stderr, and the run is still a success.

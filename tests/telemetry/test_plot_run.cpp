@@ -140,7 +140,7 @@ TEST_CASE("tools/plot-run draws every figure and the report from a small recorde
   std::stringstream sim_report;
   sim_report << sim_file.rdbuf();
   CHECK(sim_report.str().find("| quantity | pid | adaptive |") != std::string::npos);
-  CHECK(sim_report.str().find("| RMS error arm (mm) | 7.3 | 7.3 |") != std::string::npos);
+  CHECK(sim_report.str().find("| tracking: RMS error arm (mm) | 7.3 | 7.3 |") != std::string::npos);
   CHECK(sim_report.str().find("| peak soil force (kN) | 13.1 | 13.1 |") != std::string::npos);
   for (const char* name :
        {"tracking_swing.png", "tracking_boom.png", "tracking_arm.png", "tracking_bucket.png",
@@ -157,6 +157,73 @@ TEST_CASE("tools/plot-run draws every figure and the report from a small recorde
     CHECK(height == 700);
     CHECK(report.str().find(std::string("(") + name + ")") != std::string::npos);
   }
+  if (std::getenv("EXC_KEEP_PLOTS") == nullptr) fs::remove_all(dir);
+}
+
+// The report's table gives every phase of excavator-sim's summary (its "phases") and the hold's
+// verdict, and says which phase each figure covers; the old table had the tracking figures alone.
+TEST_CASE("tools/plot-run: the report's summary table gives the errors per phase and the hold's verdict against the tolerance") {
+  REQUIRE_MESSAGE(exc::test::matplotlib_available(), exc::test::kMatplotlibMissing);
+  const fs::path dir = fresh_dir("exc-plot-run-phases-");
+  const fs::path log_path = dir / "run.lcm";
+  {
+    std::string error;
+    auto output = LcmOutput::open("file://" + log_path.string() + "?mode=w", &error);
+    REQUIRE_MESSAGE(output, error);
+    for (const char* suffix : {"/pid", "/adaptive"}) {
+      TelemetryConfig config;
+      config.shared_output = output;
+      config.channel_suffix = suffix;
+      TelemetryPublisher publisher(config);
+      REQUIRE(publisher.start(&error));
+      publish_synthetic_run(publisher, 1.0);
+      publisher.stop();
+    }
+  }
+  // Two runs: the PID's hold past the tolerance on the arm (3.1 mm), the adaptive law's within it.
+  auto run = [](double hold_arm, bool hold_ok) {
+    std::ostringstream r;
+    r << R"({"rms_error": {"swing": 0, "boom": 0.0015, "arm": 0.0073, "bucket": 0.002},
+      "max_error": {"swing": 0, "boom": 0.004, "arm": 0.02, "bucket": 0.011}, "peak_soil_force": 13100,
+      "reanchor_count": 25, "control_step_us": {"median": 7, "p99": 10.5, "max": 200},
+      "heap_allocations_in_loop": 0, "simulated_seconds": 600, "ok": )" << (hold_ok ? "true" : "false") << R"(,
+      "theta_hat": {"M_x": 1, "B_x": 2, "K_x": 3, "M_z": 4, "B_z": 5, "K_z": 6},
+      "theta_true": {"M_x": 1, "B_x": 2, "K_x": 3, "M_z": 4, "B_z": 5, "K_z": 6},
+      "holding_tolerance": {"swing": 0.0025, "boom": 0.0025, "arm": 0.0025, "bucket": 0.0025},
+      "hold_ok": )" << (hold_ok ? "true" : "false") << R"(,
+      "phases": {"tracking": {"samples": 10000, "seconds": 10, "rms_error": {"swing": 0, "boom": 0.0015, "arm": 0.0073, "bucket": 0.002},
+                              "max_error": {"swing": 0, "boom": 0.004, "arm": 0.02, "bucket": 0.011}},
+                 "settle": {"samples": 2000, "seconds": 2.0, "rms_error": {"swing": 0, "boom": 0.001, "arm": 0.001, "bucket": 0.001},
+                            "max_error": {"swing": 0, "boom": 0.0031, "arm": 0.0042, "bucket": 0.0011}},
+                 "hold": {"samples": 588000, "seconds": 588.0, "rms_error": {"swing": 0, "boom": 0.0008, "arm": 0.0009, "bucket": 0.0007},
+                          "max_error": {"swing": 0, "boom": 0.0015, "arm": )" << hold_arm << R"(, "bucket": 0.0016},
+                          "excursions": {"swing": 0, "boom": 0, "arm": )" << (hold_ok ? 0 : 2) << R"(, "bucket": 0}},
+                 "stop": null}})";
+    return r.str();
+  };
+  {
+    std::ofstream summary(dir / "sim_summary.json");
+    summary << "{\"adaptive\": " << run(0.0018, true) << ", \"pid\": " << run(0.0031, false) << ", \"scene\": \"hold\"}";
+  }
+  const std::string out = (dir / "report").string();
+  REQUIRE(std::system((std::string(EXC_EXCAVATOR_LOG) + " report " + log_path.string() + " --out " + out + " --summary " +
+                       (dir / "sim_summary.json").string() + " >/dev/null")
+                          .c_str()) == 0);
+  std::ifstream file(fs::path(out) / "report.md");
+  std::stringstream report;
+  report << file.rdbuf();
+  const std::string text = report.str();
+  CAPTURE(text);
+  CHECK(text.find("| tracking: max error arm (mm) | 20 | 20 |") != std::string::npos);
+  CHECK(text.find("| settle: max error arm (mm) | 4.2 | 4.2 |") != std::string::npos);
+  CHECK(text.find("| hold: max error arm (mm) | 3.1 | 1.8 |") != std::string::npos);
+  CHECK(text.find("| hold: time in it (s) | 588.0 | 588.0 |") != std::string::npos);
+  CHECK(text.find("| hold: excursions past the tolerance (boom / arm / bucket) | 0 / 2 / 0 | 0 / 0 / 0 |") != std::string::npos);
+  CHECK(text.find("| hold: verdict (holding tolerance) | NOT met: worst arm 3.1 mm against 2.5 mm | met: worst arm 1.8 mm against 2.5 mm |") !=
+        std::string::npos);
+  // A phase no run was in has no rows; the note says which phase each figure covers.
+  CHECK(text.find("| stop:") == std::string::npos);
+  CHECK(text.find("Which phase each figure covers") != std::string::npos);
   if (std::getenv("EXC_KEEP_PLOTS") == nullptr) fs::remove_all(dir);
 }
 

@@ -30,6 +30,36 @@ def sim_runs(summary):
     return dict(sorted(runs.items(), key=lambda kv: (order.index(kv[0]) if kv[0] in order else len(order), kv[0])))
 
 
+PHASE_NOTE = ("Which phase each figure covers (the plant's true positions against the pose the firmware "
+              "asks for): *tracking* the path running, a stop along the path included; *settle* each hold's "
+              "start, until every function has stayed inside half the holding tolerance for the settle dwell "
+              "(at most the settle limit): the path's last error dying out; *hold* the firmware holding a pose "
+              "from then on, judged against the holding tolerance; *stop* the safe state after a fault (the "
+              "centred valves' creep). The telemetry's table below is the firmware's own error over every "
+              "logged cycle, all phases together.")
+
+
+def phase_cell(run, phase, text):
+    """A phase's figure, "n/a" when the run never was in it or never tracked."""
+    phases = run.get("phases") or {}
+    figures = phases.get(phase)
+    if not figures or run.get("rms_error") is None:
+        return "n/a"
+    return text(figures)
+
+
+def hold_verdict(run):
+    """The hold against the holding tolerance, as the run's verdict judges it."""
+    hold = (run.get("phases") or {}).get("hold")
+    if not hold or run.get("rms_error") is None:
+        return "n/a (no hold)"
+    tolerance = run.get("holding_tolerance", {})
+    worst = max(("boom", "arm", "bucket"), key=lambda j: hold["max_error"][j] / tolerance.get(j, 2.5e-3))
+    within = run.get("hold_ok", all(hold["max_error"][j] <= tolerance.get(j, 2.5e-3) for j in tolerance))
+    return "%s: worst %s %.3g mm against %.3g mm" % ("met" if within else "NOT met", worst,
+                                                    1e3 * hold["max_error"][worst], 1e3 * tolerance.get(worst, 2.5e-3))
+
+
 def sim_table(runs):
     """excavator-sim's summary as engineers read it: one row per figure, one column per controller."""
     names = list(runs)
@@ -46,7 +76,21 @@ def sim_table(runs):
 
     for key, what in (("rms_error", "RMS error"), ("max_error", "max error")):
         for joint, unit in SIM_JOINTS:
-            row("%s %s (%s)" % (what, joint, unit), lambda r, k=key, j=joint: "%.4g" % (1e3 * r[k][j]))
+            row("tracking: %s %s (%s)" % (what, joint, unit), lambda r, k=key, j=joint: "%.4g" % (1e3 * r[k][j]))
+    # The other phases (PHASE_NOTE says what each covers), from the summary's "phases".
+    for phase, label in (("settle", "settle"), ("hold", "hold"), ("stop", "stop")):
+        if not any(isinstance(r.get("phases"), dict) and r["phases"].get(phase) for r in runs.values()):
+            continue
+        row("%s: time in it (s)" % label, lambda r, p=phase: phase_cell(r, p, lambda f: "%.1f" % f["seconds"]))
+        for key, what in (("rms_error", "RMS error"), ("max_error", "max error")):
+            for joint, unit in SIM_JOINTS:
+                row("%s: %s %s (%s)" % (label, what, joint, unit),
+                    lambda r, p=phase, k=key, j=joint: phase_cell(r, p, lambda f: "%.4g" % (1e3 * f[k][j])))
+        if phase == "hold":
+            row("hold: excursions past the tolerance (boom / arm / bucket)",
+                lambda r: phase_cell(r, "hold", lambda f: " / ".join("%d" % f["excursions"][j]
+                                                                      for j in ("boom", "arm", "bucket"))))
+            row("hold: verdict (holding tolerance)", hold_verdict)
     row("peak soil force (kN)", lambda r: "%.1f" % (1e-3 * r["peak_soil_force"]))
     row("shear re-anchorings", lambda r: "%d" % r["reanchor_count"])
     for q in ("median", "p99", "max"):
@@ -123,6 +167,8 @@ def write_report(runs, summary, title, out_dir, written):
         if isinstance(summary, dict) and isinstance(summary.get("setup"), str):
             lines += ["Scene `%s`: %s." % (summary.get("scene", "?"), summary["setup"]), ""]
         lines += table + [""]
+        if runs_in_summary:
+            lines += [PHASE_NOTE, ""]
     # From the log: the controller's own error e (estimated state against q_d) over every logged
     # cycle, hold included; the summary's figures are the plant's true state while tracking.
     lines += ["## RMS of the controller's error e over the whole log (telemetry)", ""]
