@@ -155,10 +155,10 @@ constexpr std::array<int, 6> kCylinderBodies = {kBoomBarrel, kBoomRod, kArmBarre
 
 }  // namespace
 
-void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators) {
+void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators, const Machine& nominal) {
   const plant::ActuatorFidelityEntry& fidelity = plant::fidelity_of(actuators);
   control::set_command_interface(c, fidelity.takes_valves() ? control::CommandInterface::valve
-                                                            : control::CommandInterface::effort);
+                                                            : control::CommandInterface::effort, nominal);
   c.actuator_lag = fidelity.effort_lag ? fidelity.effort_lag(actuators) : 0.0;
   if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
 }
@@ -173,7 +173,7 @@ app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& sc
   fw.controller = s.controller;
   // The firmware as it is set up for the machine it drives: valves for the hydraulic machine, efforts
   // (with the lag compensated) for the force-commanded ones.
-  configure_for_fidelity(fw.controller, scene.actuators);
+  configure_for_fidelity(fw.controller, scene.actuators, fw.machine);
   return fw;
 }
 

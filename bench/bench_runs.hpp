@@ -93,7 +93,7 @@ struct ClosedLoopResult {
 // The firmware's settings for the machine it drives: the valve interface for a fidelity that takes
 // valve commands (hydraulic), efforts otherwise, with the fidelity's effort lag compensated (limited's;
 // none for ideal ones).
-void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators);
+void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorParameters& actuators, const Machine& nominal);
 
 // The firmware's settings for a closed-loop run of `scene` (the plant's side of s, changed): the
 // bench scene's task and controller set for the scene's actuators, its model the full machine.

@@ -1,6 +1,6 @@
 #pragma once
-// excavator-loop-bench's measurements of the dig scene's closed loop (issue 17, item 3; issue 34's
-// goals): a run's real-time factors with and without lossless telemetry, a long run's first and last
+// excavator-loop-bench's measurements of the dig scene's closed loop against the
+// speed goals set for it: a run's real-time factors with and without lossless telemetry, a long run's first and last
 // second, the floor the loop's two model evaluations set on the same run's states, and the
 // callgrind counts of one model evaluation per node and path. The program (tools/loop_bench) parses
 // its flags, orders the runs and prints the tables' heads.
@@ -18,7 +18,7 @@
 
 namespace exc::bench {
 
-// Issue 34's goals for the dig scene's closed loop, all threads' CPU on one core, and for one
+// The speed goals for the dig scene's closed loop, all threads' CPU on one core, and for one
 // evaluation of the closed-chain model (half of the 14.1k instructions it took before).
 constexpr double kLoggedGoal = 300, kUnloggedGoal = 400, kModelEvaluationGoal = 7.1e3;
 

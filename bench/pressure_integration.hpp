@@ -1,5 +1,5 @@
 #pragma once
-// The pressure-integration chart (issue 14 part 5): how the hydraulic machine's chamber pressures are
+// The pressure-integration chart: how the hydraulic machine's chamber pressures are
 // integrated, as error against CPU time. The machine is driven open loop by valve commands held over
 // kProfileHold each, so every substep (up to the hold) and pressure method integrates the same input
 // from the same state. Two inputs: the commands a closed-loop dig sent (the firmware's pilot

@@ -83,7 +83,7 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
     o["fault_detected_time"] = r.first_fault_detected_time;
     o["fault_code"] = r.first_fault_code;
   }
-  // Judged by the machine (issue 32): when it came to rest for good (plant truth), and whether the
+  // Judged by the machine, not the mode: when it came to rest for good (plant truth), and whether the
   // emergency stop was sent.
   o["machine_at_rest_time"] = r.machine_at_rest_time >= 0 ? nlohmann::json(r.machine_at_rest_time) : nlohmann::json(nullptr);
   o["estop"] = r.estop;

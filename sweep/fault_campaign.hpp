@@ -1,5 +1,5 @@
 #pragma once
-// The fault campaign (issue 16, docs/sweeps.md): a sweep whose cases each carry one random fault.
+// The fault campaign (docs/sweeps.md): a sweep whose cases each carry one random fault.
 // Kept apart from the sweep's reading, sharding and merging (sweep.cpp): the fault a case draws, the
 // schedule the harness injects, a run's outcome, and the merge's count of outcomes per controller
 // and fault kind.

@@ -1,6 +1,6 @@
 #pragma once
 // Robustness of the controllers on one scene: the same run with the controller's model, the sensors
-// or the soil made wrong on purpose (issue 5: +-20 % model mass, sensor noise and delay, a soil three
+// or the soil made wrong on purpose (+-20 % model mass, sensor noise and delay, a soil three
 // times stiffer than the controller's nominal estimate), PID against adaptive in each. The variants
 // are a sweep spec's (sweeps/robustness.yaml), run through the sweep's cases.
 #include <ostream>

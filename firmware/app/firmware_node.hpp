@@ -4,8 +4,9 @@
 //   begin_cycle(): send SYNC(k) (+ heartbeat)              -> the plant steps once and answers
 //   end_cycle():   read + validate sensors -> supervisor (operator, machine signals) -> state
 //                  machine -> estimate -> path -> control law -> supervisor's checks -> actuation
-//                  stage (blend and lag lead, or the valve stage) -> write commands -> telemetry
-//                  (estimate to actuation: the control step, control_step.hpp)
+//                  stage (blend and lag lead, or the valve stage) -> the valve stage's monitors ->
+//                  write commands -> telemetry (estimate to the monitors: the control step,
+//                  control_step.hpp, timed as one stage and in parts)
 // Time is the cycle count times the period, so a run is deterministic and the plant's time is the
 // firmware's. Nothing here allocates, locks or blocks after construction.
 #include <cmath>

@@ -10,6 +10,7 @@
 #include "model/model.hpp"
 #include "model/scene_common_reader.hpp"
 #include "control/controller_config_reader.hpp"
+#include "control/controller_registry.hpp"
 #include "control/task_reader.hpp"
 
 namespace exc::app {
@@ -58,6 +59,27 @@ void check_task_efforts(FirmwareSettings& s) {
   for (control::DigWaypoint& w : task.path) w.t = t0 + (w.t - t0) * task.timing_scale;
 }
 
+// Each law the scene may run (the one it names, else every law its command interface carries) built
+// once while the file is at hand, so that what only a law's construction can find (eq. 24's Lyapunov
+// equation without a positive definite solution) is refused at the scene's line and key, not as a
+// bare message when a run starts. A law's SettingsError names its key (controller.kv, ...) and no
+// file: the file is this scene's.
+void check_laws_build(const FirmwareSettings& s) {
+  const Model model = build_model(s.machine);
+  for (const control::ControllerEntry& law : control::controller_registry().entries()) {
+    if (s.controller.law_given ? law.name != s.controller.law
+                               : !control::interface_misfit(law, s.controller.command_interface).empty())
+      continue;
+    control::ControllerConfig c = s.controller;
+    c.law = law.name;
+    try {
+      law.make(model, c);
+    } catch (const SettingsError& e) {
+      throw SettingsError(s.file, 0, 0, e.field(), "the " + law.name + " law cannot be built: " + e.reason());
+    }
+  }
+}
+
 // A paced path (controller.pump_pacing) takes longer than its times say: a run that covered the
 // path covers the paced one, estimated without the clock's lag, plus a tenth and the lag's settling
 // (4 T) for what the lag adds.
@@ -86,13 +108,13 @@ FirmwareSettings read_firmware_settings(const settings::Document& scene, const S
   s.terrain = common.terrain;
   s.duration = s.scene_duration = common.duration;
   settings::SectionReader controller = top.section("controller", "the control law's settings");
-  s.controller = control::controller_defaults(s.machine);
-  control::read_controller_config(controller, s.controller);
+  control::read_controller_config(controller, s.controller, s.machine);
   settings::SectionReader task = top.section("task", "what the machine does");
   s.task = control::read_task(task, s.machine);
   top.others(kPlantSceneSections);
   top.finish();
   try {
+    check_laws_build(s);
     check_task_efforts(s);
     extend_for_pump_pacing(s);
   } catch (const SettingsError& e) {

@@ -3,7 +3,7 @@
 // (docs/floating-point.md). While the machine holds, decaying states (the velocity filters, the
 // spool lead, the plant's spool lag) fall into the subnormal range and stay there; x86-64 handles a
 // subnormal operand or result in microcode, many times slower, so without this a cycle's cost grew
-// with the time the machine had stood still (issue 34: the control step 4-5x slower after a minute).
+// with the time the machine had stood still (the control step had run 4-5x slower after a minute).
 // The loop's mode flushes them: a result below the smallest normal number (2.2e-308) becomes zero
 // and a subnormal operand is read as zero. x86-64: MXCSR FTZ (bit 15) and DAZ (bit 6); AArch64:
 // FPCR.FZ (bit 24), which does both. The mode belongs to a thread; Linux copies it into the threads

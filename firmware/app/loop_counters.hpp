@@ -35,7 +35,8 @@ enum class LoopStage : std::int8_t {
   estimate = 7,   // the state estimator and the path's desired motion
   law = 8,        // the control law
   actuation = 9,  // the stages after the law: blend and lag lead, or the valve stage
-  monitors = 10,  // the supervisor's checks of the law's output, the pressures and the flow
+  monitors = 10,  // the supervisor's checks of the law's output, the pressures, the pumps' demand,
+                  // the flow and the spools
 };
 
 // The stages published each round, the interval aside (it is published once a real-time loop has one).

@@ -30,13 +30,13 @@ AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const Control
     Vec12 q;
     q << config.lyapunov_q_integral, config.lyapunov_q;
     if (!solve_lyapunov(A, Mat12(q.asDiagonal()), P_))
-      throw SettingsError("<controller>", 0, 0, "controller.kp/kv/ki", "A^T P + P A + Q = 0 has no SPD solution");
+      throw SettingsError("", 0, 0, "controller.ki", "A^T P + P A + Q = 0 (integral states) has no positive definite solution for kp, kv, ki and lyapunov_q_integral");
   } else {
     gains.ki.setZero();  // the paper's law: no integral state, zero rows and columns of P for it
     const Mat8 A = error_dynamics_matrix(gains.kp, gains.kv);
     Mat8 P8;
     if (!solve_lyapunov(A, Mat8(config.lyapunov_q.asDiagonal()), P8))
-      throw SettingsError("<controller>", 0, 0, "controller.kp/kv", "A^T P + P A + Q = 0 has no SPD solution");
+      throw SettingsError("", 0, 0, "controller.kv", "A^T P + P A + Q = 0 has no positive definite solution for kp, kv and lyapunov_q");
     P_.bottomRightCorner<8, 8>() = P8;
   }
   feedback_.set_gains(gains);

@@ -59,6 +59,16 @@ void visit_fields(Visitor& v, ExternalForceSettings& e) {
   v("dead_zone", e.dead_zone);
 }
 
+// Which of the values that follow the machine, the command interface and other settings the scene
+// gave itself; the others derive_defaults fills. The host's business: not in the settings blob.
+struct GivenSettings {
+  bool force_time_constant = false, spool_lag_target = false, position_gain = false;  // valves.*
+  bool velocity_floor = false, frozen_speed = false;                                  // plausibility.*
+  bool adaptation_rate = false, tracking_dead_zone = false;
+  bool observer_cutoff = false;  // external_force.cutoff_hz
+  bool tracking_error_limit = false;
+};
+
 // The longest control law's name the settings blob carries.
 inline constexpr std::size_t kMaxLawName = 64;
 
@@ -84,9 +94,6 @@ struct ControllerConfig {
   // standard dead-zone modification). Default on valves: the valve stage's hold window, the error the
   // valves cannot resolve; 0 on efforts (eq. 27 as published).
   Vec4 tracking_dead_zone = Vec4::Zero();
-  // The rates above were the default's, derived for the command interface (x period / T_f on valves:
-  // valve_adaptation_scale), not given by the scene.
-  bool adaptation_rate_derived = true;
   // Physical bounds of the soil parameters (machine.md): M 50..500 kg, B 1e3..3e4 N s/m,
   // K 1e4..1e6 N/m; and the initial estimate.
   Vec6 theta_min = (Vec6() << 50, 1e3, 1e4, 50, 1e3, 1e4).finished();
@@ -143,7 +150,6 @@ struct ControllerConfig {
   // (kValveMachineReach); on the effort interface (the paper's force actuators, whose PID baseline
   // errs up to 0.12 m on the bucket in its dig) about twice that baseline's worst, 0.5-1 m at the tip.
   Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();
-  bool tracking_error_limit_derived = true;  // not given: follows the command interface
   double blend_time = 0.2;          // s, bumpless switch fade
   // A stop along the path (an operator's stop, a stop request) slows the path so that each function
   // decelerates at most its top speed per this time (path_stop.hpp): a function at top speed stops
@@ -155,6 +161,9 @@ struct ControllerConfig {
   // tracking limit stops it.
   bool pump_pacing = false;
   double pump_pacing_share = 0.9;
+
+  // Which derived values the scene gave (derive_defaults leaves those alone).
+  GivenSettings given;
 
   static PidGains default_gains() {
     PidGains g;
@@ -168,8 +177,8 @@ struct ControllerConfig {
   }
 };
 // The settings blob's field list (app/settings_blob.hpp): a field added above that the cycle reads is
-// added here too. Left out: law_given, adaptation_rate_derived and tracking_error_limit_derived, which
-// say how the reader came by a value (the host's business, before the blob is made).
+// added here too. Left out: law_given and given, which say how the reader came by a value (the host's
+// business, before the blob is made).
 template <typename Visitor>
 void visit_fields(Visitor& v, ControllerConfig& c) {
   v("law", c.law, kMaxLawName);
@@ -208,8 +217,6 @@ void visit_fields(Visitor& v, ControllerConfig& c) {
   v("pump_pacing_share", c.pump_pacing_share);
 }
 
-// The defaults a nominal machine implies (before the scene's section is read): the force loop's T_f
-// is its spools' time constant (at least 5 ms), the spool lead aims at a third of it.
 // The flow plausibility floor as a share of each function's top speed (Machine::speed_max): the
 // shipped hydraulic scenes' fault-free figures stay inside it (test firmware/plausibility prints the
 // margins), and a spool stuck at a share s of its opening is found after about share / s windows.
@@ -226,15 +233,21 @@ inline constexpr double kFrozenSpeedShare = 0.02;
 inline constexpr double kValveMachineReach[4] = {0.0078, 0.0074, 0.0191, 0.0104};
 // The default tracking-error limit on the valve interface, in multiples of that reach: well clear of
 // every fault-free run (the worst is a fifth of it by construction), and far closer than the fixed
-// 0.1 rad / 0.2 m (10-27x the reach) that let a stuck spool run 1.45 s (issue 32).
+// 0.1 rad / 0.2 m (10-27x the reach) that let a stuck spool run 1.45 s.
 inline constexpr double kTrackingLimitMultiple = 5;
 // The default tracking-error limit for a command interface (ControllerConfig::tracking_error_limit).
 Vec4 default_tracking_error_limit(CommandInterface interface);
-ControllerConfig controller_defaults(const Machine& nominal);
 // Through the valves eq. 27's default rates are the force-commanded machine's times this (period / T_f).
 double valve_adaptation_scale(const ControllerConfig& c);
-// Switches the command interface of a configuration (a bench variant on other actuators), carrying
-// the default rates that depend on it with it.
-void set_command_interface(ControllerConfig& c, CommandInterface interface);
+// Every default that follows the nominal machine, the command interface or another setting, in this
+// one place; a value the scene gave (c.given) is left alone. Idempotent: the reader calls it before
+// each derived key is read (so the effective dump shows what it derived to), a bench after it
+// switches the interface. The derivations and their reasons: docs/control.md.
+void derive_defaults(ControllerConfig& c, const Machine& nominal);
+// The configuration a scene without a `controller:` section gets on `nominal`.
+ControllerConfig controller_defaults(const Machine& nominal);
+// Switches the command interface of a configuration (a bench variant on other actuators), the
+// defaults that follow it derived again.
+void set_command_interface(ControllerConfig& c, CommandInterface interface, const Machine& nominal);
 
 }  // namespace exc::control

@@ -53,7 +53,10 @@ void check_nyquist(const SectionReader& f, const ControllerConfig& c) {
 
 }  // namespace
 
-void read_controller_config(SectionReader& r, ControllerConfig& c) {
+void read_controller_config(SectionReader& r, ControllerConfig& c, const Machine& nominal) {
+  // The derived defaults (derive_defaults) are filled before each derived key is read, from the
+  // values read so far, so that the effective dump shows what each derived to.
+  derive_defaults(c, nominal);
   r.choice("type", c.law, c.law_given, controller_registry(),
            "the control law to run (absent: the program's choice; excavator-sim runs pid and adaptive)");
   r.number("period", c.period, {1e-5, 0.1}, "s", "control period (the update law integrated at it)");
@@ -64,15 +67,17 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   r.numbers("lyapunov_q", c.lyapunov_q, kWeight, "", "Q of A^T P + P A + Q = 0, [e; ed] order (eqs. 21-25)");
   r.choice("command_interface", c.command_interface, kCommandInterfaces, "what the firmware commands on the bus");
   SectionReader v = r.section("valves", "the valve stage between the law and a hydraulic machine's valves");
+  c.given.force_time_constant = v.value_given("force_time_constant");
+  c.given.spool_lag_target = v.value_given("spool_lag_target");
+  c.given.position_gain = v.value_given("position_gain");
+  derive_defaults(c, nominal);
   v.number("force_time_constant", c.valves.force_time_constant, {1e-3, 1}, "s", "T_f: the force loop's time constant");
   v.number("force_integral_time", c.valves.force_integral_time, {0, 100}, "s",
            "T_i of the force loop's integral (0: none; docs/control.md)");
   v.number("spool_lag_target", c.valves.spool_lag_target, {0, 1}, "s",
            "the spool lag the lead aims for (0: no lead); at most the machine's valve_time_constant");
   v.number("opening_band", c.valves.opening_band, {0, 0.5}, "", "opening below which the dead-zone inverse is linear");
-  // Derived: a fifth of the force loop's bandwidth, so the position correction the flow feedforward
-  // carries stays clear of the loop that delivers it (docs/control.md).
-  if (!v.value_given("position_gain")) c.valves.position_gain = Vec4::Constant(1 / (5 * c.valves.force_time_constant));
+  derive_defaults(c, nominal);  // the position gain follows T_f
   v.numbers("position_gain", c.valves.position_gain, {0, 1e3}, "1/s",
             "flow feedforward qd_d - position_gain e: the valve stage's own position correction (default: 1 / (5 T_f))");
   v.numbers("hold_window", c.valves.hold_window, {0, 0.1}, "",
@@ -81,6 +86,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
            "holding a pose: the low-pass on the error the in-position judgement reads (0: none; docs/control.md)");
   v.finish();
   SectionReader pl = r.section("plausibility", "commanded against measured velocity per function, valve interface (docs/safety.md)");
+  c.given.velocity_floor = pl.value_given("velocity_floor");
+  c.given.frozen_speed = pl.value_given("frozen_speed");
   pl.flag("enabled", c.plausibility.enabled, "the monitor runs (a fault, emergency stop, when a function moves unlike its command)");
   pl.numbers("velocity_floor", c.plausibility.velocity_floor, {1e-4, 10}, "",
              "rad/s (swing), m/s: how much more flow per piston area than commanded may arrive, averaged over the window (default: kPlausibilityVelocityShare of its top speed)");
@@ -116,14 +123,9 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
             "of the stroke: an expected spool nearer neutral than this counts as neutral commanded");
   sm.whole("debounce", c.spool_monitor.debounce, 1, 1000, "", "sensor sets in a row a test must fail");
   sm.finish();
-  // Derived: eq. 27 reads the tracking error as the soil's doing. Through the valves the effort arrives
-  // through the force loop's T_f, whose lag the update would read as soil: the rates are those of the
-  // force-commanded machine scaled by period / T_f (docs/control.md).
-  c.adaptation_rate_derived = !r.value_given("adaptation_rate");
-  if (c.adaptation_rate_derived && c.command_interface == CommandInterface::valve)
-    c.adaptation_rate *= valve_adaptation_scale(c);
-  if (!r.value_given("tracking_dead_zone") && c.command_interface == CommandInterface::valve)
-    c.tracking_dead_zone = c.valves.hold_window;
+  c.given.adaptation_rate = r.value_given("adaptation_rate");
+  c.given.tracking_dead_zone = r.value_given("tracking_dead_zone");
+  derive_defaults(c, nominal);  // eq. 27's rates and dead zone follow the interface, the period, T_f and the hold window
   r.numbers("tracking_dead_zone", c.tracking_dead_zone, {0, 1}, "",
             "rad (swing), m: eq. 27 leaves a joint out while |e| is below it (default on valves: valves.hold_window)");
   r.numbers("adaptation_rate", c.adaptation_rate, kRate, "",
@@ -144,9 +146,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
   f.finish();
   SectionReader ef = r.section("external_force", "the external force observer and the composite update (beyond the paper)");
   ef.flag("observer", c.external_force.observer, "add the observer's estimate of what the model misses to eq. 12's command");
-  // Derived: the observer differentiates nothing itself, but its residual carries the filtered
-  // acceleration, so it stays well inside that filter's band.
-  if (!ef.value_given("cutoff_hz")) c.external_force.cutoff_hz = c.filter.acceleration_cutoff_hz / 3;
+  c.given.observer_cutoff = ef.value_given("cutoff_hz");
+  derive_defaults(c, nominal);  // the observer's cut-off follows the acceleration filter's
   ef.number("cutoff_hz", c.external_force.cutoff_hz, {0.01, 1e3}, "Hz",
             "the observer's low-pass (default: a third of filters.acceleration_cutoff_hz)");
   ef.number("identification_memory", c.external_force.identification_memory, {0, 1e6}, "s",
@@ -164,8 +165,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
            "without a SUPERVISOR frame once a keep-alive was heard -> the operator's stop (0: not monitored)");
   r.whole("max_missed_deadlines", c.max_missed_deadlines, 1, 100000, "",
           "real time: wake-ups in a row after their deadline that are a fault (controlled stop)");
-  c.tracking_error_limit_derived = !r.value_given("tracking_error_limit");
-  if (c.tracking_error_limit_derived) c.tracking_error_limit = default_tracking_error_limit(c.command_interface);
+  c.given.tracking_error_limit = r.value_given("tracking_error_limit");
+  derive_defaults(c, nominal);
   r.numbers("tracking_error_limit", c.tracking_error_limit, {1e-4, 10}, "",
             "rad (swing), m: above it the firmware faults (default on valves: 5x what the machine reaches)");
   r.number("blend_time", c.blend_time, {0, 10}, "s", "bumpless switch fade");
@@ -190,7 +191,7 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
     if (const std::string why = interface_misfit(controller_registry().at(c.law), c.command_interface); !why.empty())
       r.fail("type", why);
   }
-  c.filter.period = c.period;
+  derive_defaults(c, nominal);  // the filters' period
   check_nyquist(f, c);
   if (!(c.external_force.cutoff_hz < c.filter.acceleration_cutoff_hz))
     ef.fail("cutoff_hz", format_number(c.external_force.cutoff_hz) + " Hz must be below filters.acceleration_cutoff_hz = " +
@@ -201,8 +202,8 @@ void read_controller_config(SectionReader& r, ControllerConfig& c) {
 ControllerConfig read_controller_config(const settings::Document& scene, const Machine& nominal) {
   SectionReader top(scene);
   SectionReader controller = top.section("controller", "the control law's settings");
-  ControllerConfig c = controller_defaults(nominal);
-  read_controller_config(controller, c);
+  ControllerConfig c;
+  read_controller_config(controller, c, nominal);
   return c;
 }
 

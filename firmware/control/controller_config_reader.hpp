@@ -9,10 +9,10 @@
 
 namespace exc::control {
 
-// Reads the `controller:` section into c (a field the section does not give keeps c's value, which
-// is range-checked like a given one and recorded), then the cross-field rules (min < initial < max,
-// Hurwitz gains, ...).
-void read_controller_config(settings::SectionReader& controller, ControllerConfig& c);
+// Reads the `controller:` section into c (a field the section does not give keeps c's value, or the
+// value derive_defaults derives for it on `nominal`; either is range-checked like a given one and
+// recorded), then the cross-field rules (min < initial < max, Hurwitz gains, ...).
+void read_controller_config(settings::SectionReader& controller, ControllerConfig& c, const Machine& nominal);
 // The `controller:` section of a parsed scene file (absent: the defaults), the rest of the file left to
 // its readers: a sweep's case that changes only controller settings reads them again so.
 ControllerConfig read_controller_config(const settings::Document& scene, const Machine& nominal);

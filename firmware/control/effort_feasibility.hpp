@@ -1,5 +1,5 @@
 #pragma once
-// Effort feasibility of a task before the run (issue 16): the model's inverse dynamics along the
+// Effort feasibility of a task before the run: the model's inverse dynamics along the
 // whole desired trajectory, every control period, against the actuators' limits. Where the tip is
 // below the terrain the soil will take part of the effort, so there only (1 - soil_margin) of each
 // limit is counted as available.

@@ -32,7 +32,7 @@ task:
     - {t: 8.0, q: [0.0, 2.45, 2.40, 2.10]}
 )";
 
-// Issue 16's task: the swing turns 2 rad in 2.5 s, inside its speed limit but needing about 4.5x the
+// A saturating task: the swing turns 2 rad in 2.5 s, inside its speed limit but needing about 4.5x the
 // swing motor's torque.
 inline const char* kFastSwingTask = R"(
 task:

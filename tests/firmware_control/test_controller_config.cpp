@@ -50,8 +50,8 @@ TEST_CASE("firmware/controller config: the tracking-error limit defaults by comm
   CHECK(given.tracking_error_limit == (Vec4() << 0.3, 0.4, 0.5, 0.6).finished());
   // A bench variant switching the interface carries a derived limit with it, a given one not.
   ControllerConfig switched = effort, kept = given;
-  set_command_interface(switched, CommandInterface::valve);
-  set_command_interface(kept, CommandInterface::effort);
+  set_command_interface(switched, CommandInterface::valve, reference_machine());
+  set_command_interface(kept, CommandInterface::effort, reference_machine());
   CHECK(switched.tracking_error_limit == valve.tracking_error_limit);
   CHECK(kept.tracking_error_limit == given.tracking_error_limit);
 }

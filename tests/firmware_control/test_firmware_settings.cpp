@@ -8,6 +8,7 @@
 
 #include "app/firmware_node.hpp"
 #include "app/firmware_settings.hpp"
+#include "control/controller_registry.hpp"
 #include "control/effort_feasibility.hpp"
 #include "scenes.hpp"
 #include "settings_error_check.hpp"
@@ -78,6 +79,34 @@ TEST_CASE("firmware/settings refuse a flow law on the effort interface, naming b
               "flow commands the valves' flow: it needs command_interface: valve");
   CHECK(read("name: x\nduration: 2\ncontroller: {type: flow, command_interface: valve}\n" + std::string(kTask))
             .controller.law == "flow");
+}
+
+// A law whose construction refuses its settings, as the adaptive law refuses gains whose Lyapunov
+// equation has no positive definite solution: a swing position gain above 500 (a test law).
+class PickyLaw final : public control::Controller {
+ public:
+  explicit PickyLaw(const control::ControllerConfig& c) {
+    if (c.gains.kp[0] > 500) throw SettingsError("", 0, 0, "controller.kp", "the picky law takes a swing gain of at most 500");
+  }
+  void reset() override {}
+  control::ControlOutput update(const control::ControlInput&) override { return {}; }
+};
+
+TEST_CASE("firmware/settings name the file, line and key of a settings error only a law's construction finds") {
+  static const bool registered = [] {
+    control::register_controller({"picky", "refuses a swing gain above 500 when built (a test law)",
+                                  control::build_law<PickyLaw>, control::kAnyInterface});
+    return true;
+  }();
+  (void)registered;
+  const std::string scene = "name: x\nduration: 2\ncontroller:\n  type: picky\n  kp: [600, 64, 64, 64]\n" + std::string(kTask);
+  check_error(scene, "controller.kp", "[600", "the picky law cannot be built: the picky law takes a swing gain of at most 500");
+  // Named or not, a law the scene may run is built: with no type, every law its interface carries.
+  check_error("name: x\nduration: 2\ncontroller:\n  kp: [600, 64, 64, 64]\n" + std::string(kTask), "controller.kp", "[600",
+              "the picky law cannot be built");
+  // The control: within its range the scene reads.
+  CHECK(read("name: x\nduration: 2\ncontroller:\n  type: picky\n  kp: [400, 64, 64, 64]\n" + std::string(kTask)).controller.law ==
+        "picky");
 }
 
 TEST_CASE("firmware/settings derive the defaults a scene leaves out from the machine, the interface and the other settings, and keep what it gives") {
@@ -151,7 +180,7 @@ TEST_CASE("firmware/settings name the file when it is missing or not YAML") {
 
 namespace {
 
-// Issue 16's scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
+// A saturating scene: a 2 rad swing in 2.5 s, inside the swing's speed limit but not its torque.
 std::string fast_swing_scene(const std::string& efforts, const std::string& duration = "3") {
   std::string task = exc::control::sim::kFastSwingTask;
   const std::string type = "  type: joint_waypoints\n";

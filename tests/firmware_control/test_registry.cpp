@@ -1,4 +1,4 @@
-// Issue 33's "one file to add a thing": a control law defined here, in this file alone, registered
+// "One file to add a thing": a control law defined here, in this file alone, registered
 // with one call, then named by a scene's controller.type and run the way excavator-sim runs a scene
 // (scene reader, firmware node and hydraulic plant in lockstep over the in-memory bus). Its commands
 // must reach the machine: the law asks the arm's valve for a constant flow and nothing else, the task

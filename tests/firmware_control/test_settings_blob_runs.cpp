@@ -45,8 +45,8 @@ void poison_left_out(app::FirmwareImageSettings& s) {
   h.swing_brake_torque = kNaN;
   control::ControllerConfig& c = s.node.controller;
   c.law_given = !c.law_given;
-  c.adaptation_rate_derived = !c.adaptation_rate_derived;
-  c.tracking_error_limit_derived = !c.tracking_error_limit_derived;
+  c.given.adaptation_rate = !c.given.adaptation_rate;
+  c.given.tracking_error_limit = !c.given.tracking_error_limit;
   control::Task& t = s.task;
   t.waypoint_times.assign(1, kNaN);
   t.swing = kNaN;

@@ -1,4 +1,4 @@
-// The hydraulic machine's failure regions (issue 14 part 5), each found and reported by a check, a
+// The hydraulic machine's failure regions, each found and reported by a check, a
 // counter of the run or a firmware fault, never by a NaN, and each figure against evidence from
 // outside the code: pump flow saturation in a multi-function move (the pumps' whole flow, read off
 // the mechanism's motion), cavitation in a fast boom-down (the make-up valves' capacity in closed

@@ -1,4 +1,4 @@
-// Issue 33's "one file to add a thing", for actuator fidelities: slow force actuators (the commanded
+// "One file to add a thing", for actuator fidelities: slow force actuators (the commanded
 // efforts through a first-order lag of 50 ms, no clamp, no stops) defined here, in this file alone,
 // registered with one call, named by a scene's actuators.fidelity and run on the plant. Checked
 // against closed forms: the effort's step response hold + d (1 - exp(-t / T)) at every cycle, and the

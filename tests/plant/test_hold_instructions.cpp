@@ -1,4 +1,4 @@
-// Instructions per cycle late in a long hold against early in it (issue 34): the whole loop (the
+// Instructions per cycle late in a long hold against early in it (subnormal numbers must not slow a held loop): the whole loop (the
 // firmware's cycle, the CAN frames, the plant's step) counted by callgrind over 1000 cycles from 11 s
 // (the path ends at 10.05 s) and over the last 1000 of a 60 s run, for each law. A cost that grows
 // with the run's history (a search over what was logged, an iteration that needs more steps the

@@ -1,4 +1,4 @@
-// Issue 33's "one file to add a thing", for integrators: explicit (forward) Euler defined here, in
+// "One file to add a thing", for integrators: explicit (forward) Euler defined here, in
 // this file alone, registered with one call, named by a scene's integrator.method and stepping the
 // plant. Checked against its closed form (a step from rest leaves the position where it was and
 // gives the velocity h a, where semi-implicit Euler already moves the position by h^2 a) and against

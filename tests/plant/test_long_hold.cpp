@@ -1,4 +1,4 @@
-// A cycle's cost must not depend on the run's history (issue 34, docs/floating-point.md). The dig
+// A cycle's cost must not depend on the run's history (docs/floating-point.md). The dig
 // scene's path ends at 10.05 s and the machine then holds; in a long hold the decaying states of the
 // firmware and the plant fell into the subnormal range, which this processor computes many times
 // slower. Counted, not timed: every value either node carries from one cycle to the next is looked

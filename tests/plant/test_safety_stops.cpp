@@ -171,7 +171,7 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
 }
 
 TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x what the machine reaches, stops a boom stuck half open with the velocity and spool monitors off within 0.3 s, where the effort interface's fixed 0.2 m took 1.4 s") {
-  // Issue 32: with the fixed 0.2 m limit (17x the valve machine's worst error) the tracking error
+  // With the fixed 0.2 m limit (17x the valve machine's worst error) the tracking error
   // found a stuck boom spool after 1.45 s. The dig scene, the boom's spool stuck at +0.5 from 3 s
   // (extending at about 0.13 m/s against a path that goes the other way), the flow monitor off so
   // that the tracking limit is the only monitor: the default limit's 37 mm is crossed within

@@ -254,7 +254,7 @@ TEST_CASE("tools/excavator-sim names the file and field of a bad scene and exits
   CHECK(help.out.find("--json") != std::string::npos);
 }
 
-TEST_CASE("tools/excavator-sim refuses issue 16's too-fast swing before the run, and forced, stops it safely with the reason and exit 1") {
+TEST_CASE("tools/excavator-sim refuses a too-fast swing before the run, and forced, stops it safely with the reason and exit 1") {
   const std::string free_motion = std::string(EXC_SOURCE_DIR) + "/scenes/free_motion.yaml";
   std::string text = read_text_file(free_motion);
   const std::string from = "    - {t: 2.0, q: [0.4, 2.70, 2.60, 1.90]}";

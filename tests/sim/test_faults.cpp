@@ -1,4 +1,4 @@
-// Issue 16 as a user meets it through excavator-sim: a path fitted to the actuators runs to its end,
+// A path the actuators cannot follow, as a user meets it through excavator-sim: a path fitted to the actuators runs to its end,
 // the shipped scenes do not trip the tracking-error fault (but flow-based control where the swing
 // moves), and a forced trip is in the log and the report with its code and its reason.
 #include <doctest/doctest.h>
@@ -28,7 +28,7 @@ const std::string kFreeMotion = std::string(EXC_SOURCE_DIR) + "/scenes/free_moti
 // swing past its limit (below), and is left out of the default controllers.
 const std::set<std::string> kSwingLags{"free_motion.yaml", "truck_loading.yaml", "truck_clay_slope.yaml"};
 
-// Issue 16's swing in a free-motion scene (2 rad in 2.5 s where it turns 0.4 rad in 2 s), with the
+// A saturating swing in a free-motion scene (2 rad in 2.5 s where it turns 0.4 rad in 2 s), with the
 // task's `efforts:` mapping and any further edits.
 fs::path fast_swing(const std::string& efforts, const std::string& stem,
                     std::vector<std::pair<std::string, std::string>> edits = {}, const std::string& scene = kFreeMotion) {
@@ -55,7 +55,7 @@ nlohmann::json saturated_swing(const std::string& scene, const std::string& stem
 
 }  // namespace
 
-TEST_CASE("tools/excavator-sim runs issue 16's swing fitted to the actuators end to end: the run's duration stretched with the path and said in the setup line, the task finished") {
+TEST_CASE("tools/excavator-sim runs a too-fast swing fitted to the actuators end to end: the run's duration stretched with the path and said in the setup line, the task finished") {
   const fs::path scene = fast_swing("{fit_timing: true}", "fitted_swing");
   const exc::sim::SceneBundle bundle = exc::sim::load_scene_bundle(scene.string());
   const double scale = bundle.firmware.task.timing_scale;
@@ -169,7 +169,7 @@ TEST_CASE("tools/excavator-sim: a forced trip of the tracking-error fault is on 
   CHECK(report.find("| status | FAILED: " + failure + " |") != std::string::npos);
 }
 
-TEST_CASE("tools/excavator-sim: in issue 16's saturated swing with no soil the adaptive law's arm and bucket errors are within 1.5x of PID's, tens of times PID's only where the firmware takes itself to be in soil") {
+TEST_CASE("tools/excavator-sim: in a saturated swing with no soil the adaptive law's arm and bucket errors are within 1.5x of PID's, tens of times PID's only where the firmware takes itself to be in soil") {
   // The tip stays above the ground (docs/control.md, "Saturation and the soil term"): no contact is
   // estimated, so the law has no soil term and no update (its estimates end where they began): it
   // is the PD computed torque, PID's law without the integral. On the paper's force actuators and

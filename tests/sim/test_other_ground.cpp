@@ -1,4 +1,4 @@
-// Control on ground it was not tuned for (issue 31): the shipped scenes of other soils, slopes, speeds,
+// Control on ground it was not tuned for: the shipped scenes of other soils, slopes, speeds,
 // sensors and work cycles, every law on its defaults, run as a user runs them.
 #include <doctest/doctest.h>
 

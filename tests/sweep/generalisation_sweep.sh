@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The generalisation sweep (issue 31 item 6) in small: the shipped spec cut to 4 cases (12 runs of the
+# The generalisation sweep in small: the shipped spec cut to 4 cases (12 runs of the
 # dig, every law on its defaults), through tools/sweep/parallel-sweep in 2 shards, merged, and
 # tools/sweep/plot_generalisation.py's table and charts. Checks the merged table's columns and drawn
 # values against the spec's ranges, the criterion's count against the table recomputed here, and that

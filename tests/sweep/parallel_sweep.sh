@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# tools/sweep/parallel-sweep itself (issue 17): 8 cases in 4 shards through GNU parallel, one shard
+# tools/sweep/parallel-sweep itself: 8 cases in 4 shards through GNU parallel, one shard
 # failing. The script must merge the three shard files there are, name the missing shard's cases
 # (1 and 5) and exit 1; the rows it has equal the single process's. Then --resume-failed reruns the
 # failed shard alone and the merged table equals the single process's byte for byte.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sweep through a real one-node Slurm cluster (issue 17): the same spec run by one process and
+# The sweep through a real one-node Slurm cluster: the same spec run by one process and
 # as a 4-task job array (tools/sweep/slurm-sweep.sbatch), merged by a job that depends on the array
 # (the README's recipe), must give the same table, case for case.
 #   slurm_sweep.sh EXC_SIM SPEC_TEMPLATE SCENE WORK

@@ -9,7 +9,7 @@
 #   kill-firmware  the firmware is killed mid-run: the plant holds and says so (PLANT_EMERGENCY).
 #   no-plant       (not in all) the firmware alone on the bus: nothing answers, so it never tracks;
 #                  it must say so: exit 1, ok false, the reason, its tracking figures null (not 0).
-#   ack            (not in all) issue 32's capture: the arm's spool sticks (the plant's --stuck-spool),
+#   ack            (not in all) the acknowledge capture: the arm's spool sticks (the plant's --stuck-spool),
 #                  the firmware's emergency stop holds until excavator-operator's acknowledge frame;
 #                  then the plant is frozen (SIGSTOP: a sensor timeout), the stop holds again until a
 #                  second acknowledge. --ack-check judges the capture on the host.
@@ -435,7 +435,7 @@ scenario_no_plant() {
   grep -q 'FAILED: the firmware never tracked' "$dir/firmware.out" || fail "with no plant the firmware did not say it never tracked"
 }
 
-# Issue 32's capture: a stuck spool, then a sensor timeout, each stop held until an acknowledge.
+# The acknowledge capture: a stuck spool, then a sensor timeout, each stop held until an acknowledge.
 # Every wait counts cycles on the bus (SYNC frames), never wall-clock time.
 sends_at_least() { [ "$(grep -c " $2#" "$1" 2>/dev/null)" -ge "$3" ]; }
 # The firmware on vcan0 for LONG simulated seconds (dir, long): fw_pid, and give_up to end the scenario.

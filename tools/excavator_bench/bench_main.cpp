@@ -1,4 +1,4 @@
-// excavator-bench: speed against accuracy (issues 8 and 14). One run writes the work-precision chart,
+// excavator-bench: speed against accuracy. One run writes the work-precision chart,
 // the pressure-integration chart, the fidelity chart, the stability maps and the MuJoCo comparison
 // (CSV + PNG each), a summary table on stdout and --json FILE. `excavator-bench export-mjcf` writes the machine as MJCF.
 #include <CLI/CLI.hpp>

@@ -1,4 +1,4 @@
-// excavator-loop-bench: the closed loop's real-time factor (issue 17, item 3). The dig scene's whole
+// excavator-loop-bench: the closed loop's real-time factor. The dig scene's whole
 // in-process loop (firmware, CAN codec and in-memory bus, plant, lossless telemetry into an LCM log)
 // through the harness every tool uses, medians over repeats; the floor the loop's two model
 // evaluations set (the plant's forward dynamics, the firmware's M_a and h_a) on the same run's

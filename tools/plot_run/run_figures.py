@@ -86,8 +86,8 @@ def last_of_stage(timing, stage):
 
 def plot_timing(plt, runs, out_dir, written):
     # Stage 0 of EXC_TIMING, the whole firmware cycle; the summary's "control step" is stage 2 (the
-    # update: estimate, path and law), a part of it: both are named, so that the figures are not
-    # taken for one another.
+    # update: estimate, path, law, the stages after it and the monitors), a part of it: both are
+    # named, so that the figures are not taken for one another.
     fig, axes = new_figure(plt, 1, 1, "Firmware cycle timing: the whole cycle (read, update, write, telemetry encode)")
     ax = axes[0][0]
     drawn = False

@@ -1,12 +1,12 @@
 #!/usr/bin/python3
-"""The generalisation sweep's table and charts (issue 31 item 6), from a merged sweep's directory.
+"""The generalisation sweep's table and charts, from a merged sweep's directory.
 
 usage: plot_generalisation.py DIR [--figures FIGDIR] [--baseline pid] [--law adaptive]
   reads DIR/sweep.csv (the merge's table: the cases, their draws, each law's ok and RMS per joint)
   and DIR/shard-*.jsonl (each run's worst error per joint; only the cases the table has, once each)
   writes DIR/generalisation.md: per law, the failed runs and the RMS and worst error of boom, arm and
     bucket (median, 90th percentile, largest, mm), and the fraction of cases where LAW's RMS on arm
-    and bucket is at most half BASELINE's (issue 31's criterion)
+    and bucket is at most half BASELINE's (the criterion for ground the laws were not tuned for)
   FIGDIR/generalisation.png: each law's worst error per case (the largest of boom, arm and bucket),
     the cases sorted per law, failed runs marked
   FIGDIR/generalisation_regions.png: LAW's RMS over BASELINE's (the worse of arm and bucket) against
