@@ -6,7 +6,7 @@
 // before it begins; on a target (no node in this process) both are.
 #include <cstdint>
 
-#include "control/perf_counter.hpp"
+#include "diagnostics/perf_counter.hpp"
 #include "harness/lockstep_run.hpp"
 
 namespace exc::sim {

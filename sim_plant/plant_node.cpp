@@ -2,8 +2,8 @@
 
 #include <algorithm>
 
-#include "app/can_stats_message.hpp"
-#include "app/timing_message.hpp"
+#include "diagnostics/can_stats_message.hpp"
+#include "diagnostics/timing_message.hpp"
 #include "hal/clock.hpp"
 #include "exlcm/machine_state_t.hpp"
 #include "model/closed_chain.hpp"

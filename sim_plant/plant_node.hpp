@@ -7,8 +7,8 @@
 // timeout, or on an emergency stop. Nothing allocates after construction.
 #include <cstdint>
 
-#include "app/subnormal_scan.hpp"
-#include "control/perf_counter.hpp"
+#include "diagnostics/subnormal_scan.hpp"
+#include "diagnostics/perf_counter.hpp"
 #include "hal/can_ports.hpp"
 #include "model/workspace.hpp"
 #include "sim_plant/injected_fault.hpp"

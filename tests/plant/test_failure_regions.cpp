@@ -179,7 +179,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
 
 TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its end under every law on the default tracking limit, the pumps never short, later by less than the run's added time") {
   // The path above asks the pumps for 1.8x their flow at its peak; controller.pump_pacing slows its
-  // clock so that its own oil stays within 0.9 of theirs (control/pump_pacing.hpp). The reader
+  // clock so that its own oil stays within 0.9 of theirs (control/task/pump_pacing.hpp). The reader
   // lengthens the run by the load's estimate of what that costs.
   const std::string q0 = "[0.0, 2.10, 3.00, 2.30]", q1 = "[0.0, 2.50, 2.40, 1.90]";
   const Scenario plain = move(q0, q1, 2.0);

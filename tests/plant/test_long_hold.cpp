@@ -13,7 +13,7 @@
 
 #include "app/firmware_node.hpp"
 #include "app/float_environment.hpp"
-#include "app/subnormal_scan.hpp"
+#include "diagnostics/subnormal_scan.hpp"
 #include "harness/lockstep_run.hpp"
 #include "sim_plant/plant_node.hpp"
 
