@@ -53,6 +53,20 @@
 
 namespace exc::control {
 
+// The settings this law reads, its own copy (a law keeps no other law's settings).
+struct AdaptiveLawSettings {
+  double period = 1e-3;
+  Vec6 adaptation_rate = Vec6::Zero();
+  Vec4 tracking_dead_zone = Vec4::Zero();
+  Vec6 theta_min = Vec6::Zero(), theta_max = Vec6::Zero(), theta_initial = Vec6::Zero();
+  RegressorAcceleration regressor_acceleration = RegressorAcceleration::filtered;
+  ExternalForceSettings external_force;
+  static AdaptiveLawSettings of(const ControllerConfig& c) {
+    return {c.period, c.adaptation_rate, c.tracking_dead_zone, c.theta_min, c.theta_max, c.theta_initial,
+            c.regressor_acceleration, c.external_force};
+  }
+};
+
 class AdaptiveComputedTorque final : public Controller {
  public:
   // The model must outlive the controller. Start-up: allocates (the Workspace, the Lyapunov solve).
@@ -65,7 +79,7 @@ class AdaptiveComputedTorque final : public Controller {
   // P of V over z = [int e; e; ed] (without integral action the int e rows and columns are zero).
   const Mat12& lyapunov_p() const { return P_; }
   const Vec6& theta_hat() const { return theta_hat_; }
-  void set_theta_hat(const Vec6& th) { theta_hat_ = th.cwiseMax(config_.theta_min).cwiseMin(config_.theta_max); }
+  void set_theta_hat(const Vec6& th) { theta_hat_ = th.cwiseMax(settings_.theta_min).cwiseMin(settings_.theta_max); }
   // The integral of e (with integral action; tests start from a given one).
   void set_error_integral(const Vec4& i) { feedback_.set_integral(i); }
   // Gamma of V (the inverse of the adaptation rates; a zero rate gives an infinite weight, so V is
@@ -81,7 +95,7 @@ class AdaptiveComputedTorque final : public Controller {
  private:
   const Model& model_;
   Workspace ws_;
-  ControllerConfig config_;
+  AdaptiveLawSettings settings_;
   EffortLimits limits_;
   Mat12 P_ = Mat12::Zero();
   Pid feedback_;                      // K_p e + K_v ed (+ K_i int e), the integral frozen on saturation

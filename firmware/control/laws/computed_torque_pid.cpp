@@ -7,7 +7,7 @@ namespace exc::control {
 
 ComputedTorquePid::ComputedTorquePid(const Model& model, const ControllerConfig& config,
                                      const EffortLimits& limits)
-    : model_(model), ws_(model), config_(config), limits_(limits), pid_(config.gains) {
+    : model_(model), ws_(model), period_(config.period), limits_(limits), pid_(config.gains) {
   const Mat8 A = error_dynamics_matrix(config.gains.kp, config.gains.kv);
   const Mat8 Q = config.lyapunov_q.asDiagonal();
   solve_lyapunov(A, Q, P_);
@@ -25,7 +25,7 @@ ControlOutput ComputedTorquePid::update(const ControlInput& in) {
   Mat4 M_a;
   Vec4 h_a;
   if (!model_at(model_, ws_, in.q, in.qd, last_tau_, out, M_a, h_a)) return out;
-  const Vec4 feedback = pid_.update(out.e, out.ed, config_.period, saturated_ | in.actuator_limited);
+  const Vec4 feedback = pid_.update(out.e, out.ed, period_, saturated_ | in.actuator_limited);
   out.tau_unsaturated = M_a * (in.qdd_d - feedback) + h_a;  // eq. 12 without the soil term
   saturated_ = saturate_output(limits_, out, last_tau_);
 

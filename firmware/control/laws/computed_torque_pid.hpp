@@ -25,7 +25,7 @@ class ComputedTorquePid final : public Controller {
  private:
   const Model& model_;
   Workspace ws_;
-  ControllerConfig config_;
+  double period_;  // s: the only setting it keeps besides its gains (in pid_)
   EffortLimits limits_;
   Pid pid_;
   Mat8 P_ = Mat8::Identity();

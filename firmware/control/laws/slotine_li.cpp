@@ -5,12 +5,12 @@
 namespace exc::control {
 
 SlotineLi::SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits)
-    : model_(model), ws_(model), config_(config), limits_(limits) {
+    : model_(model), ws_(model), settings_(SlotineLiSettings::of(config)), limits_(limits) {
   reset();
 }
 
 void SlotineLi::reset() {
-  theta_hat_ = config_.theta_initial;
+  theta_hat_ = settings_.theta_initial;
   anchor_.reset();
 }
 
@@ -18,7 +18,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
   ControlOutput out;
   tracking_errors(in, out);
   out.theta_hat = theta_hat_;
-  const Vec4& lambda = config_.sl_lambda;
+  const Vec4& lambda = settings_.lambda;
   const Vec4 qd_r = in.qd_d - lambda.cwiseProduct(out.e);
   const Vec4 qdd_r = in.qdd_d - lambda.cwiseProduct(out.ed);
   const Vec4 s = out.ed + lambda.cwiseProduct(out.e);
@@ -34,7 +34,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
   const Vec2 rhodd_r = ws_.J_t * qdd_r + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, ws_.rho, rhod_r, rhodd_r, out.rho_env, out.in_soil);
 
-  const Vec4 kd = config_.sl_kd.cwiseProduct(M_a.diagonal());
+  const Vec4 kd = settings_.kd.cwiseProduct(M_a.diagonal());
   out.tau_unsaturated = M_a * qdd_r + h_r + Y * theta_hat_ - kd.cwiseProduct(s);
   saturate_output(limits_, out, last_tau_);
 
@@ -43,8 +43,8 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
   if (in.soil.theta_known) {
     const Vec6 tilde = theta_hat_ - in.soil.theta;
     for (int i = 0; i < 6; ++i)
-      if (config_.sl_adaptation_rate[i] > 0)
-        out.lyapunov += 0.5 * tilde[i] * tilde[i] / config_.sl_adaptation_rate[i];
+      if (settings_.adaptation_rate[i] > 0)
+        out.lyapunov += 0.5 * tilde[i] * tilde[i] / settings_.adaptation_rate[i];
   }
   // A joint not driven as commanded (saturated, or clamped by the lag stage) is left out of the update.
   const std::uint8_t off_dynamics = out.saturated | in.actuator_limited;
@@ -52,8 +52,8 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
     Vec4 s_used = s;
     for (int j = 0; j < 4; ++j)
       if ((off_dynamics >> j) & 1u) s_used[j] = 0;
-    const Vec6 theta_dot = -config_.sl_adaptation_rate.cwiseProduct(Y.transpose() * s_used);
-    theta_hat_ = (theta_hat_ + config_.period * theta_dot).cwiseMax(config_.theta_min).cwiseMin(config_.theta_max);
+    const Vec6 theta_dot = -settings_.adaptation_rate.cwiseProduct(Y.transpose() * s_used);
+    theta_hat_ = (theta_hat_ + settings_.period * theta_dot).cwiseMax(settings_.theta_min).cwiseMin(settings_.theta_max);
   }
   return out;
 }

@@ -19,6 +19,17 @@
 
 namespace exc::control {
 
+// The settings this law reads, its own copy (a law keeps no other law's settings).
+struct SlotineLiSettings {
+  double period = 1e-3;
+  Vec4 lambda = Vec4::Zero(), kd = Vec4::Zero();
+  Vec6 adaptation_rate = Vec6::Zero();
+  Vec6 theta_min = Vec6::Zero(), theta_max = Vec6::Zero(), theta_initial = Vec6::Zero();
+  static SlotineLiSettings of(const ControllerConfig& c) {
+    return {c.period, c.sl_lambda, c.sl_kd, c.sl_adaptation_rate, c.theta_min, c.theta_max, c.theta_initial};
+  }
+};
+
 class SlotineLi final : public Controller {
  public:
   SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
@@ -29,7 +40,7 @@ class SlotineLi final : public Controller {
  private:
   const Model& model_;
   Workspace ws_;
-  ControllerConfig config_;
+  SlotineLiSettings settings_;
   EffortLimits limits_;
   Vec6 theta_hat_ = Vec6::Zero();
   SoilContactEstimator anchor_;
