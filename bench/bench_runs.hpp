@@ -11,7 +11,7 @@
 
 #include "app/firmware_settings.hpp"
 #include "control/controller_config.hpp"
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "harness/scene_source.hpp"
 #include "sim_plant/scene.hpp"
 

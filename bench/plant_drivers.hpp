@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "model/closed_chain.hpp"
 #include "sim_plant/plant.hpp"
 

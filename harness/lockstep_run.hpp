@@ -16,12 +16,11 @@
 #include "app/float_environment.hpp"
 #include "app/run_phases.hpp"
 #include "app/settings_blob.hpp"
+#include "harness/fault_injector.hpp"
 #include "harness/scene_source.hpp"
 #include "harness/stop_judge.hpp"
 #include "harness/target_figures.hpp"
 #include "control/controller_config.hpp"
-#include "hal/can_protocol.hpp"
-#include "settings/enum_table.hpp"
 #include "sim_plant/scene.hpp"
 
 namespace exc::telemetry {
@@ -29,10 +28,10 @@ class LcmOutput;
 }
 namespace exc::plant {
 class Plant;
+class PlantNode;
 }
 namespace exc::app {
 class FirmwareNode;
-class PlantNode;
 }
 
 namespace exc::sim {
@@ -139,57 +138,6 @@ struct RunRecord {
   std::optional<StopJudgement> stop_judgement;
 };
 
-// One fault injected into a run (the fault campaign): from `start` for `duration` s of simulated time.
-struct FaultSchedule {
-  enum class Kind : std::uint8_t {
-    none, bus_burst, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, rock, pump_loss, spool_stuck,
-    pressure_stuck, pressure_jump, pressure_drift, operator_stop, machine_fault, operator_link_lost
-  };
-  Kind kind = Kind::none;
-  double start = 0, duration = 0;  // s
-  int joint = 1;                   // sensor and actuator faults: 0 swing .. 3 bucket
-  int chamber = 0;                 // pressure faults: 0 side A (bore, port A), 1 side B
-  // bus_burst: fraction of frames damaged (split evenly into dropped, corrupted, delayed);
-  // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; rock: soil stiffness x;
-  // pump_loss: fraction of the pumps' flow lost (the hydraulic machine only); spool_stuck: the
-  // spool position (-1..1) the joint's main-valve spool sticks at (the hydraulic machine only);
-  // pressure_jump: offset (Pa); pressure_drift: rate (Pa/s); pressure_stuck: none.
-  double magnitude = 0;
-  std::uint64_t seed = 1;
-};
-// The faults a campaign draws from (a sweep spec's `faults:`), by name; to_string adds "none".
-inline constexpr settings::EnumTable<FaultSchedule::Kind, 14> kFaultKinds{{{
-    {FaultSchedule::Kind::bus_burst, "bus_burst", "dropped, corrupted and delayed frames at both ends"},
-    {FaultSchedule::Kind::sensor_freeze, "sensor_freeze", "a sensor holds its reading"},
-    {FaultSchedule::Kind::sensor_jump, "sensor_jump", "a sensor reading jumps by an offset"},
-    {FaultSchedule::Kind::actuator_loss, "actuator_loss", "an actuator loses a fraction of its effort"},
-    {FaultSchedule::Kind::actuator_jam, "actuator_jam", "an actuator jams"},
-    {FaultSchedule::Kind::rock, "rock", "the soil 5-50x stiffer"},
-    {FaultSchedule::Kind::pump_loss, "pump_loss", "the hydraulic machine's pumps lose a fraction of their flow"},
-    {FaultSchedule::Kind::spool_stuck, "spool_stuck", "a main-valve spool sticks at an opening (the hydraulic machine)"},
-    {FaultSchedule::Kind::pressure_stuck, "pressure_stuck", "a chamber pressure sensor holds its reading (the hydraulic machine)"},
-    {FaultSchedule::Kind::pressure_jump, "pressure_jump", "a chamber pressure reading steps by an offset (the hydraulic machine)"},
-    {FaultSchedule::Kind::pressure_drift, "pressure_drift", "a chamber pressure reading drifts out of range (the hydraulic machine)"},
-    {FaultSchedule::Kind::operator_stop, "operator_stop", "the operator station sends a SUPERVISOR stop at the fault's start"},
-    {FaultSchedule::Kind::machine_fault, "machine_fault", "the machine's own controller reports a fault (PlantFaults) and holds"},
-    {FaultSchedule::Kind::operator_link_lost, "operator_link_lost",
-     "the operator station's keep-alive (SUPERVISOR none every 0.1 s from 0.1 s) ends at the fault's start"},
-}}};
-inline const char* to_string(FaultSchedule::Kind kind) {
-  return kind == FaultSchedule::Kind::none ? "none" : kFaultKinds.name_of(kind);
-}
-
-// Why a fault of `kind` cannot run on `scene` ("" when it can): pump_loss needs the hydraulic
-// machine's pumps. run_lockstep refuses such a run, a sweep such a spec before any run.
-std::string fault_misfit(FaultSchedule::Kind kind, const plant::Scene& scene);
-
-// An operator's command, sent as a SUPERVISOR frame by a third node on the bus (an operator station)
-// just before the first cycle at or after `time` (s).
-struct SupervisorFrameAt {
-  double time = 0;
-  hal::SupervisorCommand command = hal::SupervisorCommand::none;
-};
-
 struct LockstepOptions {
   std::string controller = "adaptive";  // the law's registered name (control/controller_registry.hpp)
   double duration = 0;  // s; 0: the scene's
@@ -211,7 +159,7 @@ struct LockstepOptions {
   // Called after every cycle (e.g. to sample the tip for a chart). Must not allocate in the loop.
   std::function<void(std::int64_t cycle, const plant::Plant&, const app::FirmwareNode&)> observer;
   // Called after every cycle with both nodes (e.g. to scan their state). Must not allocate in the loop.
-  std::function<void(std::int64_t cycle, const app::PlantNode&, const app::FirmwareNode&)> node_observer;
+  std::function<void(std::int64_t cycle, const plant::PlantNode&, const app::FirmwareNode&)> node_observer;
   // The run's floating-point mode (the thread's own is restored after it): flush_subnormals, the
   // loop's; ieee only to measure what it saves (docs/floating-point.md).
   app::FloatMode float_mode = app::FloatMode::flush_subnormals;

@@ -2,14 +2,14 @@
 
 #include <algorithm>
 
-#include "app/can_stats_message.hpp"
-#include "app/timing_message.hpp"
+#include "diagnostics/can_stats_message.hpp"
+#include "diagnostics/timing_message.hpp"
 #include "hal/clock.hpp"
 #include "exlcm/machine_state_t.hpp"
 #include "model/closed_chain.hpp"
 #include "telemetry/telemetry_publisher.hpp"
 
-namespace exc::app {
+namespace exc::plant {
 
 PlantNode::PlantNode(plant::Plant& plant, hal::PlantCanPort& port, telemetry::TelemetryPublisher* telemetry,
                      const PlantNodeConfig& config)
@@ -44,7 +44,7 @@ Vec4 PlantNode::hold_effort() {
   return tau;
 }
 
-void PlantNode::scan_state(SubnormalScan& scan) const {
+void PlantNode::scan_state(app::SubnormalScan& scan) const {
   const plant::PlantState& s = plant_.state();
   scan.scan("plant q_a", s.q_a);
   scan.scan("plant qd_a", s.qd_a);
@@ -245,21 +245,21 @@ void PlantNode::publish_state() {
 void PlantNode::publish_counters() {
   if (telemetry_ == nullptr) return;
   const exlcm::can_stats_t cs =
-      can_stats_message(port_.rx_stats(), port_.tx_stats(), 1, static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5));
+      app::can_stats_message(port_.rx_stats(), port_.tx_stats(), 1, static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5));
   telemetry_->publish(telemetry::Channel::can_stats, cs);
   exlcm::timing_t m{};
-  fill_timing(step_timing_, 4, cs.utime, m);  // stage 4: the plant step
+  app::fill_timing(step_timing_, 4, cs.utime, m);  // stage 4: the plant step
   telemetry_->publish(telemetry::Channel::timing, m);
 }
 
 void PlantNode::set_fault(const InjectedFault& fault) {
-  if (fault_.kind == InjectedFault::Kind::valve_stuck || fault_.kind == InjectedFault::Kind::actuator_jam)
+  if (fault_.kind == InjectedFault::Kind::spool_stuck || fault_.kind == InjectedFault::Kind::actuator_jam)
     plant_.release_spool();  // a spool held by the fault that ends (none on a force-actuated plant)
   fault_ = fault;
   fault_started_ = false;
   // A stuck spool is the circuit's own state: no command moves it (hydraulic plants; the others have
   // no spools and ignore it).
-  if (fault.kind == InjectedFault::Kind::valve_stuck) plant_.stick_spool(fault.joint, fault.magnitude);
+  if (fault.kind == InjectedFault::Kind::spool_stuck) plant_.stick_spool(fault.joint, fault.magnitude);
 }
 
 void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
@@ -271,7 +271,7 @@ void PlantNode::apply_actuator_fault(plant::ActuatorCommand& actuator) {
   } else if (fault_.kind == InjectedFault::Kind::actuator_jam) {
     // A stuck actuator keeps what it applied when it stuck, whatever is commanded: a force actuator
     // its effort; on the hydraulic machine its spool, through the circuit's own stuck-spool state (the
-    // valve_stuck fault's), so the safe state's centred valves do not move it either.
+    // spool_stuck fault's), so the safe state's centred valves do not move it either.
     if (actuator.mode == plant::ActuatorCommand::effort) {
       if (!fault_started_) jammed_effort_ = plant_.state().effort[j];
       actuator.value[j] = jammed_effort_;
@@ -312,4 +312,4 @@ void PlantNode::apply_sensor_fault() {
   }
 }
 
-}  // namespace exc::app
+}  // namespace exc::plant

@@ -7,38 +7,18 @@
 // timeout, or on an emergency stop. Nothing allocates after construction.
 #include <cstdint>
 
-#include "app/subnormal_scan.hpp"
-#include "control/perf_counter.hpp"
+#include "diagnostics/subnormal_scan.hpp"
+#include "diagnostics/perf_counter.hpp"
 #include "hal/can_ports.hpp"
 #include "model/workspace.hpp"
+#include "sim_plant/injected_fault.hpp"
 #include "sim_plant/plant.hpp"
 
 namespace exc::telemetry {
 class TelemetryPublisher;
 }
 
-namespace exc::app {
-
-// A fault injected into the simulated machine (the fault campaign): what a real machine's sensor or
-// actuator can do while the firmware cannot tell from the frames alone.
-struct InjectedFault {
-  enum class Kind : std::uint8_t {
-    none, sensor_freeze, sensor_jump, actuator_loss, actuator_jam, valve_stuck,
-    // A chamber's pressure transmitter (the hydraulic machine): stuck at its reading of the fault's
-    // start, stepped by an offset, or drifting at a rate (out of range without any step).
-    pressure_stuck, pressure_jump, pressure_drift,
-    // The machine's own controller reports a fault (PlantFaults bit 1) and holds its valves centred
-    // while it lasts: an ECU's pump or oil-temperature fault, a stop the machine takes by itself.
-    machine_fault
-  };
-  Kind kind = Kind::none;
-  int joint = 0;          // 0 swing .. 3 bucket
-  int chamber = 0;        // pressure faults: 0 side A (bore, port A), 1 side B
-  // sensor_jump: offset (m or rad); actuator_loss: fraction of effort lost; valve_stuck: the spool
-  // position (-1..1) it sticks at, whatever is commanded (the hydraulic plant's circuit holds it);
-  // pressure_jump: offset (Pa); pressure_drift: rate (Pa/s).
-  double magnitude = 0;
-};
+namespace exc::plant {
 
 struct PlantNodeConfig {
   int command_timeout_cycles = 20;  // cycles without a new valid command set -> hold
@@ -76,7 +56,7 @@ class PlantNode {
   // Every value the plant and this node carry from one step to the next (the machine's state, its
   // circuit and soil, the sensor and command sets, the dynamics' workspace), for a look for
   // subnormals (docs/floating-point.md). Not on the loop's path.
-  void scan_state(SubnormalScan& scan) const;
+  void scan_state(app::SubnormalScan& scan) const;
 
  private:
   void step(std::uint64_t cycle, bool answer = true);
@@ -108,4 +88,4 @@ class PlantNode {
   control::PerfCounter step_timing_{"plant_step", 1000.0};
 };
 
-}  // namespace exc::app
+}  // namespace exc::plant

@@ -3,7 +3,7 @@
 #include <stdexcept>
 
 #include "safety/firmware_faults.hpp"
-#include "control/path_stop.hpp"
+#include "control/task/path_stop.hpp"
 #include "report/run_report.hpp"
 
 namespace exc::sim {

@@ -7,11 +7,11 @@
 #include <cstdint>
 #include <memory>
 
-#include "app/loop_counters.hpp"
-#include "control/actuation_stage.hpp"
+#include "diagnostics/loop_counters.hpp"
+#include "control/actuation/actuation_stage.hpp"
 #include "control/control_types.hpp"
 #include "control/controller_config.hpp"
-#include "control/state_estimator.hpp"
+#include "control/estimation/state_estimator.hpp"
 #include "hal/excavator_interface.hpp"
 #include "model/model.hpp"
 #include "safety/supervisor.hpp"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "control/actuation_stage.hpp"
+#include "control/actuation/actuation_stage.hpp"
 #include "control/control_types.hpp"
 #include "exlcm/command_t.hpp"
 #include "exlcm/controller_state_t.hpp"

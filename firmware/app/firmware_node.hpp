@@ -13,12 +13,12 @@
 #include <cstdint>
 
 #include "app/control_step.hpp"
-#include "app/loop_counters.hpp"
-#include "app/subnormal_scan.hpp"
+#include "diagnostics/loop_counters.hpp"
+#include "diagnostics/subnormal_scan.hpp"
 #include "app/tracking_metrics.hpp"
-#include "control/path_clock.hpp"
-#include "control/perf_counter.hpp"
-#include "control/task.hpp"
+#include "control/task/path_clock.hpp"
+#include "diagnostics/perf_counter.hpp"
+#include "control/task/task.hpp"
 #include "app/firmware_node_config.hpp"
 #include "hal/can_ports.hpp"
 #include "model/model.hpp"
@@ -47,7 +47,7 @@ class FirmwareNode {
   // Completes the cycle once the plant had its chance to answer: read, update, write, telemetry.
   void end_cycle();
   // A stop from outside the control loop (a signal, the caller): a tracking machine decelerates
-  // along its path (control/path_stop.hpp, controller.stop_ramp_time) and then holds where the path
+  // along its path (control/task/path_stop.hpp, controller.stop_ramp_time) and then holds where the path
   // came to rest; the node stays in hold. Real-time safe (sets a flag). An operator's SUPERVISOR
   // stop is stronger: the same deceleration, then a controlled stop that latches until acknowledged.
   void request_stop() { stop_requested_ = true; }

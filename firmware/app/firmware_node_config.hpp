@@ -11,7 +11,7 @@ namespace exc::app {
 
 struct FirmwareNodeConfig {
   control::ControllerConfig controller;  // its law names the control law the node runs
-  Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/soil_contact.hpp)
+  Terrain site_map;               // the scene's ground, for the soil-contact estimate (control/estimation/soil_contact.hpp)
   double track_delay = 0.05;      // s held at the first sensor reading before tracking starts
   // Hold until an operator's start (SUPERVISOR Command = start) before tracking; false: the task
   // starts by itself after track_delay (the default: runs without an operator station).

@@ -4,15 +4,15 @@
 #include <cmath>
 
 #include "app/firmware_node.hpp"
-#include "control/effort_feasibility.hpp"
-#include "control/pump_pacing.hpp"
+#include "control/task/effort_feasibility.hpp"
+#include "control/task/pump_pacing.hpp"
 #include "model/actuator_friction.hpp"
 #include "model/model.hpp"
 #include "model/plant_scene_keys.hpp"
 #include "model/scene_common_reader.hpp"
 #include "control/controller_config_reader.hpp"
 #include "control/controller_registry.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 namespace exc::app {
 namespace {

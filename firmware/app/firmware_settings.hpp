@@ -12,7 +12,7 @@
 #include "app/firmware_node_config.hpp"
 #include "app/settings_blob.hpp"
 #include "control/controller_config.hpp"
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "model/machine.hpp"
 #include "model/terrain.hpp"
 #include "model/scene_common_reader.hpp"

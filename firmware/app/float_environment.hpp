@@ -56,12 +56,5 @@ class LoopFloatModeScope {
   FloatControl saved_;
 };
 
-// A subnormal, told by its bits (exponent field zero, fraction not): under DAZ a comparison reads a
-// subnormal as zero, and std::fpclassify compiles to comparisons.
-inline bool is_subnormal(double x) {
-  std::uint64_t b = 0;
-  std::memcpy(&b, &x, sizeof b);
-  return (b & 0x7ff0000000000000ull) == 0 && (b & 0x000fffffffffffffull) != 0;
-}
 
 }  // namespace exc::app

@@ -38,7 +38,7 @@
 #include <Eigen/Core>
 
 #include "app/firmware_node_config.hpp"
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "model/machine.hpp"
 
 namespace exc::app {

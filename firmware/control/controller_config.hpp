@@ -9,12 +9,12 @@
 #include <string>
 
 #include "control/control_types.hpp"
-#include "control/pid.hpp"
+#include "control/laws/pid.hpp"
 #include "safety/pressure_plausibility.hpp"
 #include "safety/spool_monitor.hpp"
-#include "control/soil_contact.hpp"
-#include "control/state_estimator.hpp"
-#include "control/valve_inner_loop.hpp"
+#include "control/estimation/soil_contact.hpp"
+#include "control/estimation/state_estimator.hpp"
+#include "control/actuation/valve_inner_loop.hpp"
 #include "safety/velocity_plausibility.hpp"
 #include "model/machine.hpp"
 #include "settings/enum_table.hpp"

@@ -3,10 +3,10 @@
 
 #include <stdexcept>
 
-#include "control/adaptive_computed_torque.hpp"
-#include "control/computed_torque_pid.hpp"
-#include "control/flow_position_control.hpp"
-#include "control/slotine_li.hpp"
+#include "control/laws/adaptive_computed_torque.hpp"
+#include "control/laws/computed_torque_pid.hpp"
+#include "control/laws/flow_position_control.hpp"
+#include "control/laws/slotine_li.hpp"
 
 namespace exc::control {
 namespace {

@@ -17,8 +17,8 @@
 #include <type_traits>
 
 #include "control/controller_config.hpp"
-#include "control/effort_limits.hpp"
-#include "control/task.hpp"
+#include "control/laws/effort_limits.hpp"
+#include "control/task/task.hpp"
 #include "model/model.hpp"
 #include "settings/name_registry.hpp"
 

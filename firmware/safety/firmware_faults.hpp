@@ -61,7 +61,7 @@ constexpr StopKind stop_of(FirmwareFault fault) {
   return StopKind::emergency;  // an unknown code: the stronger stop
 }
 
-// A controlled stop that first decelerates the machine along its path (control/path_stop.hpp) and
+// A controlled stop that first decelerates the machine along its path (control/task/path_stop.hpp) and
 // latches once the path is at rest: only where the law, its sensors and the path are all sound. An
 // operator's stop (or a lost operator link) is; a tracking error, a refused model state, a late or pressure-blind loop are not,
 // and their stop centres the valves at once.

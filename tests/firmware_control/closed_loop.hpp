@@ -2,8 +2,8 @@
 // A test plant built from the model itself (so the controller's model is exact): independent-
 // coordinate forward dynamics with the paper's soil (eqs. 9-11: spring-damper-mass to an anchor that
 // re-anchors at S_dist), integrated by semi-implicit Euler. Allocation-free after construction.
-#include "control/regressor.hpp"
-#include "control/soil_contact.hpp"
+#include "control/laws/regressor.hpp"
+#include "control/estimation/soil_contact.hpp"
 #include "model/forward_dynamics.hpp"
 
 namespace exc::control::sim {

@@ -4,14 +4,14 @@
 #include <random>
 
 #include "closed_loop.hpp"
-#include "control/adaptive_computed_torque.hpp"
+#include "control/laws/adaptive_computed_torque.hpp"
 #include "control/controller_registry.hpp"
-#include "control/state_estimator.hpp"
-#include "control/task.hpp"
+#include "control/estimation/state_estimator.hpp"
+#include "control/task/task.hpp"
 #include "scenes.hpp"
 #include "tracking_run.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

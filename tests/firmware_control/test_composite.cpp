@@ -7,16 +7,16 @@
 #include <random>
 
 #include "closed_loop.hpp"
-#include "control/adaptive_computed_torque.hpp"
-#include "control/external_force_observer.hpp"
-#include "control/soil_contact.hpp"
-#include "control/soil_identification.hpp"
-#include "control/task.hpp"
+#include "control/laws/adaptive_computed_torque.hpp"
+#include "control/estimation/external_force_observer.hpp"
+#include "control/estimation/soil_contact.hpp"
+#include "control/estimation/soil_identification.hpp"
+#include "control/task/task.hpp"
 #include "settings/document.hpp"
 #include "scenes.hpp"
 #include "tracking_run.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -8,14 +8,14 @@
 #include <string>
 
 #include "app/firmware_settings.hpp"
-#include "control/effort_feasibility.hpp"
-#include "control/task.hpp"
+#include "control/task/effort_feasibility.hpp"
+#include "control/task/task.hpp"
 #include "model/actuator_friction.hpp"
 #include "model/closed_chain.hpp"
 #include "model/workspace.hpp"
 #include "scenes.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

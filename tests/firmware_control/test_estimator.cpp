@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "control/state_estimator.hpp"
+#include "control/estimation/state_estimator.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -23,7 +23,7 @@
 #include "model/closed_chain.hpp"
 #include "scenes.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;
@@ -335,7 +335,7 @@ TEST_CASE("firmware/node: zero heap allocations through a stop along the path (r
   for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
     app::FirmwareNodeConfig cfg;
     cfg.controller.law = kind;
-    cfg.controller.pump_pacing = paced;  // control/pump_pacing.hpp: the clock a state stepped each cycle
+    cfg.controller.pump_pacing = paced;  // control/task/pump_pacing.hpp: the clock a state stepped each cycle
     Loop loop(model, sim::kDigTask, cfg);
     loop.cycle();  // start-up cycle outside the count (first touch)
     std::size_t allocations = 0;

@@ -9,7 +9,7 @@
 #include "app/firmware_node.hpp"
 #include "app/firmware_settings.hpp"
 #include "control/controller_registry.hpp"
-#include "control/effort_feasibility.hpp"
+#include "control/task/effort_feasibility.hpp"
 #include "scenes.hpp"
 #include "settings_error_check.hpp"
 #include "model/machine_reader.hpp"

@@ -11,7 +11,8 @@
 #include <thread>
 
 #include "app/float_environment.hpp"
-#include "app/subnormal_scan.hpp"
+#include "diagnostics/subnormal_scan.hpp"
+#include "diagnostics/subnormal_scan.hpp"
 
 using namespace exc::app;
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "control/inverse_kinematics.hpp"
+#include "control/task/inverse_kinematics.hpp"
 #include "model/closed_chain.hpp"
 #include "model/machine_reader.hpp"
 

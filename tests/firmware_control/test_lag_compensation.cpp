@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "control/actuator_lag_compensator.hpp"
+#include "control/actuation/actuator_lag_compensator.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -2,7 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "control/lyapunov.hpp"
+#include "control/laws/lyapunov.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -4,7 +4,7 @@
 #include <random>
 #include <vector>
 
-#include "control/perf_counter.hpp"
+#include "diagnostics/perf_counter.hpp"
 
 using namespace exc::control;
 

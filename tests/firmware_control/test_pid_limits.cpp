@@ -1,7 +1,7 @@
 #include <doctest/doctest.h>
 
-#include "control/effort_limits.hpp"
-#include "control/pid.hpp"
+#include "control/laws/effort_limits.hpp"
+#include "control/laws/pid.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -1,4 +1,4 @@
-// The chamber pressures' plausibility monitor on its own (control/pressure_plausibility.hpp): its
+// The chamber pressures' plausibility monitor on its own (safety/pressure_plausibility.hpp): its
 // range from the machine file's hydraulics numbers, a jump against a spike that returns, a frozen
 // reading only while the function moves and away from the circuit's clamps, a non-finite reading.
 #include <doctest/doctest.h>

@@ -1,12 +1,12 @@
-// The path's clock paced to the pumps (control/pump_pacing.hpp) and the stop along the path from a
-// paced rate (control/path_stop.hpp), against closed forms and an independent quadrature.
+// The path's clock paced to the pumps (control/task/pump_pacing.hpp) and the stop along the path from a
+// paced rate (control/task/path_stop.hpp), against closed forms and an independent quadrature.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <vector>
 
-#include "control/path_stop.hpp"
-#include "control/pump_pacing.hpp"
+#include "control/task/path_stop.hpp"
+#include "control/task/pump_pacing.hpp"
 #include "model/machine.hpp"
 #include "model/machine_reader.hpp"
 

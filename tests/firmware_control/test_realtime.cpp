@@ -13,15 +13,15 @@
 
 #include "app/allocation_counter.hpp"
 #include "app/realtime_setup.hpp"
-#include "control/actuator_lag_compensator.hpp"
-#include "control/adaptive_computed_torque.hpp"
-#include "control/perf_counter.hpp"
-#include "control/command_blender.hpp"
+#include "control/actuation/actuator_lag_compensator.hpp"
+#include "control/laws/adaptive_computed_torque.hpp"
+#include "diagnostics/perf_counter.hpp"
+#include "control/actuation/command_blender.hpp"
 #include "safety/state_machine.hpp"
 #include "scenes.hpp"
 #include "tracking_run.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -2,7 +2,7 @@
 
 #include <cstring>
 
-#include "control/command_blender.hpp"
+#include "control/actuation/command_blender.hpp"
 #include "safety/state_machine.hpp"
 
 using namespace exc;

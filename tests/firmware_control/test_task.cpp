@@ -3,12 +3,12 @@
 
 #include <cmath>
 
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "model/closed_chain.hpp"
 #include "scenes.hpp"
 #include "settings_error_check.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -5,7 +5,7 @@
 #include "scenes.hpp"
 #include "tracking_run.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

@@ -1,6 +1,6 @@
 #include <doctest/doctest.h>
 
-#include "control/trajectory.hpp"
+#include "control/task/trajectory.hpp"
 
 using namespace exc;
 using namespace exc::control;

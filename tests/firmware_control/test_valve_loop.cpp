@@ -7,8 +7,8 @@
 #include <cmath>
 
 #include "app/allocation_counter.hpp"
-#include "control/flow_position_control.hpp"
-#include "control/valve_inner_loop.hpp"
+#include "control/laws/flow_position_control.hpp"
+#include "control/actuation/valve_inner_loop.hpp"
 
 using namespace exc;
 using namespace exc::control;

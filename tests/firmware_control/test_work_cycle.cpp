@@ -6,12 +6,12 @@
 #include <cmath>
 #include <string>
 
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "model/closed_chain.hpp"
 #include "model/workspace.hpp"
 #include "scenes.hpp"
 #include "model/machine_reader.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::control;

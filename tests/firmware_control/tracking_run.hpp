@@ -5,8 +5,8 @@
 
 #include "closed_loop.hpp"
 #include "control/controller_registry.hpp"
-#include "control/state_estimator.hpp"
-#include "control/task.hpp"
+#include "control/estimation/state_estimator.hpp"
+#include "control/task/task.hpp"
 
 namespace exc::control::sim {
 

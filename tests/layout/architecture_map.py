@@ -20,7 +20,7 @@ so that moving a folder needs only the doc updated:
 - the include rules' table (read as include_rules.py reads it): every folder row is a floor, a room
   or a program's folder of the map.
 - every path the doc names in backquotes (`sim_plant/plant.cpp`; the firmware's from firmware/,
-  `control/pid.hpp`; a file prefix, `sim_plant/plant_node`), the include rules' arrows among them,
+  `control/laws/pid.hpp`; a file prefix, `sim_plant/plant_node`), the include rules' arrows among them,
   names a file or folder of ROOT.
 
 Exit 1 naming each claim that is false (the doc's line, or the folder or file off the map); exit 2 for

@@ -15,7 +15,8 @@ Every .cpp, .hpp and .h outside tests/, hidden folders and build trees is a prod
 would: beside the including file, from ROOT, from ROOT/firmware (the firmware's include root), as a
 generated header (exlcm/ from lcmtypes/, message_fields.hpp from log_export/), or by its file name
 through a library's include folder. Exit 1, naming file:line, for an include its row does not allow,
-one that cannot be resolved, or a source that no row covers; exit 2 for a missing or bad table.
+one that cannot be resolved, or a source that no row covers; exit 2 for a missing or bad table. A
+folder's row covers the rooms inside it as one floor: they may include each other.
 """
 import os
 import re
@@ -135,7 +136,9 @@ def main():
                             "rules covers its folder (add one, in floor order)")
             continue
         allowed = allowed_targets(rows, key)
-        own = os.path.dirname(source) + "/"
+        # A folder's row covers its rooms, one floor: they include each other freely (firmware/control/'s
+        # rooms do: its settings gather every room's); a file-prefix row, its own folder only.
+        own = key if key.endswith("/") and not key.endswith("*/") else os.path.dirname(source) + "/"
         with open(os.path.join(root, source), encoding="utf-8", errors="replace") as f:
             for number, line in enumerate(f, 1):
                 m = INCLUDE.match(line)
@@ -150,7 +153,7 @@ def main():
                     problems.append(f'{source}:{number}: #include "{name}" names no file of ours '
                                     "(nor a unique file name, nor a generated header)")
                     continue
-                if target.startswith(own) and "/" not in target[len(own):]:
+                if target.startswith(own) and ("/" not in target[len(own):] or own == key):
                     continue
                 if any(target == a or (a.endswith("/") and target.startswith(a)) for a in allowed):
                     continue

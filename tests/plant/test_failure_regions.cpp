@@ -179,7 +179,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
 
 TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its end under every law on the default tracking limit, the pumps never short, later by less than the run's added time") {
   // The path above asks the pumps for 1.8x their flow at its peak; controller.pump_pacing slows its
-  // clock so that its own oil stays within 0.9 of theirs (control/pump_pacing.hpp). The reader
+  // clock so that its own oil stays within 0.9 of theirs (control/task/pump_pacing.hpp). The reader
   // lengthens the run by the load's estimate of what that costs.
   const std::string q0 = "[0.0, 2.10, 3.00, 2.30]", q1 = "[0.0, 2.50, 2.40, 1.90]";
   const Scenario plain = move(q0, q1, 2.0);
@@ -347,7 +347,7 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity and spool monitor
   // only monitor left is the tracking error, whose controlled stop centres valves that cannot move a
   // stuck spool; before the standstill monitor the boom ran on to its end stop and stalled at the main
   // relief for as long as the engine ran (the monitor on: test_safety_stops.cpp).
-  // The dig scene; at 3 s the boom's spool sticks at +0.5 (plant fault valve_stuck): metering
+  // The dig scene; at 3 s the boom's spool sticks at +0.5 (plant fault spool_stuck): metering
   // opening (0.5 - d) / (1 - d) of the dead zone d, so the boom extends at that fraction of its
   // 0.32 m/s (the compensated meter-in at its margin) whatever the firmware sends. The firmware sees
   // the boom leave its path and stops when the error reaches its limit; its safe state centres the
@@ -373,7 +373,7 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity and spool monitor
   fc.site_map = b.firmware.terrain;
   const Model model = build_model(b.firmware.machine);
   app::FirmwareNode node(model, b.firmware.task, fc, fw_port, nullptr);
-  app::PlantNode plant_node(plant, plant_port, nullptr);
+  plant::PlantNode plant_node(plant, plant_port, nullptr);
   double t_stop = -1, q_stop = 0, t_end_stop = -1, predicted_error = 0, e_stick = 0;
   double q_stuck0 = 0, others_max = 0;
   Vec4 q_d_prev = Vec4::Zero();
@@ -381,8 +381,8 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity and spool monitor
   for (long k = 0; k < cycles; ++k) {
     const double now = static_cast<double>(k) * b.scene.cycle;
     if (k == std::lround(t_stick / b.scene.cycle)) {
-      app::InjectedFault f;
-      f.kind = app::InjectedFault::Kind::valve_stuck;
+      plant::InjectedFault f;
+      f.kind = plant::InjectedFault::Kind::spool_stuck;
       f.joint = 1;
       f.magnitude = stuck;
       plant_node.set_fault(f);

@@ -13,7 +13,7 @@
 
 #include "app/firmware_node.hpp"
 #include "app/float_environment.hpp"
-#include "app/subnormal_scan.hpp"
+#include "diagnostics/subnormal_scan.hpp"
 #include "harness/lockstep_run.hpp"
 #include "sim_plant/plant_node.hpp"
 
@@ -35,7 +35,7 @@ HoldScan hold(const std::string& law, double duration, app::FloatMode mode) {
   o.controller = law;
   o.duration = duration;
   o.float_mode = mode;
-  o.node_observer = [&h, &b, mode](std::int64_t k, const app::PlantNode& plant, const app::FirmwareNode& firmware) {
+  o.node_observer = [&h, &b, mode](std::int64_t k, const plant::PlantNode& plant, const app::FirmwareNode& firmware) {
     const double t = static_cast<double>(k + 1) * b.scene.cycle;
     if (app::take_underflow_flag()) ++h.underflow_cycles;
     if (app::float_mode_of_thread() != mode) ++h.cycles_not_in_mode;

@@ -23,7 +23,7 @@ struct NodeBench {
   hal::MemoryBusNode* plant_bus = hub.attach();
   hal::FirmwareCanPort firmware{*fw_bus};
   hal::PlantCanPort port{*plant_bus};
-  app::PlantNode node{plant, port, nullptr};
+  plant::PlantNode node{plant, port, nullptr};
   explicit NodeBench(const Scene& scene) : plant(scene) {}
   // One cycle: SYNC(k), the plant's step and answer, the firmware's read, then its command.
   bool cycle(std::uint64_t k, const hal::CommandState& command, hal::SensorState& seen) {
@@ -96,8 +96,8 @@ TEST_CASE("plant/node: a jammed actuator on the hydraulic machine is a stuck spo
   std::uint64_t k = raise_boom(bench, seen);
   const double open = bench.plant.state().spool[1];
   REQUIRE(open > 0.1);
-  app::InjectedFault jam;
-  jam.kind = app::InjectedFault::Kind::actuator_jam;
+  plant::InjectedFault jam;
+  jam.kind = plant::InjectedFault::Kind::actuator_jam;
   jam.joint = hal::kBoom;
   bench.node.set_fault(jam);
   hal::CommandState centred;
@@ -106,7 +106,7 @@ TEST_CASE("plant/node: a jammed actuator on the hydraulic machine is a stuck spo
     bench.cycle(k, k < 450 ? boom_pilots(0, 4e6) : centred, seen);
     REQUIRE(bench.plant.state().spool[1] == doctest::Approx(open).epsilon(1e-9));
   }
-  bench.node.set_fault(app::InjectedFault{});
+  bench.node.set_fault(plant::InjectedFault{});
   for (; k < 900; ++k) bench.cycle(k, boom_pilots(0, 4e6), seen);
   MESSAGE("spool stuck at " << open << ", freed: " << bench.plant.state().spool[1]);
   CHECK(bench.plant.state().spool[1] < -0.1);
@@ -167,10 +167,10 @@ TEST_CASE("plant/node: a force-commanded plant sends PressureValid 0, and stops 
   CHECK_FALSE(bench.firmware.read(seen));
 }
 
-TEST_CASE("plant/node: a valve_stuck fault holds a spool at its opening whatever CMD_PILOT asks, the others follow their pilots, and its end frees it") {
+TEST_CASE("plant/node: a spool_stuck fault holds a spool at its opening whatever CMD_PILOT asks, the others follow their pilots, and its end frees it") {
   NodeBench bench(hydraulic_scene_text());
-  app::InjectedFault stuck;
-  stuck.kind = app::InjectedFault::Kind::valve_stuck;
+  plant::InjectedFault stuck;
+  stuck.kind = plant::InjectedFault::Kind::spool_stuck;
   stuck.joint = 1;
   stuck.magnitude = -0.4;
   bench.node.set_fault(stuck);
@@ -184,7 +184,7 @@ TEST_CASE("plant/node: a valve_stuck fault holds a spool at its opening whatever
   CHECK(s.spool[1] == -0.4);                                              // stuck, lowering the boom
   CHECK(s.q_a[1] < l0 - 0.01);
   CHECK(s.spool[2] == doctest::Approx(2e6 / full).epsilon(1e-3));         // the arm's spool follows
-  bench.node.set_fault(app::InjectedFault{});
+  bench.node.set_fault(plant::InjectedFault{});
   for (std::uint64_t k = 300; k < 600; ++k) REQUIRE(bench.cycle(k, c, seen));
   CHECK(bench.plant.state().spool[1] == doctest::Approx(3e6 / full).epsilon(1e-3));  // free again
   CHECK_FALSE(bench.node.failed());
@@ -197,8 +197,8 @@ TEST_CASE("plant/node: a lost link cuts the pilot supply as an autonomy kit's re
   NodeBench bench(hydraulic_scene_text());
   hal::SensorState seen;
   std::uint64_t k = raise_boom(bench, seen);  // raise the boom a little
-  app::InjectedFault stuck;
-  stuck.kind = app::InjectedFault::Kind::valve_stuck;
+  plant::InjectedFault stuck;
+  stuck.kind = plant::InjectedFault::Kind::spool_stuck;
   stuck.joint = hal::kBoom;
   stuck.magnitude = -0.5;  // lowering, whatever is commanded
   bench.node.set_fault(stuck);

@@ -59,7 +59,7 @@ TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting cha
           bool escalated = false;
           const double top = s.range_margin + b.scene.machine.hydraulics.relief_override +
                              std::max(b.scene.machine.hydraulics.port_relief_pressure, b.scene.machine.hydraulics.pump_pressure_limit());
-          o.node_observer = [&](std::int64_t, const app::PlantNode& plant, const app::FirmwareNode& node) {
+          o.node_observer = [&](std::int64_t, const plant::PlantNode& plant, const app::FirmwareNode& node) {
             escalated = escalated || node.supervisor().stop_escalated();
             if (!sampled && node.time() >= start - 1e-9) {
               sampled = true;
@@ -170,7 +170,7 @@ TEST_CASE("firmware/pressure plausibility: without a fault the pressure monitor 
       int longest_frozen = 0;
       sim::LockstepOptions o;
       o.controller = law;
-      o.node_observer = [&](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+      o.node_observer = [&](std::int64_t, const plant::PlantNode&, const app::FirmwareNode& node) {
         for (int c = 0; c < safety::PressurePlausibility::kChambers; ++c) {
           worst_step = std::max(worst_step, node.supervisor().pressure_plausibility().worst_step_ratio(c));
           longest_frozen = std::max(longest_frozen, node.supervisor().pressure_plausibility().longest_frozen(c));
@@ -202,7 +202,7 @@ TEST_CASE("firmware/pressure plausibility: with 5 kPa of noise on the readings a
     sim::LockstepOptions o;
     o.controller = "pid";
     int longest = 0;
-    o.node_observer = [&](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+    o.node_observer = [&](std::int64_t, const plant::PlantNode&, const app::FirmwareNode& node) {
       for (int c = 0; c < safety::PressurePlausibility::kChambers; ++c)
         longest = std::max(longest, node.supervisor().pressure_plausibility().longest_frozen(c));
     };
@@ -226,7 +226,7 @@ TEST_CASE("firmware/pressure plausibility: with 5 kPa of noise on the readings a
       o.fault.chamber = chamber;
       int moving_sets = 0, moving_complete = -1;
       double p0 = -1;
-      o.node_observer = [&](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+      o.node_observer = [&](std::int64_t, const plant::PlantNode&, const app::FirmwareNode& node) {
         if (p0 < 0 && node.time() >= start - 1e-9)
           p0 = (chamber == 0 ? node.sensors().pressure_a : node.sensors().pressure_b)[static_cast<std::size_t>(joint)];
         const long n = std::lround((node.time() - start) / dt);

@@ -69,7 +69,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, both ways, at opening
         o.rest_horizon = 6.0;  // a late find (a spool stuck where it was commanded) is judged as long after
         o.fault = stuck_spool(joint, opening, t_stick, 1e9);  // to the run's end
         double lagged = 0, onset = -1;  // the command through the valve's lag, stepped here
-        o.node_observer = [&](std::int64_t k, const app::PlantNode&, const app::FirmwareNode& node) {
+        o.node_observer = [&](std::int64_t k, const plant::PlantNode&, const app::FirmwareNode& node) {
           const double t = static_cast<double>(k) * dt;  // the firmware's clock, which detection is stamped in
           const double e = lagged;
           lagged += (1.0 - std::exp(-dt / tau)) * (std::clamp(node.last_command().value[static_cast<std::size_t>(joint)], -1.0, 1.0) - lagged);
@@ -142,7 +142,7 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       sim::LockstepOptions o;
       o.controller = law;
       double worst_spool = 0;  // the spool monitor's largest test value over its limit
-      o.node_observer = [&worst, &longest_frozen, &worst_spool](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+      o.node_observer = [&worst, &longest_frozen, &worst_spool](std::int64_t, const plant::PlantNode&, const app::FirmwareNode& node) {
         worst = node.supervisor().plausibility().worst_ratio();
         worst_spool = node.supervisor().spool_monitor().worst_ratio();
         for (int i = 0; i < 4; ++i) longest_frozen = std::max(longest_frozen, node.supervisor().frozen_position().run(i));
@@ -412,7 +412,7 @@ TEST_CASE("firmware/standstill: a swing spool stuck just past its dead zone, fou
     o.duration = 12.6;
     o.fault = stuck_spool(0, 0.19340007372785273, 5.814950679714288, 1e9);
     bool escalated = false;
-    o.node_observer = [&escalated](std::int64_t, const app::PlantNode&, const app::FirmwareNode& node) {
+    o.node_observer = [&escalated](std::int64_t, const plant::PlantNode&, const app::FirmwareNode& node) {
       escalated = escalated || node.supervisor().stop_escalated();
     };
     const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);

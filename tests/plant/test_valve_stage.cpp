@@ -1,4 +1,4 @@
-// The firmware's valve stage (firmware/control/valve_inner_loop.hpp) on the hydraulic plant, without
+// The firmware's valve stage (firmware/control/actuation/valve_inner_loop.hpp) on the hydraulic plant, without
 // CAN in between: the force loop's step response against its stated time constant, and the inverse
 // orifice map against the plant's own valves (the speed a function reaches for the speed asked).
 #include <doctest/doctest.h>
@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "control/valve_inner_loop.hpp"
+#include "control/actuation/valve_inner_loop.hpp"
 #include "plant_scenes.hpp"
 
 using namespace exc;

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "control/flow_position_control.hpp"
+#include "control/laws/flow_position_control.hpp"
 #include "exlcm/fault_t.hpp"
 #include "harness/lockstep_run.hpp"
 #include "sim_runs.hpp"

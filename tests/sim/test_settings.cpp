@@ -16,7 +16,7 @@
 
 #include "control/controller_config.hpp"
 #include "control/controller_registry.hpp"
-#include "control/task.hpp"
+#include "control/task/task.hpp"
 #include "harness/lockstep_run.hpp"
 #include "sim_plant/integration_methods.hpp"
 #include "settings/section_reader.hpp"

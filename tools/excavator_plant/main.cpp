@@ -93,10 +93,10 @@ int main(int argc, char** argv) {
     auto& bus = io.bus;
     auto& publisher = io.publisher;
     exc::hal::PlantCanPort port(*bus);
-    exc::app::PlantNode node(plant, port, publisher.get());
-    exc::app::InjectedFault stuck;
+    exc::plant::PlantNode node(plant, port, publisher.get());
+    exc::plant::InjectedFault stuck;
     if (!stuck_function.empty()) {
-      stuck.kind = exc::app::InjectedFault::Kind::valve_stuck;
+      stuck.kind = exc::plant::InjectedFault::Kind::spool_stuck;
       stuck.joint = stuck_function == "swing" ? 0 : stuck_function == "boom" ? 1 : stuck_function == "arm" ? 2 : 3;
       stuck.magnitude = stuck_opening;
     }
@@ -120,9 +120,9 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     while (!g_stop && (node.steps() < cycles || follow_firmware)) {
       const double t = static_cast<double>(node.steps()) * plant.scene().cycle;
-      if (stuck.kind != exc::app::InjectedFault::Kind::none && (t >= stuck_from && t < stuck_until) != stuck_now) {
+      if (stuck.kind != exc::plant::InjectedFault::Kind::none && (t >= stuck_from && t < stuck_until) != stuck_now) {
         stuck_now = !stuck_now;
-        node.set_fault(stuck_now ? stuck : exc::app::InjectedFault{});
+        node.set_fault(stuck_now ? stuck : exc::plant::InjectedFault{});
         std::printf("excavator-plant: %s spool %s at %.3f s\n", stuck_function.c_str(), stuck_now ? "stuck" : "freed", t);
         std::fflush(stdout);
       }

@@ -17,7 +17,7 @@
 #include "output_files/output_file.hpp"
 #include "sim_plant/integration_methods.hpp"
 #include "sim_plant/plant.hpp"
-#include "control/task_reader.hpp"
+#include "control/task/task_reader.hpp"
 
 using namespace exc;
 using namespace exc::plant;
