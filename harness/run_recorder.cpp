@@ -32,7 +32,6 @@ void RunRecorder::record(const plant::PlantState& s, const app::CycleStatus& st)
   }
   phases_.add(s.time, scene_.cycle, static_cast<safety::Mode>(st.mode), st.tracking, s.q_a, q_desired);
   if (st.tracking) {
-    metrics_.add(s.q_a, q_desired);
     const std::size_t c = starts_.empty() ? 0
         : static_cast<std::size_t>(std::max<std::ptrdiff_t>(
               0, std::upper_bound(starts_.begin(), starts_.end(), st.task_time) - starts_.begin() - 1));
@@ -67,12 +66,13 @@ bool RunRecorder::runs_on(double now, double rest_horizon) const {
 
 void RunRecorder::finish(RunRecord& r) const {
   r.hydraulic = hydraulic_;
-  r.tracking_samples = static_cast<std::uint64_t>(metrics_.samples());
-  for (int j = 0; j < 4; ++j) {
-    r.rms_error[j] = metrics_.rms(j);
-    r.max_error[j] = metrics_.max_abs(j);
-  }
+  // The tracking figures are the tracking phase's (the same samples, the same errors).
   r.tracking = phases_.tracking();
+  r.tracking_samples = r.tracking.samples;
+  for (int j = 0; j < 4; ++j) {
+    r.rms_error[j] = r.tracking.rms_error[j];
+    r.max_error[j] = r.tracking.max_error[j];
+  }
   r.settle = phases_.settle();
   r.hold = phases_.hold();
   r.stop = phases_.stop();

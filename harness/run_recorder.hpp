@@ -10,7 +10,6 @@
 
 #include "app/run_phases.hpp"
 #include "app/pil_records.hpp"
-#include "app/tracking_metrics.hpp"
 #include "harness/fault_injector.hpp"
 #include "harness/lockstep_run.hpp"
 #include "harness/stop_judge.hpp"
@@ -41,7 +40,6 @@ class RunRecorder {
   const std::vector<double>& starts_;
   const FaultSchedule fault_;
   const bool hydraulic_;
-  TrackingMetrics metrics_;
   app::RunPhases phases_;  // tracking, settle, hold, stop: on the plant's truth
   // Per work cycle: sized here, so the loop allocates nothing.
   std::vector<CycleRecord> cycles_;
