@@ -110,7 +110,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   if (options.telemetry) result.telemetry_per_cycle_every = options.log_every;
   LockstepRig rig(scene, firmware, options);
   const std::int64_t cycles = lockstep_cycles(scene, options.duration);
-  RunRecorder recorder(scene, firmware.task.cycle_starts, options.fault, rig.machine());
+  RunRecorder recorder(scene, firmware.task.cycle_starts, options.fault, rig.machine(), firmware.node.controller.spool_monitor);
   TimingWindows timing(cycles, scene.cycle);
   const auto control_timing = [&rig] { return rig.host_node() != nullptr ? &rig.host_node()->control_timing() : nullptr; };
   // A stopped run may go on past the scene's end, to see the machine come to rest (rest_horizon).
@@ -131,7 +131,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
       rig.step(k, now);
       cycles_run = k + 1;
       timing.after_cycle(cycles_run, control_timing(), rig.plant_node().step_timing());
-      recorder.record(rig.machine().state(), rig.firmware().status());
+      recorder.record(rig.machine(), rig.firmware().status());
       if (options.observer) options.observer(k, rig.machine(), *rig.host_node());
       if (options.node_observer) options.node_observer(k, rig.plant_node(), *rig.host_node());
       if (rig.plant_node().failed() || (options.stop_at_safe_state && rig.firmware().status().safe_stops > 0)) break;

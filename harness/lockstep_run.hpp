@@ -109,6 +109,9 @@ struct RunRecord {
   std::vector<CycleRecord> cycles;    // per work cycle of the task
   double first_safe_stop_time = -1;   // s of the first safe state (-1: none)
   double first_fault_detected_time = -1;  // s its fault was detected (FirmwareNode::fault_detected_time)
+  // s, the plant's truth: a stuck spool's onset of disagreement before that detection
+  // (harness/spool_disagreement.hpp; -1: none, or no stop)
+  double spool_disagreement_onset = -1;
   int first_fault_code = 0;               // safety::FirmwareFault of the first safe state
   // Judged by the machine (docs/safety.md), from the plant's truth: the first time after which every
   // cylinder stays under 1 mm/s and the swing under 1 mrad/s to the run's end (-1: it never does,

@@ -8,18 +8,23 @@
 namespace exc::sim {
 
 RunRecorder::RunRecorder(const plant::Scene& scene, const std::vector<double>& cycle_starts, const FaultSchedule& fault,
-                         const plant::Plant& plant)
+                         const plant::Plant& plant, const safety::SpoolMonitorSettings& spool_limits)
     : scene_(scene),
       starts_(cycle_starts),
       fault_(fault),
       hydraulic_(plant.fidelity().has(plant::kHydraulicCircuit)),
       cycles_(std::max<std::size_t>(1, cycle_starts.size())),
-      cycle_sum_sq_(cycles_.size(), std::array<double, 4>{}) {
+      cycle_sum_sq_(cycles_.size(), std::array<double, 4>{}),
+      disagreement_(spool_limits) {
   if (hydraulic_) min_pressure_ = peak_pressure_ = plant.state().hydraulics.min_pressure;
   if (fault.kind != plant::FaultKind::none) judge_.emplace(scene.machine, fault.start, scene.cycle);
 }
 
-void RunRecorder::record(const plant::PlantState& s, const app::CycleStatus& st) {
+void RunRecorder::record(const plant::Plant& plant, const app::CycleStatus& st) {
+  const plant::PlantState& s = plant.state();
+  // The plant's time of the spools the firmware reads next cycle; only an onset before the first
+  // detection counts (the safe state's centred command disagrees with a stuck spool afterwards).
+  if (hydraulic_ && first_fault_detected_time_ < 0) disagreement_.record(s.time, s.spool, plant.healthy_spool());
   const Vec4 q_desired(st.q_desired[0], st.q_desired[1], st.q_desired[2], st.q_desired[3]);
   moving_now_ = std::abs(s.qd_a[0]) >= kRestSwingRate;
   for (int j = 1; j < 4; ++j) moving_now_ = moving_now_ || std::abs(s.qd_a[j]) >= kRestCylinderRate;
@@ -57,10 +62,9 @@ void RunRecorder::record(const plant::PlantState& s, const app::CycleStatus& st)
 
 bool RunRecorder::runs_on(double now, double rest_horizon) const {
   if (rest_horizon <= 0 || first_safe_stop_time_ < 0 || now >= first_safe_stop_time_ + rest_horizon) return false;
-  // At rest for kRestSettle, and a judged stop's drift fit covered (kStopJudgeSpan from the onset,
-  // at the earliest the fault's start or 0.1 s before its detection).
-  const double onset = std::max(fault_.start, first_fault_detected_time_ - 0.1);
-  const bool judged = !judge_ || now >= onset + kStopJudgeSpan + scene_.cycle;
+  // At rest for kRestSettle, and a judged stop's drift fit covered (kStopJudgeSpan from its onset).
+  const bool judged =
+      !judge_ || now >= judge_->fit_onset(first_fault_detected_time_, disagreement_.onset()) + kStopJudgeSpan + scene_.cycle;
   return moving_now_ || now - std::max(last_moving_, 0.0) < kRestSettle || !judged;
 }
 
@@ -92,12 +96,13 @@ void RunRecorder::finish(RunRecord& r) const {
   r.first_safe_stop_time = first_safe_stop_time_;
   r.first_fault_detected_time = first_fault_detected_time_;
   r.first_fault_code = first_fault_code_;
+  r.spool_disagreement_onset = disagreement_.onset();
   if (judge_ && first_safe_stop_time_ >= 0) {
     // The emergency stop's figures (the solenoids' closing, the brake) for a fault that takes it at
     // once; a controlled stop escalated later is judged as the controlled stop it began as.
     const bool emergency =
         safety::stop_of(static_cast<safety::FirmwareFault>(first_fault_code_)) == safety::StopKind::emergency;
-    r.stop_judgement = judge_->judge(first_fault_detected_time_, first_safe_stop_time_, scene_.cycle, emergency);
+    r.stop_judgement = judge_->judge(first_fault_detected_time_, disagreement_.onset(), first_safe_stop_time_, scene_.cycle, emergency);
     if (!r.stop_judgement->judged) r.stop_judgement.reset();
   }
 }

@@ -2,7 +2,7 @@
 // What a lockstep run records after each cycle, from the plant's truth and the firmware's status
 // (allocation-free in the loop): the errors per phase and per work cycle, the peaks of soil force and
 // chamber pressure, when the machine last moved, the first safe stop and, for a run with a fault,
-// the stop's judge. After the run it fills its part of the RunRecord.
+// the onset of a stuck spool's disagreement and the stop's judge. After the run it fills its part of the RunRecord.
 #include <array>
 #include <cstdint>
 #include <optional>
@@ -12,6 +12,7 @@
 #include "app/pil_records.hpp"
 #include "harness/fault_injector.hpp"
 #include "harness/lockstep_run.hpp"
+#include "harness/spool_disagreement.hpp"
 #include "harness/stop_judge.hpp"
 #include "sim_plant/plant.hpp"
 
@@ -21,11 +22,12 @@ class RunRecorder {
  public:
   // `cycle_starts`: the task's work cycles' start times (empty: one); `fault`: the run's (its judge
   // records from its start); `plant`: the machine before the first cycle.
+  // `spool_limits`: the spool monitor's, by which a stuck spool's onset of disagreement is judged.
   RunRecorder(const plant::Scene& scene, const std::vector<double>& cycle_starts, const FaultSchedule& fault,
-              const plant::Plant& plant);
+              const plant::Plant& plant, const safety::SpoolMonitorSettings& spool_limits);
 
-  // After each cycle.
-  void record(const plant::PlantState& s, const app::CycleStatus& st);
+  // After each cycle: the plant's truth and the firmware's status.
+  void record(const plant::Plant& plant, const app::CycleStatus& st);
   // Past the scene's end: whether a stopped run goes on at `now` to see its machine come to rest
   // (at rest for kRestSettle and, for a judged stop, its drift fit covered), at most rest_horizon s
   // after its first safe stop.
@@ -50,6 +52,8 @@ class RunRecorder {
   bool moving_now_ = false;
   double first_safe_stop_time_ = -1, first_fault_detected_time_ = -1;
   int first_fault_code_ = 0;
+  // A stuck spool's onset of disagreement, up to the first detection (R1 counts from it).
+  SpoolDisagreement disagreement_;
   // The stop's judge records the plant's truth from the fault's start (its ring reserved here).
   std::optional<StopJudge> judge_;
 };

@@ -117,13 +117,21 @@ void StopJudge::record(double t, const Vec4& q_a, const Vec4& qd_a, bool brake_a
   samples_.push_back(Sample{t, q_a, qd_a, brake_applied});
 }
 
-StopJudgement StopJudge::judge(double detected, double safe_state, double period, bool emergency) const {
+double StopJudge::fit_onset(double detected, double spool_onset) const {
+  if (spool_onset >= 0 && spool_onset <= detected) return spool_onset;
+  return std::max(start_, detected - 0.1);
+}
+
+StopJudgement StopJudge::judge(double detected, double spool_onset, double safe_state, double period, bool emergency) const {
   StopJudgement j;
   if (detected < 0 || safe_state < 0 || samples_.empty() || detected > samples_.back().t) return j;
   j.judged = true;
   j.detected_after_s = detected - start_;
   j.outputs_after_s = safe_state - detected;
-  j.meets_r1 = j.detected_after_s <= 0.1 + 1e-9;
+  const bool onset_known = spool_onset >= 0 && spool_onset <= detected;
+  j.onset_after_s = onset_known ? spool_onset - start_ : -1.0;
+  j.detected_after_onset_s = onset_known ? detected - spool_onset : j.detected_after_s;
+  j.meets_r1 = j.detected_after_onset_s <= 0.1 + 1e-9;
   j.meets_r2 = j.outputs_after_s <= period + 1e-9;
   std::size_t d = 0;
   while (d + 1 < samples_.size() && samples_[d].t < detected - 1e-9) ++d;
@@ -131,11 +139,8 @@ StopJudgement StopJudge::judge(double detected, double safe_state, double period
   // The valve that ends a function's motion: on the emergency stop the pump-line shut-off and the
   // holding valves; on a controlled stop the main spools centring (95 % of their lag).
   const double closing = emergency ? std::max(hp_.pump_shutoff_time, hp_.holding_valve_close_time) : 3 * hp_.valve_time_constant;
-  // The drift's fit: from 1.5 s after the onset of disagreement to the record's end. The onset is
-  // taken as early as R1 lets it lie: the fault's start, or 0.1 s before a later detection (a spool
-  // stuck where it was commanded disagrees only once the command moves away).
-  const double onset = std::max(start_, detected - 0.1);
-  const double fit_from = onset + kDriftFrom;
+  // The drift's fit: from 1.5 s after the onset of disagreement to the record's end.
+  const double fit_from = fit_onset(detected, spool_onset) + kDriftFrom;
   j.drift_span = samples_.back().t - fit_from;
   for (int f = 0; f < 4; ++f) {
     // The first stop after detection: the velocity reverses or falls to "at rest".
@@ -193,7 +198,7 @@ StopJudgement StopJudge::judge(double detected, double safe_state, double period
   }
   std::string why;
   if (j.drift_span < kDriftSpan - 2 * period)
-    why = format("the record ends %.2f s after 1.5 s from the fault's start, short of the drift fit's %.1f s", j.drift_span, kDriftSpan);
+    why = format("the record ends %.2f s after 1.5 s from the onset, short of the drift fit's %.1f s", j.drift_span, kDriftSpan);
   for (int f = 0; f < 4 && why.empty(); ++f) {
     if (exempt[f]) continue;
     const std::string name = kFunctions[f];

@@ -21,7 +21,7 @@ namespace exc::sim {
 
 // R3's figures (docs/safety.md): drift below 1 mm/s (1 mrad/s swing) from 1.5 s after the onset over
 // at least 2 s, a ring's envelope time constant at most 3.5 s, the swing's brake within 0.3 s.
-inline constexpr double kDriftFrom = 1.5;          // s after the onset (the fault's start, or 0.1 s before a later detection)
+inline constexpr double kDriftFrom = 1.5;          // s after the onset (StopJudge::fit_onset)
 inline constexpr double kDriftSpan = 2.0;          // s, the fit's least span
 inline constexpr double kDriftLimit = 1e-3;        // m/s, rad/s
 inline constexpr double kRingTauLimit = 3.5;       // s
@@ -37,7 +37,12 @@ struct StopExemption {
 
 struct StopJudgement {
   bool judged = false;              // a stop was taken after a fault's start and recorded
-  double detected_after_s = -1;     // R1: from the fault's start
+  double detected_after_s = -1;     // from the fault's start
+  // R1: from the onset of a stuck spool's disagreement (harness/spool_disagreement.hpp); for a run
+  // whose spool disagreed only after detection, or a fault that sticks no spool, from the fault's start
+  // as above. onset_after_s: the onset from the fault's start (-1: none before detection).
+  double onset_after_s = -1;
+  double detected_after_onset_s = -1;
   double outputs_after_s = -1;      // R2: the safe state's outputs after detection
   std::array<double, 4> peak_speed{};  // m/s (rad/s), from detection to the first stop
   std::array<double, 4> travel{};              // to the function's first stop after detection
@@ -59,9 +64,14 @@ class StopJudge {
   StopJudge(const Machine& machine, double fault_start, double cycle, double span = 12.0);
   // Every cycle from the fault's start: the plant's truth (no allocation).
   void record(double t, const Vec4& q_a, const Vec4& qd_a, bool brake_applied);
-  // After the run: detected and safe_state are the firmware's times (s; -1: no stop); emergency: the
-  // stop was the emergency stop (the safety solenoids dropped, the swing brake dumped).
-  StopJudgement judge(double detected, double safe_state, double period, bool emergency) const;
+  // After the run: detected and safe_state are the firmware's times (s; -1: no stop); spool_onset the
+  // onset of a stuck spool's disagreement (s, -1: none); emergency: the stop was the emergency stop
+  // (the safety solenoids dropped, the swing brake dumped).
+  StopJudgement judge(double detected, double spool_onset, double safe_state, double period, bool emergency) const;
+  // The onset the drift fit counts from: a stuck spool's onset of disagreement when it came no later
+  // than detection; otherwise as early as R1 lets it lie, the fault's start or 0.1 s before a later
+  // detection.
+  double fit_onset(double detected, double spool_onset) const;
 
  private:
   struct Sample {

@@ -189,6 +189,8 @@ nlohmann::json stop_json(const StopJudgement& s) {
   for (const StopExemption& e : s.exempt)
     exempt.push_back({{"function", kActiveNames[static_cast<std::size_t>(e.function)]}, {"reason", e.reason}, {"travel", e.travel}});
   nlohmann::json j = {{"detected_after_s", s.detected_after_s},
+                      {"onset_after_s", s.onset_after_s >= 0 ? nlohmann::json(s.onset_after_s) : nlohmann::json(nullptr)},
+                      {"detected_after_onset_s", s.detected_after_onset_s},
                       {"outputs_after_s", s.outputs_after_s},
                       {"peak_speed_after_detection", four(s.peak_speed)},
                       {"travel_to_first_stop", four(s.travel)},

@@ -54,6 +54,7 @@ class ActuatorModel {
   void set_safety_solenoids(bool energised) { circuit_.set_safety_solenoids(energised); }
   void set_swing_lock(bool on) { circuit_.set_swing_lock(on); }
   const Vec4& spool() const { return circuit_.spool(); }
+  Vec4 healthy_spool() const { return circuit_.healthy_spool(); }  // HydraulicCircuit::healthy_spool
   const Vec4& pressure_a() const { return circuit_.pressure_a(); }  // cylinder bore side; swing: port A
   const Vec4& pressure_b() const { return circuit_.pressure_b(); }
   // Areas (m^2) of the bore and annulus sides; swing: displacement (m^3/rad) on both.

@@ -80,6 +80,7 @@ void HydraulicCircuit::command_opening(const Vec4& opening) {
 }
 
 void HydraulicCircuit::stick_spool(int function, double spool) {
+  if (stuck_ != std::clamp(function, 0, kNumActive - 1)) free_spool_ = spool_[std::clamp(function, 0, kNumActive - 1)];
   stuck_ = std::clamp(function, 0, kNumActive - 1);
   stuck_spool_ = std::clamp(spool, -1.0, 1.0);
 }
@@ -145,6 +146,7 @@ void HydraulicCircuit::advance(double dt, const Vec4& q_a, const Vec4& qd_a) {
   // Spools: lag toward the target (what the pilots push, as far as the supply gives them), then the
   // dead zone of the direction they moved in.
   const double lag_gain = spool_lag_gain_;
+  if (stuck_ >= 0) free_spool_ = spool_lag(free_spool_, target_[stuck_] * pilot_, lag_gain);
   for (int i = 0; i < kNumActive; ++i) {
     spool_[i] = i == stuck_ ? stuck_spool_ : spool_lag(spool_[i], target_[i] * pilot_, lag_gain);
     const double a = metering_opening(spool_[i], hp_.dead_zone_extend[i], hp_.dead_zone_retract[i]);

@@ -98,6 +98,14 @@ class HydraulicCircuit {
   void stick_spool(int function, double spool);
   void release_spool() { stuck_ = -1; }
   int stuck_function() const { return stuck_; }  // -1: none
+  // The spools a healthy valve would have: spool() with a stuck one's replaced by where its command
+  // would have taken it from where it stuck (the same lag, pilots and dead zone). The onset of a stuck
+  // spool's disagreement is judged against it (the stop requirement's R1, docs/safety.md).
+  Vec4 healthy_spool() const {
+    Vec4 s = spool_;
+    if (stuck_ >= 0) s[stuck_] = free_spool_;
+    return s;
+  }
   // Fault injection (the fault campaign): the pumps deliver `scale` of pump_flow from now on.
   void set_pump_flow_scale(double scale) { pump_flow_scale_ = scale; }
   // The machine's safety hardware (docs/safety.md). Pilot cut-off: with the supply off, the pilot
@@ -158,6 +166,7 @@ class HydraulicCircuit {
   PressureMethod pressures_ = PressureMethod::backward_euler;
   int stuck_ = -1;
   double stuck_spool_ = 0;
+  double free_spool_ = 0;  // the stuck function's spool had it not stuck
   double main_relief_ = 0;
   Vec4 q_min_ = Vec4::Zero(), q_max_ = Vec4::Zero();
   HydraulicGeometry g_;  // areas and fully open orifice gains (model/hydraulic_geometry.hpp)

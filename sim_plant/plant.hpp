@@ -60,6 +60,9 @@ class Plant {
   // `spool` (-1..1) whatever is commanded, from the next step until release_spool() or reset().
   void stick_spool(int function, double spool) { actuators_.stick_spool(function, spool); }
   void release_spool() { actuators_.release_spool(); }
+  // The spools a healthy valve would have (a stuck one's where its command would have taken it;
+  // HydraulicCircuit::healthy_spool): the truth a stuck spool's onset of disagreement is judged on.
+  Vec4 healthy_spool() const { return actuators_.healthy_spool(); }
   // The hydraulic machine's pumps deliver `scale` of their flow from now on (1: the machine's).
   void set_pump_flow_scale(double scale) { actuators_.set_pump_flow_scale(scale); }
   // The machine's safety hardware (kHydraulicCircuit; HydraulicCircuit): the pilot cut-off, the

@@ -165,12 +165,19 @@ void count_safety_function(nlohmann::json& table, const nlohmann::json& line, co
     keep_worst(k["worst_time_to_rest"], std::max(0.0, r["machine_at_rest_time"].get<double>() - start));
   else
     k["never_at_rest"] = k["never_at_rest"].get<int>() + 1;
-  // The stop against R1-R3 (docs/safety.md): R1 counted for the spool faults from the stick (the
-  // onset of disagreement is at or after it), R2 and R3 for every stop; exemptions per function.
+  // The stop against R1-R3 (docs/safety.md): R1 counted for the faults that stick a spool (a jammed
+  // valve actuator sticks its spool where it is) from the onset of the spool's disagreement, or
+  // apart when it was found before its spool disagreed past the monitor's limits; R2 and R3 for
+  // every stop; exemptions per function.
   if (!r.contains("stop")) return;
   const nlohmann::json& s = r["stop"];
   auto add = [&k](const char* key) { k[key] = k.value(key, 0) + 1; };
-  if (kind == "spool_stuck") add(s["detected_after_s"].get<double>() <= 0.1 + 1e-9 ? "r1_within_100ms_of_stick" : "r1_later_than_100ms_of_stick");
+  if (kind == "spool_stuck" || kind == "actuator_jam") {
+    if (!s.contains("onset_after_s") || s["onset_after_s"].is_null())
+      add("r1_found_before_disagreement");
+    else
+      add(s["meets_r1"].get<bool>() ? "r1_within_100ms_of_onset" : "r1_later_than_100ms_of_onset");
+  }
   add(s["meets_r2"].get<bool>() ? "r2_met" : "r2_missed");
   add(s["meets_r3"].get<bool>() ? "r3_met" : "r3_missed");
   if (!s["exempt"].empty()) add("exempt");

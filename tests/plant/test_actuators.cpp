@@ -101,6 +101,33 @@ TEST_CASE("plant/hydraulic spool follows its first-order lag") {
   CHECK((a.spool() - c.value * (1 - std::exp(-1.0))).norm() < 1e-12);
 }
 
+TEST_CASE("plant/hydraulic a stuck spool stays where it stuck while its healthy twin follows the command through the valve's lag from there") {
+  // The truth a stuck spool's onset of disagreement is judged on (harness/spool_disagreement.hpp).
+  Machine m = reference_machine();
+  m.hydraulics.valve_time_constant = 0.03;
+  ActuatorParameters p;
+  p.fidelity = "hydraulic";
+  ActuatorModel a(m, p);
+  a.reset(kMid, Vec4::Zero());
+  ActuatorCommand c;
+  c.mode = ActuatorCommand::valve;
+  c.value = Vec4(0, 0.6, 0, 0);
+  a.set_command(c);
+  for (int k = 0; k < 200; ++k) a.advance(1e-3, kMid, Vec4::Zero());
+  const double s0 = a.spool()[1];
+  REQUIRE(s0 == doctest::Approx(0.6).epsilon(1e-3));
+  CHECK(a.healthy_spool() == a.spool());  // nothing stuck: the same spools
+  a.stick_spool(1, s0);
+  c.value = Vec4(0, -0.4, 0, 0);
+  a.set_command(c);
+  for (int k = 0; k < 45; ++k) a.advance(1e-3, kMid, Vec4::Zero());
+  CHECK(a.spool()[1] == s0);
+  // The healthy one from s0 toward -0.4: -0.4 + (s0 + 0.4) exp(-t / tau), t = 45 ms.
+  CHECK(a.healthy_spool()[1] == doctest::Approx(-0.4 + (s0 + 0.4) * std::exp(-0.045 / 0.03)).epsilon(1e-12));
+  a.release_spool();
+  CHECK(a.healthy_spool() == a.spool());
+}
+
 TEST_CASE("plant/orifice flow is continuous at the laminar limit") {
   double f1, d1, f2, d2;
   orifice_flow(0.2e6 * (1 - 1e-9), 0.2e6, f1, d1);

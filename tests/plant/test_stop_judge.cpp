@@ -54,7 +54,7 @@ sim::StopJudgement judge_rings(const std::vector<Ring>& rings, double stick, dou
     q[kRingFunction] += qd[kRingFunction] * kCycle;
   }
   // Detected at the start, the valves centred in the same cycle (a controlled stop: no brake asked).
-  return judge.judge(0.0, kCycle, kCycle, false);
+  return judge.judge(0.0, -1.0, kCycle, kCycle, false);
 }
 
 }  // namespace

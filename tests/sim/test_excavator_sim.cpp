@@ -11,6 +11,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include "exlcm/controller_state_t.hpp"
 #include "exlcm/machine_state_t.hpp"
+#include <array>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -872,6 +873,9 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
   // printed apart; every other way of ending neither must not happen.
   std::map<std::string, int> not_at_rest;
   int not_at_rest_total = 0, judged = 0;
+  // R1 counted here from each run's own stop (a stuck spool's: within 100 ms of its onset of
+  // disagreement, later, or found before its spool disagreed), for the tables' R1 line below.
+  std::map<std::string, std::array<int, 3>> r1;
   {
     std::istringstream lines(read_text_file(dir / "all.jsonl"));
     for (std::string line; std::getline(lines, line);) {
@@ -885,11 +889,21 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
           CHECK(stop["detected_after_s"].get<double>() ==
                 doctest::Approx(r["fault_detected_time"].get<double>() - l["fault"]["start"].get<double>()));
           CHECK(stop["outputs_after_s"].get<double>() >= 0);
+          // R1 from a stuck spool's onset of disagreement when it came before detection, else from
+          // the fault's start.
+          if (stop["onset_after_s"].is_null())
+            CHECK(stop["detected_after_onset_s"].get<double>() == doctest::Approx(stop["detected_after_s"].get<double>()));
+          else
+            CHECK(stop["detected_after_onset_s"].get<double>() ==
+                  doctest::Approx(stop["detected_after_s"].get<double>() - stop["onset_after_s"].get<double>()));
           CHECK(stop["drift_after_1_5_s"].size() == 4);
           CHECK(stop["ring_tau_s"].size() == 4);
           CHECK(stop["drift_fit_span_s"].get<double>() >= 2.0 - 2e-3);  // the run went on until the fit had its span
           CHECK(stop["exempt"].is_array());
           ++judged;
+          const std::string kind = l["fault"]["kind"].get<std::string>();
+          if (kind == "spool_stuck" || kind == "actuator_jam")
+            ++r1[c][stop["onset_after_s"].is_null() ? 2 : stop["detected_after_onset_s"].get<double>() <= 0.1 + 1e-9 ? 0 : 1];
         }
         if (r.value("outcome", "") != "neither") continue;
         const std::string why = r.value("why", "");
@@ -955,6 +969,12 @@ TEST_CASE("tools/excavator-sim fault campaign (a CI sample): every run under a r
   for (const auto& [kind, k] : j["campaign"]["pid"].items()) neither += k["neither"].get<int>();
   CHECK(read_text_file(dir / "req.md").find("R4, runs that neither track nor meet R3: " + std::to_string(neither) + " / ") !=
         std::string::npos);
+  // R1's line: the stuck spools' counts per law as the runs' own stops give them.
+  const auto pair = [&r1](int i) { return std::to_string(r1["pid"][i]) + " / " + std::to_string(r1["adaptive"][i]); };
+  const std::string r1_line = "onset of disagreement (pid / adaptive): " + pair(0) + "; later: " + pair(1) +
+                              "; found before their spool disagreed past the spool monitor's limits: " + pair(2) + ".";
+  INFO(r1_line << "\n" << read_text_file(dir / "req.md"));
+  CHECK(read_text_file(dir / "req.md").find(r1_line) != std::string::npos);
 }
 
 TEST_CASE("tools/excavator-sim sweep refuses a spec naming both scene and scenes, and pump_loss on a scene without pumps before any run") {

@@ -126,14 +126,18 @@ def print_stop_requirement(functions, campaign, laws):
             pair(rows, "r3_met", lambda v: str(v or 0)), pair(rows, "r3_missed", lambda v: str(v or 0)),
             pair(rows, "exempt", lambda v: str(v or 0)), pair(rows, "worst_drift", mm), "%.2f" % tau,
             pair(rows, "worst_exempt_travel", mm)))
-    r1 = [sum((functions[law].get(n) or {}).get("r1_within_100ms_of_stick", 0) for n in functions[law]) for law in laws]
-    r1_late = [sum((functions[law].get(n) or {}).get("r1_later_than_100ms_of_stick", 0) for n in functions[law]) for law in laws]
+    def r1_count(key):
+        return [sum((functions[law].get(n) or {}).get(key, 0) for n in functions[law]) for law in laws]
+    r1, r1_late, r1_before = (r1_count("r1_within_100ms_of_onset"), r1_count("r1_later_than_100ms_of_onset"),
+                              r1_count("r1_found_before_disagreement"))
     neither = [sum(r.get("neither", 0) for r in campaign[law].values()) for law in laws]
     runs = [sum(r.get("runs", 0) for r in campaign[law].values()) for law in laws]
     print()
-    print("R1, stuck spools found within 100 ms of the stick (%s): %s; later: %s. R4, runs that neither track nor meet R3: "
-          "%s of %s." % (" / ".join(laws), " / ".join(map(str, r1)), " / ".join(map(str, r1_late)),
-                         " / ".join(map(str, neither)), " / ".join(map(str, runs))))
+    print("R1, stuck spools (spool_stuck, actuator_jam) found within 100 ms of the onset of disagreement (%s): %s; "
+          "later: %s; found before their spool disagreed past the spool monitor's limits: %s. R4, runs that neither "
+          "track nor meet R3: %s of %s." % (" / ".join(laws), " / ".join(map(str, r1)), " / ".join(map(str, r1_late)),
+                                            " / ".join(map(str, r1_before)), " / ".join(map(str, neither)),
+                                            " / ".join(map(str, runs))))
 
 
 if __name__ == "__main__":
