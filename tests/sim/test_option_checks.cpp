@@ -125,6 +125,8 @@ TEST_CASE("tools/every program exits 2 with the reason on a bad command line: an
       {src + "/tools/sweep/sweep-scaling spec.yaml", "usage: sweep-scaling"},
       {src + "/tools/vcan_vm/vcan-vm --no-such-option", "unknown option '--no-such-option'"},
       {src + "/tools/sanitizer-tests leaky", "unknown sanitizer 'leaky'"},
+      {src + "/tools/sanitizer-tests address -j0", "-j0: -j takes a whole number 1-99"},
+      {src + "/tools/sanitizer-tests address -j two", "-j 'two': a whole number 1-99"},
       {src + "/tools/install-deps everything", "unknown set 'everything'"},
   };
 #ifdef EXC_MODEL_BENCH_TOOL
@@ -136,6 +138,18 @@ TEST_CASE("tools/every program exits 2 with the reason on a bad command line: an
     INFO(e.err);
     CHECK(e.status == 2);
     CHECK(e.err.find(c.message) != std::string::npos);
+  }
+}
+
+TEST_CASE("tools/sanitizer-tests takes its job count as -j 2 and as -j2, the way make and ctest take it") {
+  const std::string src = EXC_SOURCE_DIR;
+  for (const char* jobs : {"-j 2", "-j2"}) {
+    INFO(jobs);
+    // --left-out prints what the sanitizer leaves out and exits, after the options are read.
+    // Exit 0 from grep only when the list came out (a refused option prints none).
+    const Exit e = run(src + "/tools/sanitizer-tests address " + jobs + " --left-out | grep -q callgrind");
+    INFO(e.err);
+    CHECK(e.status == 0);
   }
 }
 
