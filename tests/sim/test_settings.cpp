@@ -185,7 +185,7 @@ TEST_CASE("tools/excavator-firmware --print-config prints the firmware's section
   for (const std::string& k : keys) CHECK_MESSAGE(exc::settings::emit(f[k]) == exc::settings::emit(s[k]), k);
 }
 
-TEST_CASE("tools/excavator-firmware and excavator-plant --print-config name a misspelt key of the plant's sections with its file, line and the key it nearly spells (the firmware leaves their values to the plant and says so), and the help texts say what the programs do") {
+TEST_CASE("tools/excavator-firmware and excavator-plant --print-config name a misspelt key of the plant's sections, and of the firmware's, with its file, line and the key it nearly spells (the firmware leaves their values to the plant and says so), and the help texts say what the programs do") {
   const fs::path dir = fresh_dir("plant_config");
   const std::string dig = std::string(EXC_SOURCE_DIR) + "/scenes/dig.yaml";
   // A misspelt key in the plant's soil section.
@@ -205,6 +205,22 @@ TEST_CASE("tools/excavator-firmware and excavator-plant --print-config name a mi
     CHECK(r.status == 2);
     CHECK(r.out.empty());
     CHECK(r.err.find(expected) != std::string::npos);
+  }
+  // And the other way round: a misspelt key of the firmware's controller section is named by both
+  // programs too, the plant reading those sections as the firmware does.
+  std::string fw_typo = read_text_file(dig);
+  const auto iface = fw_typo.find("  command_interface:");
+  REQUIRE(iface != std::string::npos);
+  fw_typo.replace(iface, 20, "  comand_interface:");
+  std::ofstream(dir / "fw_typo.yaml") << fw_typo;
+  const std::string fw_line = std::to_string(1 + std::count(fw_typo.begin(), fw_typo.begin() + static_cast<long>(iface), '\n'));
+  const std::string fw_expected = "fw_typo.yaml:" + fw_line + ":3: controller.comand_interface: unknown key; did you mean command_interface?";
+  for (const char* tool : {EXC_FIRMWARE_TOOL, EXC_PLANT_TOOL}) {
+    const Run r = run(std::string(tool) + " --print-config --scene fw_typo.yaml", dir);
+    INFO(tool, ": ", r.err);
+    CHECK(r.status == 2);
+    CHECK(r.out.empty());
+    CHECK(r.err.find(fw_expected) != std::string::npos);
   }
   // The shipped scene: the firmware prints its sections and says the plant's values are the plant's to check.
   const Run fw = run(std::string(EXC_FIRMWARE_TOOL) + " --print-config --scene " + dig, dir);

@@ -14,6 +14,7 @@
 #include <memory>
 #include <stdexcept>
 
+#include "app/firmware_settings.hpp"
 #include "app/float_environment.hpp"
 #include "app/node_io.hpp"
 #include "hal/can_protocol.hpp"
@@ -72,6 +73,10 @@ int main(int argc, char** argv) {
 
   try {
     exc::plant::Plant plant(exc::plant::load_scene(scene_path));
+    // The firmware's sections of the same file, read as excavator-firmware reads them: a misspelt
+    // key or a value out of range there is named here too, at its line, before the bus is opened,
+    // rather than by the other program of the pair alone.
+    if (plant.scene().has_controller || plant.scene().has_task) (void)exc::app::load_firmware_settings(scene_path);
     if (print_config) {
       std::cout << exc::settings::emit(plant.scene().effective);
       return 0;
