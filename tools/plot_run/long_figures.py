@@ -17,6 +17,17 @@ def bucket_seconds(columns):
     return (u["max"][-1] - u["min"][0]) * 1e-6 / len(u["min"])
 
 
+def broken_at_gaps(t, values):
+    """The rows with a NaN between two that lie more than 10 logged periods apart (the detail rows of
+    separate windows), so that a line is not drawn across time the log kept no rows of."""
+    t, values = np.asarray(t, dtype=float), np.asarray(values, dtype=float)
+    if len(t) < 3:
+        return t, values
+    steps = np.diff(t)
+    gaps = np.nonzero(steps > 10 * np.median(steps))[0] + 1
+    return np.insert(t, gaps, np.nan), np.insert(values, gaps, np.nan)
+
+
 def zoom_title(label, z, unit):
     """A worst window's title: the summary's figure of that phase (the plant's), or the firmware's own
     worst (said so), or why there is none."""
@@ -55,22 +66,22 @@ def plot_tracking(plt, runs, out_dir, written, summary=None):
                     top.axvspan(t0, t1, color=colour, alpha=0.25,
                                 label="worst window" if phase is None else "%s worst" % phase)
                     rows, desired = within(ctrl, t0, t1, "q_desired_%d" % j, only_commanded=True) if ctrl else ([], [])
+                    # The log's own error there (the firmware's estimate) beside the summary's (the plant's).
+                    logged = logged_error_at(ctrl, z.time, j)
                     if len(rows):
-                        ax.plot(rows, desired, "--", color="black", label="desired")
+                        ax.plot(*broken_at_gaps(rows, desired), "--", color="black", label="desired")
                         if state:
-                            ax.plot(*within(state, t0, t1, "q_active_%d" % j), color="tab:blue", label="actual (as logged)")
-                        # The log's own error there (the firmware's estimate) beside the summary's (the plant's).
-                        logged = logged_error_at(ctrl, z.time, j) if z.source == "plant" else None
-                        ax.axvline(z.time, color=colour, linewidth=0.8,
-                                   label="worst; logged |e| there %.4g %s" % (1e3 * logged[0], ERROR_UNITS[j])
-                                   if logged else "worst")
+                            ax.plot(*broken_at_gaps(*within(state, t0, t1, "q_active_%d" % j)), color="tab:blue",
+                                    label="actual (as logged)")
                         ax.ticklabel_format(axis="y", useOffset=False)
-                    else:
-                        # The export kept no rows there (run without the summary): the figure stands, the
-                        # zoom says why it is empty.
-                        ax.axvline(z.time, color=colour, linewidth=0.8)
-                        ax.set_xlim(t0, t1)
-                        title += "; no logged rows there"
+                    ax.axvline(z.time, color=colour, linewidth=0.8,
+                               label="worst; logged |e| there %.4g %s" % (1e3 * logged[0], ERROR_UNITS[j])
+                               if logged and z.source == "plant" else "worst")
+                    ax.set_xlim(t0, t1)
+                    if logged is None:
+                        # The export kept no rows at that moment (a log exported without the summary): the
+                        # figure stands, the zoom says why it has no curve there.
+                        title += "; no logged rows at it"
                 decorate(ax, "time [s]", "%s %s" % (joint, unit), title=title, fontsize="small")
                 ax.title.set_fontsize("small")
             decorate(top, "time [s]", "%s %s" % (joint, unit), title="%s: whole run" % label,
