@@ -292,6 +292,13 @@ ChannelWriter open_writer(const std::string& channel, const std::string& file_na
       }
     }
   }
+  const auto moments = options.detail_moments.find(controller_of(channel));
+  if (moments != options.detail_moments.end()) {
+    for (const double t : moments->second) {
+      const std::int64_t at = us(t);
+      w.windows.push_back({shifted(at, -us(options.detail_half_width_s)), shifted(at, us(options.detail_half_width_s))});
+    }
+  }
   w.windows.push_back({shifted(counts.max_utime, -us(options.detail_tail_s)), counts.max_utime});
   w.detail_path = path_in("detail");
   w.detail = open_csv(w.detail_path, error, failed);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace exc::log {
 
@@ -68,10 +69,15 @@ struct ExportOptions {
   std::uint64_t bucket_rows = 20000;
   // The bucketed view: this many buckets of equal length over the channel's utime span (see
   // csv_writers.hpp's BucketView). The detail rows: every message within detail_half_width_s of its
-  // controller's largest tracking error on each joint, and in its last detail_tail_s.
+  // controller's largest tracking error on each joint, around each of its detail_moments, and in its
+  // last detail_tail_s.
   int buckets = 2000;
   double detail_half_width_s = 2.0;
   double detail_tail_s = 1.0;
+  // More moments (s of the run) whose detail rows are kept, detail_half_width_s either side, per
+  // controller (a channel's suffix): the run summary's worst error per joint and phase, which is the
+  // plant's truth and so not in the log, for the report's zoom on it (excavator-log report --summary).
+  std::map<std::string, std::vector<double>> detail_moments;
 };
 
 // Writes one CSV per channel of a known exlcm type into `out_dir` (created if missing). Header

@@ -11,7 +11,9 @@ void PhaseAccumulator::add(double t, double dt, const Vec4& q, const Vec4& q_des
   for (int j = 0; j < 4; ++j) {
     const double e = std::abs(q[j] - q_desired[j]);
     sum_sq_[j] += e * e;
-    if (e > errors_.max_error[j]) {
+    // The first sample sets the time too: a joint whose error stays 0 (a swing the task never moves)
+    // still has a moment its worst is at, so the report's worst window has one to centre on.
+    if (e > errors_.max_error[j] || errors_.worst_time[j] < 0) {
       errors_.max_error[j] = e;
       errors_.worst_time[j] = t;
     }

@@ -22,7 +22,8 @@ struct PhaseErrors {
   double seconds = 0;                   // s spent in the phase
   double rms_error[4] = {0, 0, 0, 0};
   double max_error[4] = {0, 0, 0, 0};
-  double worst_time[4] = {-1, -1, -1, -1};  // s of the run at each joint's max (-1: no sample)
+  double worst_time[4] = {-1, -1, -1, -1};  // s of the run (the positions' time) at each joint's max, its first if
+                                            // several are equal (-1: no sample)
   // Per joint: how often the error rose past the holding tolerance (an excursion: a hunt's
   // overshoot or a correction that came too late).
   std::uint64_t excursions[4] = {0, 0, 0, 0};

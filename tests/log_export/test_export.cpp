@@ -252,7 +252,7 @@ double cell(const std::vector<std::vector<std::string>>& rows, std::size_t row, 
 
 }  // namespace
 
-TEST_CASE("telemetry/export writes a long channel's bucketed view (min, max, first, last and exact sums per bucket) in place of its rows beyond full_rows, beside them beyond bucket_rows, and its detail rows around the largest error and at the end") {
+TEST_CASE("telemetry/export writes a long channel's bucketed view (min, max, first, last and exact sums per bucket) in place of its rows beyond full_rows, beside them beyond bucket_rows, and its detail rows around the largest error, around each moment the run's summary names and at the end") {
   const fs::path dir = fs::temp_directory_path() / ("exc-export-buckets-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
@@ -349,6 +349,19 @@ TEST_CASE("telemetry/export writes a long channel's bucketed view (min, max, fir
       CHECK(cell(detail, 5000, "utime") == 9999000);
     }
   }
+  // A summary's moment (the plant's worst error, not in the log) keeps its 2 s either side too:
+  // 0 .. 4.0 s besides 5.0 .. 9.999 s; another controller's moment keeps none of pid's rows.
+  exc::log::ExportOptions with_moment = joined;
+  with_moment.detail_moments = {{"pid", {2.0}}, {"adaptive", {4.5}}};
+  const fs::path out = dir / "moment";
+  exc::log::LogSummary summary;
+  std::string error;
+  REQUIRE_MESSAGE(exc::log::export_log_to_csv(log_path.string(), out.string(), &summary, &error, with_moment), error);
+  const auto detail = read_csv(out / "detail" / "EXC_CONTROLLER__pid.csv");
+  REQUIRE(detail.size() == 1 + 4001 + 5000);
+  CHECK(cell(detail, 1, "utime") == 0);
+  CHECK(cell(detail, 4001, "utime") == 4000000);
+  CHECK(cell(detail, 4002, "utime") == 5000000);
   fs::remove_all(dir);
 }
 
@@ -566,6 +579,32 @@ TEST_CASE("tools/excavator-log exits 2 for bad input (no such file, not a log, a
   CHECK(sync.status == 0);
   CHECK(sync.err.find("Invalid header") == std::string::npos);
   CHECK(sync.err.find(std::to_string(2 * event_size) + " bytes are in no complete event") != std::string::npos);
+}
+
+TEST_CASE("tools/excavator-log export and report refuse a summary whose worst moment is not a number of seconds, naming the file and field, exit 2") {
+  const fs::path dir = exc::test::scratch_dir(fs::temp_directory_path() / ("exc-moments-" + std::to_string(::getpid())));
+  const fs::path log = dir / "ten.lcm";
+  write_ten_timing_events(log, "EXC_TIMING/pid");
+  for (const auto& [json, field] : {std::pair<std::string, std::string>{R"({"pid": {"phases": {"hold": {"worst_time": {"arm": "soon"}}}}})",
+                                                                        "pid.phases.hold.worst_time.arm: not a number"},
+                                    {R"({"pid": {"phases": {"stop": {"worst_time": {"boom": 1e300}}}}})",
+                                     "pid.phases.stop.worst_time.boom: 1e+300 is outside 0 .. 1e6 s"},
+                                    {"{\"pid\": ", "summary.json: not a JSON summary"}}) {
+    std::ofstream(dir / "summary.json", std::ios::trunc) << json;
+    for (const char* sub : {"export --csv csv", "report --out rep"}) {
+      INFO(sub << " " << json);
+      const ToolRun run = run_excavator_log(std::string(sub) + " '" + log.string() + "' --summary '" + (dir / "summary.json").string() + "'", dir);
+      CHECK(run.status == 2);
+      CHECK(run.err.find("summary.json: ") != std::string::npos);
+      CHECK(run.err.find(field) != std::string::npos);
+    }
+  }
+  // Every phase's moment a number, -1 for a phase without samples, another summary's keys ignored: read.
+  std::ofstream(dir / "summary.json", std::ios::trunc)
+      << R"({"scene": "dig", "pid": {"phases": {"tracking": {"worst_time": {"arm": 0.004, "swing": -1}}, "hold": null}}})";
+  const ToolRun fine = run_excavator_log("export '" + log.string() + "' --csv csv --summary '" + (dir / "summary.json").string() + "'", dir);
+  INFO(fine.err);
+  CHECK(fine.status == 0);
 }
 
 TEST_CASE("telemetry/export keeps a channel's type through an event of another or no type, and leaves that event out") {

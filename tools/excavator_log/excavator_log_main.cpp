@@ -1,7 +1,8 @@
 // excavator-log: reads LCM logs of the excavator's telemetry (lcm-logger's or the firmware's own
 // file:// provider output) with LCM's log reader.
 //   excavator-log info run.lcm            channels, types, counts, duration
-//   excavator-log export run.lcm --csv DIR  one CSV per channel (a long one: its bucketed view)
+//   excavator-log export run.lcm --csv DIR [--summary JSON]  one CSV per channel (a long one: its
+//                                           bucketed view, and detail rows around the summary's worst moments)
 //   excavator-log report run.lcm --out DIR [--summary JSON]  CSV, then plot-run's figures and report
 #include <CLI/CLI.hpp>
 
@@ -12,6 +13,7 @@
 #include <string>
 
 #include "log_export/log_export.hpp"
+#include "summary_moments.hpp"
 #include "output_files/output_file.hpp"
 #include "output_files/helper_program.hpp"
 #include "option_checks.hpp"
@@ -106,6 +108,11 @@ int main(int argc, char** argv) {
   exporter->add_option("log", export_log, "LCM log file")->required();
   exporter->add_option("--csv", csv_dir, "Output directory for the CSV files (created)")
       ->required();
+  std::string export_summary;
+  exporter->add_option("--summary", export_summary,
+                       "The run's summary JSON (excavator-sim's): a long channel's detail rows also cover the "
+                       "moment of each phase's worst error per joint it names (the plant's truth)")
+      ->check(CLI::ExistingFile);
 
   std::string report_log;
   std::string report_dir;
@@ -132,6 +139,14 @@ int main(int argc, char** argv) {
   }
 
   if (const auto status = exc::cli::parse_command_line(app, argc, argv)) return *status;
+  // The summary's worst moments: the report's zoom on each phase's worst error needs their rows.
+  if (const std::string& json = reporter->parsed() ? summary_json : export_summary; !json.empty()) {
+    std::string error;
+    if (!exc::log::read_summary_moments(json, &options.detail_moments, &error)) {
+      std::fprintf(stderr, "excavator-log: %s\n", error.c_str());
+      return 2;
+    }
+  }
 
   exc::log::LogSummary summary;
   std::string error;

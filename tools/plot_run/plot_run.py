@@ -13,7 +13,9 @@ Figures (paper: Kim, Yoo, Lee): tracking_<joint>.png, desired against actual wit
 controller side by side (Figs. 4-7 free motion, 9-12 digging); tracking_error.png; soil_force.png
 (the zig-zag of Fig. 8); soil_estimates.png (Theta_hat against the true values); loop_timing.png
 (histogram of the control cycle). A run of more than 20 s at 1 kHz is drawn as its envelope (min
-and max over time) with a zoom on each controller's worst window. A task that repeats adds
+and max over time) with a zoom on each controller's worst window per phase: the moment the summary
+names as that phase's worst error (the plant's), its figure in the title (worst_windows.py); a short
+run's tracking figures mark those moments. A task that repeats adds
 work_cycles.png (per-cycle errors, soil force and estimates) and cycle_errors.png (each cycle's
 error over the cycle's time).
 
@@ -76,7 +78,7 @@ def main(argv):
     plt = load_matplotlib()
     os.makedirs(args.out, exist_ok=True)
     written = []
-    plot_tracking(plt, runs, args.out, written)
+    plot_tracking(plt, runs, args.out, written, summary)
     plot_errors(plt, runs, args.out, written)
     plot_soil_force(plt, runs, args.out, written)
     plot_soil_estimates(plt, runs, args.out, written)

@@ -138,11 +138,17 @@ def long_run_note(runs):
         return []
     note = ("A long run: the time-series figures show each signal's envelope (its minimum and maximum "
             "per time bucket) over the whole run, and the tracking figures a zoom on the %g s either side "
-            "of each controller's largest error on that joint." % ZOOM_HALF_WIDTH)
+            "of the moment the summary names as each controller's worst error on that joint in each phase "
+            "(tracking, hold, stop: the plant's true error, the table's max error), its figure and time in "
+            "the zoom's title; the curves are the telemetry (the machine as the firmware sensed it), and "
+            "the legend gives the logged error there (the firmware's estimate). Without a summary the zoom "
+            "is on the largest logged error, hold and track together, and its title says so."
+            % ZOOM_HALF_WIDTH)
     if any(c.buckets is not None for c in channels):
         note += (" The long channels' CSVs (csv/, a header that starts with `bucket`) are their bucketed "
                  "view (per time bucket: first, last, min, max and sums of every column), with every "
-                 "message of the zoom windows and of the run's last second in csv/detail/; the RMS "
+                 "message of the zoom windows (around the summary's worst moments and the log's largest "
+                 "errors) and of the run's last second in csv/detail/; the RMS "
                  "figures above are over every message.")
     return [note, ""]
 
@@ -198,8 +204,8 @@ def write_report(runs, summary, title, out_dir, written):
     lines += ["## Figures", ""]
     for name in written:
         caption = captions.get(name, "Tracking of the %s, desired against actual%s" % (
-            name[len("tracking_"):-4], ": the envelope over the run, and each controller's worst window"
-            if note else ""))
+            name[len("tracking_"):-4], ": the envelope over the run, and each controller's worst window per "
+            "phase" if note else ""))
         lines += ["### %s" % caption, "", "![%s](%s)" % (caption, name), ""]
     path = os.path.join(out_dir, "report.md")
     with open(path, "w") as f:

@@ -8,6 +8,7 @@ import long_figures
 from figure_base import ERROR_UNITS, JOINTS, THETA, decorate, new_figure, plot_runs, save
 from plot_failure import fail
 from run_data import commanded, is_long, seconds
+from worst_windows import PHASE_COLOURS, zoom, zoom_phases
 
 
 def any_long(runs):
@@ -15,9 +16,12 @@ def any_long(runs):
                for c in ("EXC_STATE", "EXC_CONTROLLER"))
 
 
-def plot_tracking(plt, runs, out_dir, written):
+def plot_tracking(plt, runs, out_dir, written, summary=None):
+    """Desired against actual per joint; each phase's worst error the summary names is marked at its
+    moment, its figure in the legend (a long run: a zoom on it, long_figures.py)."""
     if any_long(runs):
-        return long_figures.plot_tracking(plt, runs, out_dir, written)
+        return long_figures.plot_tracking(plt, runs, out_dir, written, summary)
+    phases = [p for p in zoom_phases(runs, summary) if p is not None]
     for j, (joint, unit) in enumerate(JOINTS):
         fig, axes = new_figure(plt, 1, len(runs), "Tracking of the %s (desired vs actual)" % joint)
         for k, (label, channels) in enumerate(runs.items()):
@@ -29,7 +33,12 @@ def plot_tracking(plt, runs, out_dir, written):
                         label="desired")
             if state:
                 ax.plot(seconds(state), state["q_active_%d" % j], color="tab:blue", label="actual")
-            decorate(ax, "time [s]", "%s %s" % (joint, unit), title=label)
+            for phase in phases:
+                z = zoom(ctrl, summary, label, phase, j)
+                if z.time is not None:
+                    ax.axvline(z.time, color=PHASE_COLOURS[phase], linewidth=0.8,
+                               label="%s worst |e| %.4g %s at %.3f s" % (phase, 1e3 * z.error, ERROR_UNITS[j], z.time))
+            decorate(ax, "time [s]", "%s %s" % (joint, unit), title=label, fontsize="small")
         save(plt, fig, out_dir, "tracking_%s.png" % joint, written)
 
 
