@@ -15,7 +15,7 @@ RunRecorder::RunRecorder(const plant::Scene& scene, const std::vector<double>& c
       hydraulic_(plant.fidelity().has(plant::kHydraulicCircuit)),
       cycles_(std::max<std::size_t>(1, cycle_starts.size())),
       cycle_sum_sq_(cycles_.size(), std::array<double, 4>{}),
-      disagreement_(spool_limits) {
+      disagreement_(spool_limits, spool_resolution(scene.sensors.spool_noise)) {
   if (hydraulic_) min_pressure_ = peak_pressure_ = plant.state().hydraulics.min_pressure;
   if (fault.kind != plant::FaultKind::none) judge_.emplace(scene.machine, fault.start, scene.cycle);
 }

@@ -5,16 +5,24 @@
 // the spool monitor promises to see, against the spool a healthy valve would have there
 // (Plant::healthy_spool): further from neutral by more than `excess` of the stroke, on the other side
 // of neutral by more than `band`, or off neutral by more than `band` where the healthy spool is within
-// `neutral_expected` of it. A spool stuck nearer neutral than commanded gives no more flow than asked
-// and never disagrees by this measure (the monitor's stated blind side).
+// `neutral_expected` of it. Each limit is taken past the spool's measurement by its resolution (three
+// of the LVDT's standard deviations and the bus's quantum): a spool stuck within the sensor's noise
+// of a limit disagrees by nothing the measurement can tell, and none can be asked to find it. A spool
+// stuck nearer neutral than commanded gives no more flow than asked and never disagrees by this
+// measure (the monitor's stated blind side).
 #include "model/types.hpp"
 #include "safety/spool_monitor.hpp"
 
 namespace exc::sim {
 
+// The measured spool's resolution, a fraction of the stroke: 3 x the LVDT's noise (sensors.spool_noise)
+// plus the quantum the bus carries it in (SENS_MACHINE's spool signals, hal/can_protocol.cpp).
+double spool_resolution(double spool_noise);
+
 class SpoolDisagreement {
  public:
-  explicit SpoolDisagreement(const safety::SpoolMonitorSettings& limits) : limits_(limits) {}
+  SpoolDisagreement(const safety::SpoolMonitorSettings& limits, double resolution)
+      : limits_(limits), resolution_(resolution) {}
   // Every cycle: t (s) the plant's time of `spool` (as it is) and `healthy` (as a healthy valve's).
   // Only the first onset is kept.
   void record(double t, const Vec4& spool, const Vec4& healthy);
@@ -25,6 +33,7 @@ class SpoolDisagreement {
 
  private:
   safety::SpoolMonitorSettings limits_;
+  double resolution_;
   double onset_ = -1;
   int function_ = -1;
 };
