@@ -221,23 +221,23 @@ void FirmwareNode::publish_counters(bool after_exit_command) {
 void FirmwareNode::scan_state(SubnormalScan& scan) const {
   struct Scan final : control::StateVisitor {
     explicit Scan(SubnormalScan& s) : scan(s) {}
-    void visit(const char* name, const double* values, std::size_t count) override { scan.scan(name, values, count); }
+    void visit(const char* name, const double* values, std::size_t count) override { scan.visit(name, values, count); }
     SubnormalScan& scan;
   } v(scan);
   // What came in and went out.
-  scan.scan("firmware sensors.position", sensors_.position);
-  scan.scan("firmware sensors.velocity", sensors_.velocity);
-  scan.scan("firmware sensors.pressure_a", sensors_.pressure_a);
-  scan.scan("firmware sensors.pressure_b", sensors_.pressure_b);
-  scan.scan("firmware sensors.pump_pressure", sensors_.pump_pressure);
-  scan.scan("firmware command.value", command_.value);
-  scan.scan("firmware command.pilot_a", command_.pilot_a);
-  scan.scan("firmware command.pilot_b", command_.pilot_b);
+  scan.visit("firmware sensors.position", sensors_.position);
+  scan.visit("firmware sensors.velocity", sensors_.velocity);
+  scan.visit("firmware sensors.pressure_a", sensors_.pressure_a);
+  scan.visit("firmware sensors.pressure_b", sensors_.pressure_b);
+  scan.visit("firmware sensors.pump_pressure", sensors_.pump_pressure);
+  scan.visit("firmware command.value", command_.value);
+  scan.visit("firmware command.pilot_a", command_.pilot_a);
+  scan.visit("firmware command.pilot_b", command_.pilot_b);
   // The path and the hold.
-  scan.scan("q_desired", desired_.q);
-  scan.scan("qd_desired", desired_.qd);
-  scan.scan("qdd_desired", desired_.qdd);
-  scan.scan("held q", held_q_);
+  scan.visit("q_desired", desired_.q);
+  scan.visit("qd_desired", desired_.qd);
+  scan.visit("qdd_desired", desired_.qdd);
+  scan.visit("held q", held_q_);
   // The law, its output and the stages after it.
   step_.visit_state(v);
 }
