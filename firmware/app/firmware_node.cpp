@@ -219,24 +219,16 @@ void FirmwareNode::publish_counters(bool after_exit_command) {
 }
 
 void FirmwareNode::scan_state(SubnormalScan& scan) const {
+  // The law, the estimator and the stages show their state through the laws' interface.
   struct Scan final : control::StateVisitor {
     explicit Scan(SubnormalScan& s) : scan(s) {}
     void visit(const char* name, const double* values, std::size_t count) override { scan.visit(name, values, count); }
     SubnormalScan& scan;
   } v(scan);
-  // What came in and went out.
-  scan.visit("firmware sensors.position", sensors_.position);
-  scan.visit("firmware sensors.velocity", sensors_.velocity);
-  scan.visit("firmware sensors.pressure_a", sensors_.pressure_a);
-  scan.visit("firmware sensors.pressure_b", sensors_.pressure_b);
-  scan.visit("firmware sensors.pump_pressure", sensors_.pump_pressure);
-  scan.visit("firmware command.value", command_.value);
-  scan.visit("firmware command.pilot_a", command_.pilot_a);
-  scan.visit("firmware command.pilot_b", command_.pilot_b);
-  // The path and the hold.
-  scan.visit("q_desired", desired_.q);
-  scan.visit("qd_desired", desired_.qd);
-  scan.visit("qdd_desired", desired_.qdd);
+  // What came in and went out, the path and the hold: each type visits its own values.
+  hal::visit_state(sensors_, scan);
+  hal::visit_state(command_, scan);
+  visit_state(desired_, scan);
   scan.visit("held q", held_q_);
   // The law, its output and the stages after it.
   step_.visit_state(v);
