@@ -45,64 +45,11 @@ Vec4 PlantNode::hold_effort() {
 }
 
 void PlantNode::scan_state(app::SubnormalScan& scan) const {
-  const plant::PlantState& s = plant_.state();
-  scan.visit("plant q_a", s.q_a);
-  scan.visit("plant qd_a", s.qd_a);
-  scan.visit("plant qdd_a", s.qdd_a);
-  scan.visit("plant q (tree)", s.q);
-  scan.visit("plant qd (tree)", s.qd);
-  scan.visit("plant tip_world", s.tip_world);
-  scan.visit("plant rho", s.rho);
-  scan.visit("plant rhod", s.rhod);
-  scan.visit("plant soil_force", s.soil_force);
-  scan.visit("plant soil_anchor", s.soil_anchor);
-  scan.visit("plant depth", s.depth);
-  scan.visit("plant effort", s.effort);
-  scan.visit("plant spool", s.spool);
-  scan.visit("plant pressure_a", s.pressure_a);
-  scan.visit("plant pressure_b", s.pressure_b);
-  const plant::HydraulicReport& h = s.hydraulics;
-  scan.visit("plant pump_pressure", h.pump_pressure);
-  scan.visit("plant pump_flow", h.pump_flow);
-  scan.visit("plant flow_scale", h.flow_scale);
-  scan.visit("plant metering opening", h.opening);
-  scan.visit("plant meter_in_flow", h.meter_in_flow);
-  scan.visit("plant meter_out_flow", h.meter_out_flow);
-  scan.visit("plant makeup_flow", h.makeup_flow);
-  scan.visit("plant relief_flow", h.relief_flow);
-  const plant::HydraulicEnergy& e = h.energy;
-  const double energy[] = {e.stored, e.pump_work, e.tank_work, e.vapour_work, e.volume_term, e.meter_in_loss,
-                           e.meter_out_loss, e.relief_loss, e.makeup_loss, e.piston_work};
-  scan.visit("plant circuit energy terms", energy, sizeof energy / sizeof energy[0]);
-  const double balance[] = {s.kinetic_energy, s.potential_energy, s.energy_error, s.actuator_work, s.soil_work,
-                            s.constraint_residual, s.end_stop_loss, s.friction_loss};
-  scan.visit("plant energy balance", balance, sizeof balance / sizeof balance[0]);
-  const plant::SensorReading& r = plant_.sensors();
-  scan.visit("plant sensor position", r.position);
-  scan.visit("plant sensor velocity", r.velocity);
-  scan.visit("plant sensor pressure_a", r.pressure_a);
-  scan.visit("plant sensor pressure_b", r.pressure_b);
-  scan.visit("plant sensor swing_pressure", r.swing_pressure);
-  // The dynamics' workspace at the last evaluation (twists, accelerations, wrenches, Psi, gamma, tip).
-  const Workspace& w = plant_.workspace();
-  for (int i = 0; i < kNumJoints; ++i) {
-    scan.visit("plant workspace V", w.V[i]);
-    scan.visit("plant workspace Vd", w.Vd[i]);
-    scan.visit("plant workspace F", w.F[i]);
-  }
-  scan.visit("plant workspace qd", w.qd);
-  scan.visit("plant workspace qdd", w.qdd);
-  scan.visit("plant workspace tau_r", w.tau_r);
-  scan.visit("plant workspace Psi", w.Psi);
-  scan.visit("plant workspace gamma", w.gamma);
-  scan.visit("plant workspace rhod", w.rhod);
-  scan.visit("plant workspace rhodd_bias", w.rhodd_bias);
-  // This node's frames: the sensor set it sent and the command set it steps with.
-  scan.visit("plant node sensors.velocity", sensors_.velocity);
-  scan.visit("plant node sensors.position", sensors_.position);
-  scan.visit("plant node command.value", command_.value);
-  scan.visit("plant node command.pilot_a", command_.pilot_a);
-  scan.visit("plant node command.pilot_b", command_.pilot_b);
+  // The machine (its state, circuit, sensors' reading and dynamics' workspace), then this node's
+  // frames: the sensor set it sent and the command set it steps with. Each type visits its own values.
+  plant_.visit_state(scan);
+  hal::visit_state(sensors_, scan);
+  hal::visit_state(command_, scan);
 }
 
 void PlantNode::hold_for_silence() {

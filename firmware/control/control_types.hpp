@@ -83,11 +83,14 @@ struct ControlOutput {
 // docs/floating-point.md), so the firmware reads a law's memory without knowing the law.
 //
 // The one shape of a state visitor, shared by the firmware and the plant: visit(name, values, count)
-// and its three conveniences (one double, a std::array of doubles, a fixed-size Eigen matrix), so a
-// state type's visit_state can be a function template that any visitor of this shape takes.
-// app::SubnormalScan (firmware/diagnostics/subnormal_scan.hpp) has the same four, for the plant's
-// node, which may not include this floor (docs/architecture.md). A name is a string literal:
-// visitors keep the pointer.
+// and its three conveniences (one double, a std::array of doubles, a fixed-size Eigen matrix). The
+// state types visit themselves beside their declarations with a function template
+// visit_state(const T&, Visitor&) that calls only these four (hal::SensorState, hal::CommandState,
+// app::DesiredMotion, ControlOutput below, exc::Workspace, the plant's PlantState and its parts), so a
+// floor below this one (hal, the model, the plant) needs no header of ours to be visited; the laws,
+// whose state is behind an interface, take this class. app::SubnormalScan
+// (firmware/diagnostics/subnormal_scan.hpp) has the same four, for the plant's node, which may not
+// include this floor (docs/architecture.md). A name is a string literal: visitors keep the pointer.
 class StateVisitor {
  public:
   virtual void visit(const char* name, const double* values, std::size_t count) = 0;

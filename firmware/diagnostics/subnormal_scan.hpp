@@ -1,8 +1,8 @@
 #pragma once
 // A look for subnormal numbers in a node's working state (docs/floating-point.md): a state visitor
 // (the shape of control::StateVisitor: visit(name, values, count), one double, a std::array of
-// doubles, a fixed-size Eigen matrix) that each node feeds with its values by name
-// (FirmwareNode::scan_state, PlantNode::scan_state). It counts the
+// doubles, a fixed-size Eigen matrix) that each state type's visit_state feeds, value by value and by
+// name (FirmwareNode::scan_state, PlantNode::scan_state name only the nodes' members). It counts the
 // subnormal ones and keeps the first it met, so a test can say which state decayed. Told by the
 // values' bits (is_subnormal), so it sees them in the loop's mode too. Allocation-free.
 #include <array>

@@ -11,9 +11,34 @@
 #include "app/control_step.hpp"
 #include "control/control_types.hpp"
 #include "hal/excavator_interface.hpp"
+#include "model/machine_reader.hpp"
+#include "model/model.hpp"
+#include "model/workspace.hpp"
 #include "visited_doubles.hpp"
 
 using namespace exc;
+
+namespace exc::test {
+
+template <>
+struct NestedFill<ModelReport> {
+  static void fill(SubnormalFill& f, ModelReport& r) { EXC_FILL_EVERY_MEMBER(f, r, status, loop, conditioning); }
+};
+
+template <>
+struct NestedFill<Workspace::PlanarLinks> {
+  static void fill(SubnormalFill& f, Workspace::PlanarLinks& p) {
+    EXC_FILL_EVERY_MEMBER(f, p, origin_y, alpha, acceleration, com, com_y, J_angle, J_origin, J_com, jacobians_valid);
+  }
+};
+
+// Not visited: the Newton loop closure forms the factor and solves with it in one call (visit_state(Workspace)).
+template <>
+struct NestedFill<Eigen::PartialPivLU<Mat8>> {
+  static void fill(SubnormalFill&, Eigen::PartialPivLU<Mat8>&) {}
+};
+
+}  // namespace exc::test
 
 namespace {
 
@@ -178,5 +203,29 @@ TEST_CASE("firmware/visit_state visits every double of control::ControlOutput on
                         rho_env, disturbance, tip_force, status, velocity_command, velocity);
   const test::VisitAudit audit = test::audit_visit(o, fill);
   INFO(audit.text());
+  CHECK(audit.complete());
+}
+
+TEST_CASE("model/visit_state visits every double of ModelReport once") {
+  ModelReport r;
+  test::SubnormalFill fill;
+  EXC_FILL_EVERY_MEMBER(fill, r, status, loop, conditioning);
+  const test::VisitAudit audit = test::audit_visit(r, fill);
+  INFO(audit.text());
+  CHECK(audit.set > 0);
+  CHECK(audit.complete());
+}
+
+TEST_CASE("model/visit_state visits every double of Workspace once") {
+  const Model model = build_model(reference_machine());
+  Workspace w(model);
+  test::SubnormalFill fill;
+  EXC_FILL_EVERY_MEMBER(fill, w, q, qd, qdd, X_Wi, front_world_poses_valid, f_parent, V, Vd, pin_valid, F, tau_r, H, Psi, gamma,
+                        F_c, M_r, report, rho, rhod, rhodd_bias, J_t, tip_world, cos_phi, sin_phi, omega, alpha, joint_cos,
+                        joint_sin, origin, origin_d, origin_dd, Hd_qd, J_tip_tree, tip_acc_tree, Hp_inv, lu_Hp,
+                        loop_jacobian_valid, planar);
+  const test::VisitAudit audit = test::audit_visit(w, fill);
+  INFO(audit.text());
+  CHECK(audit.set > 0);
   CHECK(audit.complete());
 }
