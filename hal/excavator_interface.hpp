@@ -47,6 +47,20 @@ struct SensorState {
   std::uint8_t supervisor_pending = 0;
 };
 
+// Every double of a sensor set, by name, to a state visitor (control::StateVisitor's shape: the
+// firmware's scan for subnormal numbers, docs/floating-point.md). A template, so hal includes nothing
+// of ours. A double member added above and left out here fails `firmware/visit_state visits every
+// double of hal::SensorState once`.
+template <typename Visitor>
+void visit_state(const SensorState& s, Visitor& v) {
+  v.visit("sensors position", s.position);
+  v.visit("sensors velocity", s.velocity);
+  v.visit("sensors pressure_a", s.pressure_a);
+  v.visit("sensors pressure_b", s.pressure_b);
+  v.visit("sensors pump_pressure", s.pump_pressure);
+  v.visit("sensors spool", s.spool);
+}
+
 // The three exclusive command sets (DBC ExcCommandSet): efforts, signed valve openings, or pilot
 // pressures on both ends of each main-valve spool.
 enum class CommandMode : std::uint8_t { effort, valve, pilot };
@@ -64,5 +78,14 @@ struct CommandState {
   bool emergency_stop = false;     // plant side: the firmware latched an emergency stop
   std::uint16_t fault_code = 0;
 };
+
+// Every double of a command set (as visit_state(SensorState) above; held to the struct by
+// `firmware/visit_state visits every double of hal::CommandState once`).
+template <typename Visitor>
+void visit_state(const CommandState& c, Visitor& v) {
+  v.visit("command value", c.value);
+  v.visit("command pilot_a", c.pilot_a);
+  v.visit("command pilot_b", c.pilot_b);
+}
 
 }  // namespace exc::hal

@@ -79,6 +79,46 @@ struct HydraulicReport {
   HydraulicEnergy energy;
 };
 
+// Every double of the circuit's energy terms and its report, by name, to a state visitor (the shape
+// of the firmware's control::StateVisitor, which this floor does not include: the subnormal scan of
+// PlantNode::scan_state, docs/floating-point.md). Held to the structs by `plant/visit_state visits
+// every double of HydraulicEnergy once` and `... of HydraulicReport once`.
+template <typename Visitor>
+void visit_state(const HydraulicEnergy& e, Visitor& v) {
+  v.visit("circuit energy stored", e.stored);
+  v.visit("circuit energy stored0", e.stored0);
+  v.visit("circuit energy pump_work", e.pump_work);
+  v.visit("circuit energy tank_work", e.tank_work);
+  v.visit("circuit energy vapour_work", e.vapour_work);
+  v.visit("circuit energy volume_term", e.volume_term);
+  v.visit("circuit energy meter_in_loss", e.meter_in_loss);
+  v.visit("circuit energy meter_out_loss", e.meter_out_loss);
+  v.visit("circuit energy relief_loss", e.relief_loss);
+  v.visit("circuit energy makeup_loss", e.makeup_loss);
+  v.visit("circuit energy leakage_loss", e.leakage_loss);
+  v.visit("circuit energy piston_work", e.piston_work);
+}
+
+template <typename Visitor>
+void visit_state(const HydraulicReport& h, Visitor& v) {
+  v.visit("circuit pump_pressure", h.pump_pressure);
+  v.visit("circuit pump_flow", h.pump_flow);
+  v.visit("circuit flow_scale", h.flow_scale);
+  v.visit("circuit metering opening", h.opening);
+  v.visit("circuit meter_in_flow", h.meter_in_flow);
+  v.visit("circuit meter_out_flow", h.meter_out_flow);
+  v.visit("circuit makeup_flow", h.makeup_flow);
+  v.visit("circuit relief_flow", h.relief_flow);
+  v.visit("circuit leakage_flow", h.leakage_flow);
+  v.visit("circuit piston_leakage_flow", h.piston_leakage_flow);
+  v.visit("circuit min_pressure", h.min_pressure);
+  v.visit("circuit max_pressure", h.max_pressure);
+  v.visit("circuit pilot_supply", h.pilot_supply);
+  v.visit("circuit engine_flow", h.engine_flow);
+  v.visit("circuit pump_line_open", h.pump_line_open);
+  visit_state(h.energy, v);
+}
+
 class HydraulicCircuit {
  public:
   HydraulicCircuit() = default;

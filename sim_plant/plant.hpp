@@ -48,6 +48,38 @@ struct PlantState {
   int implicit_iterations = 0;     // of the last substep (implicit_midpoint)
 };
 
+// Every double of the plant's state, its circuit's report included, by name, to a state visitor (as
+// visit_state(HydraulicReport); held to the struct by `plant/visit_state visits every double of
+// PlantState once`).
+template <typename Visitor>
+void visit_state(const PlantState& s, Visitor& v) {
+  v.visit("plant time", s.time);
+  v.visit("plant q_a", s.q_a);
+  v.visit("plant qd_a", s.qd_a);
+  v.visit("plant qdd_a", s.qdd_a);
+  v.visit("plant q (tree)", s.q);
+  v.visit("plant qd (tree)", s.qd);
+  v.visit("plant tip_world", s.tip_world);
+  v.visit("plant rho", s.rho);
+  v.visit("plant rhod", s.rhod);
+  v.visit("plant soil_force", s.soil_force);
+  v.visit("plant soil_anchor", s.soil_anchor);
+  v.visit("plant depth", s.depth);
+  v.visit("plant effort", s.effort);
+  v.visit("plant spool", s.spool);
+  v.visit("plant pressure_a", s.pressure_a);
+  v.visit("plant pressure_b", s.pressure_b);
+  visit_state(s.hydraulics, v);
+  v.visit("plant kinetic_energy", s.kinetic_energy);
+  v.visit("plant potential_energy", s.potential_energy);
+  v.visit("plant energy_error", s.energy_error);
+  v.visit("plant actuator_work", s.actuator_work);
+  v.visit("plant soil_work", s.soil_work);
+  v.visit("plant constraint_residual", s.constraint_residual);
+  v.visit("plant end_stop_loss", s.end_stop_loss);
+  v.visit("plant friction_loss", s.friction_loss);
+}
+
 class Plant {
  public:
   explicit Plant(const Scene& scene);
@@ -85,6 +117,14 @@ class Plant {
   const ActuatorFidelityEntry& fidelity() const { return actuators_.fidelity(); }
   const Model& model() const { return model_; }
   const Workspace& workspace() const { return ws_; }  // the dynamics' buffers at the last evaluation
+  // Its state, its sensors' latest reading and the dynamics' workspace, to a state visitor (the
+  // subnormal scan of PlantNode::scan_state): what the plant reports of itself from step to step.
+  template <typename Visitor>
+  void visit_state(Visitor& v) const {
+    plant::visit_state(state_, v);
+    plant::visit_state(sensors(), v);
+    exc::visit_state(ws_, v);
+  }
   // Efforts that hold the initial state still (gravity only): the hydraulic chambers start there.
   const Vec4& hold_effort() const { return hold_effort_; }
   double energy() const { return state_.kinetic_energy + state_.potential_energy; }

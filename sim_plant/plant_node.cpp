@@ -45,64 +45,11 @@ Vec4 PlantNode::hold_effort() {
 }
 
 void PlantNode::scan_state(app::SubnormalScan& scan) const {
-  const plant::PlantState& s = plant_.state();
-  scan.scan("plant q_a", s.q_a);
-  scan.scan("plant qd_a", s.qd_a);
-  scan.scan("plant qdd_a", s.qdd_a);
-  scan.scan("plant q (tree)", s.q);
-  scan.scan("plant qd (tree)", s.qd);
-  scan.scan("plant tip_world", s.tip_world);
-  scan.scan("plant rho", s.rho);
-  scan.scan("plant rhod", s.rhod);
-  scan.scan("plant soil_force", s.soil_force);
-  scan.scan("plant soil_anchor", s.soil_anchor);
-  scan.scan("plant depth", s.depth);
-  scan.scan("plant effort", s.effort);
-  scan.scan("plant spool", s.spool);
-  scan.scan("plant pressure_a", s.pressure_a);
-  scan.scan("plant pressure_b", s.pressure_b);
-  const plant::HydraulicReport& h = s.hydraulics;
-  scan.scan("plant pump_pressure", h.pump_pressure);
-  scan.scan("plant pump_flow", h.pump_flow);
-  scan.scan("plant flow_scale", h.flow_scale);
-  scan.scan("plant metering opening", h.opening);
-  scan.scan("plant meter_in_flow", h.meter_in_flow);
-  scan.scan("plant meter_out_flow", h.meter_out_flow);
-  scan.scan("plant makeup_flow", h.makeup_flow);
-  scan.scan("plant relief_flow", h.relief_flow);
-  const plant::HydraulicEnergy& e = h.energy;
-  const double energy[] = {e.stored, e.pump_work, e.tank_work, e.vapour_work, e.volume_term, e.meter_in_loss,
-                           e.meter_out_loss, e.relief_loss, e.makeup_loss, e.piston_work};
-  scan.scan("plant circuit energy terms", energy, sizeof energy / sizeof energy[0]);
-  const double balance[] = {s.kinetic_energy, s.potential_energy, s.energy_error, s.actuator_work, s.soil_work,
-                            s.constraint_residual, s.end_stop_loss, s.friction_loss};
-  scan.scan("plant energy balance", balance, sizeof balance / sizeof balance[0]);
-  const plant::SensorReading& r = plant_.sensors();
-  scan.scan("plant sensor position", r.position);
-  scan.scan("plant sensor velocity", r.velocity);
-  scan.scan("plant sensor pressure_a", r.pressure_a);
-  scan.scan("plant sensor pressure_b", r.pressure_b);
-  scan.scan("plant sensor swing_pressure", r.swing_pressure);
-  // The dynamics' workspace at the last evaluation (twists, accelerations, wrenches, Psi, gamma, tip).
-  const Workspace& w = plant_.workspace();
-  for (int i = 0; i < kNumJoints; ++i) {
-    scan.scan("plant workspace V", w.V[i]);
-    scan.scan("plant workspace Vd", w.Vd[i]);
-    scan.scan("plant workspace F", w.F[i]);
-  }
-  scan.scan("plant workspace qd", w.qd);
-  scan.scan("plant workspace qdd", w.qdd);
-  scan.scan("plant workspace tau_r", w.tau_r);
-  scan.scan("plant workspace Psi", w.Psi);
-  scan.scan("plant workspace gamma", w.gamma);
-  scan.scan("plant workspace rhod", w.rhod);
-  scan.scan("plant workspace rhodd_bias", w.rhodd_bias);
-  // This node's frames: the sensor set it sent and the command set it steps with.
-  scan.scan("plant node sensors.velocity", sensors_.velocity);
-  scan.scan("plant node sensors.position", sensors_.position);
-  scan.scan("plant node command.value", command_.value);
-  scan.scan("plant node command.pilot_a", command_.pilot_a);
-  scan.scan("plant node command.pilot_b", command_.pilot_b);
+  // The machine (its state, circuit, sensors' reading and dynamics' workspace), then this node's
+  // frames: the sensor set it sent and the command set it steps with. Each type visits its own values.
+  plant_.visit_state(scan);
+  hal::visit_state(sensors_, scan);
+  hal::visit_state(command_, scan);
 }
 
 void PlantNode::hold_for_silence() {

@@ -37,6 +37,19 @@ struct SensorReading {
   std::int64_t cycle = 0;        // the plant cycle the values were measured in
 };
 
+// Every double of a reading, by name, to a state visitor (as visit_state(HydraulicReport); held to the
+// struct by `plant/visit_state visits every double of SensorReading once`).
+template <typename Visitor>
+void visit_state(const SensorReading& r, Visitor& v) {
+  v.visit("sensor reading position", r.position);
+  v.visit("sensor reading velocity", r.velocity);
+  v.visit("sensor reading pressure_a", r.pressure_a);
+  v.visit("sensor reading pressure_b", r.pressure_b);
+  v.visit("sensor reading swing_pressure", r.swing_pressure);
+  v.visit("sensor reading pump_pressure", r.pump_pressure);
+  v.visit("sensor reading spool", r.spool);
+}
+
 class SensorModel {
  public:
   SensorModel() = default;

@@ -25,6 +25,14 @@ struct DesiredMotion {
   Vec4 q = Vec4::Zero(), qd = Vec4::Zero(), qdd = Vec4::Zero();
 };
 
+// Its values to a state visitor (control::StateVisitor's shape), for the subnormal scan.
+template <typename Visitor>
+void visit_state(const DesiredMotion& d, Visitor& v) {
+  v.visit("desired q", d.q);
+  v.visit("desired qd", d.qd);
+  v.visit("desired qdd", d.qdd);
+}
+
 // Builds the law as ControlStep does and drops it: a law the command interface cannot carry, or gains
 // the law refuses, are named before a program opens its bus (start-up code: allocates, throws).
 void check_control_law(const Model& model, const control::ControllerConfig& config);

@@ -219,25 +219,17 @@ void FirmwareNode::publish_counters(bool after_exit_command) {
 }
 
 void FirmwareNode::scan_state(SubnormalScan& scan) const {
+  // The law, the estimator and the stages show their state through the laws' interface.
   struct Scan final : control::StateVisitor {
     explicit Scan(SubnormalScan& s) : scan(s) {}
-    void visit(const char* name, const double* values, std::size_t count) override { scan.scan(name, values, count); }
+    void visit(const char* name, const double* values, std::size_t count) override { scan.visit(name, values, count); }
     SubnormalScan& scan;
   } v(scan);
-  // What came in and went out.
-  scan.scan("firmware sensors.position", sensors_.position);
-  scan.scan("firmware sensors.velocity", sensors_.velocity);
-  scan.scan("firmware sensors.pressure_a", sensors_.pressure_a);
-  scan.scan("firmware sensors.pressure_b", sensors_.pressure_b);
-  scan.scan("firmware sensors.pump_pressure", sensors_.pump_pressure);
-  scan.scan("firmware command.value", command_.value);
-  scan.scan("firmware command.pilot_a", command_.pilot_a);
-  scan.scan("firmware command.pilot_b", command_.pilot_b);
-  // The path and the hold.
-  scan.scan("q_desired", desired_.q);
-  scan.scan("qd_desired", desired_.qd);
-  scan.scan("qdd_desired", desired_.qdd);
-  scan.scan("held q", held_q_);
+  // What came in and went out, the path and the hold: each type visits its own values.
+  hal::visit_state(sensors_, scan);
+  hal::visit_state(command_, scan);
+  visit_state(desired_, scan);
+  scan.visit("held q", held_q_);
   // The law, its output and the stages after it.
   step_.visit_state(v);
 }

@@ -2,8 +2,10 @@
 // What every controller takes and returns, and the interface the firmware loop calls
 // (ros2_control's update(): the loop reads sensors, calls update(), writes the command).
 // All fixed-size; update() never allocates, throws or blocks.
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "model/model_status.hpp"
 #include "model/terrain.hpp"
@@ -79,13 +81,26 @@ struct ControlOutput {
 
 // What a law shows of its inner state, value by value (the firmware's scan for subnormal numbers,
 // docs/floating-point.md), so the firmware reads a law's memory without knowing the law.
+//
+// The one shape of a state visitor, shared by the firmware and the plant: visit(name, values, count)
+// and its three conveniences (one double, a std::array of doubles, a fixed-size Eigen matrix). The
+// state types visit themselves beside their declarations with a function template
+// visit_state(const T&, Visitor&) that calls only these four (hal::SensorState, hal::CommandState,
+// app::DesiredMotion, ControlOutput below, exc::Workspace, the plant's PlantState and its parts), so a
+// floor below this one (hal, the model, the plant) needs no header of ours to be visited; the laws,
+// whose state is behind an interface, take this class. app::SubnormalScan
+// (firmware/diagnostics/subnormal_scan.hpp) has the same four, for the plant's node, which may not
+// include this floor (docs/architecture.md). A name is a string literal: visitors keep the pointer.
 class StateVisitor {
  public:
   virtual void visit(const char* name, const double* values, std::size_t count) = 0;
   template <typename Derived>
   void visit(const char* name, const Eigen::PlainObjectBase<Derived>& values) {
+    static_assert(std::is_same_v<typename Derived::Scalar, double>, "a state visitor reads doubles");
     visit(name, values.data(), static_cast<std::size_t>(values.size()));
   }
+  template <std::size_t N>
+  void visit(const char* name, const std::array<double, N>& values) { visit(name, values.data(), N); }
   void visit(const char* name, const double& value) { visit(name, &value, 1); }
 
  protected:
@@ -93,7 +108,8 @@ class StateVisitor {
 };
 
 // A law's output, which the node keeps from one cycle to the next.
-inline void visit_state(const ControlOutput& out, StateVisitor& v) {
+template <typename Visitor>
+void visit_state(const ControlOutput& out, Visitor& v) {
   v.visit("law tau", out.tau);
   v.visit("law tau_unsaturated", out.tau_unsaturated);
   v.visit("law e", out.e);

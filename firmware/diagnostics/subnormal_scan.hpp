@@ -1,6 +1,8 @@
 #pragma once
-// A look for subnormal numbers in a node's working state (docs/floating-point.md): the node lists
-// each of its values by name (FirmwareNode::scan_state, PlantNode::scan_state), the scan counts the
+// A look for subnormal numbers in a node's working state (docs/floating-point.md): a state visitor
+// (the shape of control::StateVisitor: visit(name, values, count), one double, a std::array of
+// doubles, a fixed-size Eigen matrix) that each state type's visit_state feeds, value by value and by
+// name (FirmwareNode::scan_state, PlantNode::scan_state name only the nodes' members). It counts the
 // subnormal ones and keeps the first it met, so a test can say which state decayed. Told by the
 // values' bits (is_subnormal), so it sees them in the loop's mode too. Allocation-free.
 #include <array>
@@ -25,7 +27,7 @@ inline bool is_subnormal(double x) {
 
 class SubnormalScan {
  public:
-  void scan(const char* name, const double* values, std::size_t count) {
+  void visit(const char* name, const double* values, std::size_t count) {
     for (std::size_t i = 0; i < count; ++i) {
       if (!is_subnormal(values[i])) continue;
       if (found_ == 0) first_ = Finding{name, i, values[i], 0, time_};
@@ -34,15 +36,15 @@ class SubnormalScan {
     }
     scanned_ += count;
   }
-  void scan(const char* name, double value) { scan(name, &value, 1); }
+  void visit(const char* name, const double& value) { visit(name, &value, 1); }
   template <std::size_t N>
-  void scan(const char* name, const std::array<double, N>& values) {
-    scan(name, values.data(), N);
+  void visit(const char* name, const std::array<double, N>& values) {
+    visit(name, values.data(), N);
   }
   template <typename Derived>
-  void scan(const char* name, const Eigen::PlainObjectBase<Derived>& values) {
+  void visit(const char* name, const Eigen::PlainObjectBase<Derived>& values) {
     static_assert(std::is_same_v<typename Derived::Scalar, double>, "a scan reads doubles");
-    scan(name, values.data(), static_cast<std::size_t>(values.size()));
+    visit(name, values.data(), static_cast<std::size_t>(values.size()));
   }
 
   struct Finding {

@@ -22,4 +22,11 @@ struct ModelReport {
   bool ok() const { return status == ModelStatus::ok; }
 };
 
+// Its one double to a state visitor (the shape of the firmware's control::StateVisitor; a template,
+// so the model includes no floor above it), for a subnormal scan (docs/floating-point.md).
+template <typename Visitor>
+void visit_state(const ModelReport& r, Visitor& v) {
+  v.visit("model report conditioning", r.conditioning);
+}
+
 }  // namespace exc

@@ -83,4 +83,60 @@ struct Workspace {
   } planar;
 };
 
+// Every double of the workspace, by name, to a state visitor (the shape of the firmware's
+// control::StateVisitor; a template, so the model includes no floor above it): the plant's
+// subnormal scan (PlantNode::scan_state, docs/floating-point.md). Held to the struct by
+// `model/visit_state visits every double of Workspace once`. Not visited: lu_Hp, a factor the Newton
+// loop closure forms and solves with in one call (never read across calls; Eigen asserts on reading
+// one not yet formed).
+template <typename Visitor>
+void visit_state(const Workspace::PlanarLinks& p, Visitor& v) {
+  v.visit("workspace planar origin_y", p.origin_y);
+  v.visit("workspace planar alpha", p.alpha);
+  for (const Vec2& a : p.acceleration) v.visit("workspace planar acceleration", a);
+  for (const Vec2& c : p.com) v.visit("workspace planar com", c);
+  v.visit("workspace planar com_y", p.com_y);
+  for (const Vec3& j : p.J_angle) v.visit("workspace planar J_angle", j);
+  for (const auto& j : p.J_origin) v.visit("workspace planar J_origin", j);
+  for (const auto& j : p.J_com) v.visit("workspace planar J_com", j);
+}
+
+template <typename Visitor>
+void visit_state(const Workspace& w, Visitor& v) {
+  v.visit("workspace q", w.q);
+  v.visit("workspace qd", w.qd);
+  v.visit("workspace qdd", w.qdd);
+  for (const SE3& X : w.X_Wi) v.visit("workspace X_Wi", X);
+  for (const SE3& f : w.f_parent) v.visit("workspace f_parent", f);
+  for (const Twist& V : w.V) v.visit("workspace V", V);
+  for (const Twist& Vd : w.Vd) v.visit("workspace Vd", Vd);
+  for (const Wrench& F : w.F) v.visit("workspace F", F);
+  v.visit("workspace tau_r", w.tau_r);
+  v.visit("workspace H", w.H);
+  v.visit("workspace Psi", w.Psi);
+  v.visit("workspace gamma", w.gamma);
+  v.visit("workspace F_c", w.F_c);
+  v.visit("workspace M_r", w.M_r);
+  visit_state(w.report, v);
+  v.visit("workspace rho", w.rho);
+  v.visit("workspace rhod", w.rhod);
+  v.visit("workspace rhodd_bias", w.rhodd_bias);
+  v.visit("workspace J_t", w.J_t);
+  v.visit("workspace tip_world", w.tip_world);
+  v.visit("workspace cos_phi", w.cos_phi);
+  v.visit("workspace sin_phi", w.sin_phi);
+  v.visit("workspace omega", w.omega);
+  v.visit("workspace alpha", w.alpha);
+  v.visit("workspace joint_cos", w.joint_cos);
+  v.visit("workspace joint_sin", w.joint_sin);
+  for (const Vec2& o : w.origin) v.visit("workspace origin", o);
+  for (const Vec2& o : w.origin_d) v.visit("workspace origin_d", o);
+  for (const Vec2& o : w.origin_dd) v.visit("workspace origin_dd", o);
+  v.visit("workspace Hd_qd", w.Hd_qd);
+  v.visit("workspace J_tip_tree", w.J_tip_tree);
+  v.visit("workspace tip_acc_tree", w.tip_acc_tree);
+  v.visit("workspace Hp_inv", w.Hp_inv);
+  visit_state(w.planar, v);
+}
+
 }  // namespace exc

@@ -80,7 +80,7 @@ TEST_CASE("firmware/is_subnormal tells subnormals by their bits, in either mode"
   CHECK_FALSE(is_subnormal(std::numeric_limits<double>::quiet_NaN()));
   SubnormalScan scan;
   const double values[] = {1.0, d, 0.0, -3 * d};
-  scan.scan("values", values, 4);
+  scan.visit("values", values, 4);
   CHECK(scan.scanned() == 4);
   CHECK(scan.found() == 2);
   CHECK(scan.first().index == 1);
