@@ -118,8 +118,10 @@ void StopJudge::record(double t, const Vec4& q_a, const Vec4& qd_a, bool brake_a
 }
 
 double StopJudge::fit_onset(double detected, double spool_onset) const {
-  if (spool_onset >= 0 && spool_onset <= detected) return spool_onset;
-  return std::max(start_, detected - 0.1);
+  // Never earlier than 0.1 s before detection: a spool found late (R1 missed) leaves the machine
+  // under control until then, and the drift judges the stop, not the motion before it.
+  const double earliest = std::max(start_, detected - 0.1);
+  return spool_onset >= 0 && spool_onset <= detected ? std::max(spool_onset, earliest) : earliest;
 }
 
 StopJudgement StopJudge::judge(double detected, double spool_onset, double safe_state, double period, bool emergency) const {

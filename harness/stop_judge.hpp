@@ -69,8 +69,8 @@ class StopJudge {
   // (the safety solenoids dropped, the swing brake dumped).
   StopJudgement judge(double detected, double spool_onset, double safe_state, double period, bool emergency) const;
   // The onset the drift fit counts from: a stuck spool's onset of disagreement when it came no later
-  // than detection; otherwise as early as R1 lets it lie, the fault's start or 0.1 s before a later
-  // detection.
+  // than detection, otherwise as early as R1 lets it lie; never before the fault's start or earlier
+  // than 0.1 s before detection.
   double fit_onset(double detected, double spool_onset) const;
 
  private:

@@ -114,3 +114,35 @@ TEST_CASE("plant/stop judge: a ring shaken up again before it came to rest (a dr
     CHECK(j.meets_r3);
   }
 }
+
+TEST_CASE("plant/stop judge: R1 counts from a stuck spool's onset of disagreement, and the drift of a stop found late is fitted after its detection, not over the motion before it") {
+  // The arm moves at 10 mm/s under control from the fault's start until detection at 3 s, then stands.
+  const Machine machine = reference_machine();
+  const auto judge_at = [&](double onset, double detected) {
+    sim::StopJudge judge(machine, 0.0, kCycle, detected + 5);
+    Vec4 q(0.0, 2.46, 2.32, 2.14), qd = Vec4::Zero();
+    for (int k = 0; k * kCycle <= detected + 4; ++k) {
+      const double t = k * kCycle;
+      qd[kRingFunction] = t < detected ? 0.010 : 0.0;
+      judge.record(t, q, qd, false);
+      q[kRingFunction] += qd[kRingFunction] * kCycle;
+    }
+    return judge.judge(detected, onset, detected + kCycle, kCycle, false);
+  };
+  // Found 60 ms after its onset at 2.94 s: R1 met, counted from the onset.
+  const sim::StopJudgement soon = judge_at(2.94, 3.0);
+  CHECK(soon.onset_after_s == doctest::Approx(2.94));
+  CHECK(soon.detected_after_onset_s == doctest::Approx(0.06));
+  CHECK(soon.meets_r1);
+  // Found 3 s after an onset at the fault's start: R1 missed, and the stop's drift is the standing arm's.
+  const sim::StopJudgement late = judge_at(0.0, 3.0);
+  CHECK(late.detected_after_onset_s == doctest::Approx(3.0));
+  CHECK_FALSE(late.meets_r1);
+  CHECK(std::abs(late.drift[kRingFunction]) < 1e-9);
+  CHECK(late.meets_r3);
+  // No onset (a spool that never disagreed by detection, or a fault that sticks none): from the start.
+  const sim::StopJudgement none = judge_at(-1.0, 0.05);
+  CHECK(none.onset_after_s == -1.0);
+  CHECK(none.detected_after_onset_s == doctest::Approx(0.05));
+  CHECK(none.meets_r1);
+}
