@@ -26,7 +26,7 @@ const std::string kFreeMotion = std::string(EXC_SOURCE_DIR) + "/scenes/free_moti
 
 // The shipped scenes whose swing moves on the hydraulic machine: there flow-based control lags the
 // swing past its limit (below), and is left out of the default controllers.
-const std::set<std::string> kSwingLags{"free_motion.yaml", "truck_loading.yaml", "truck_clay_slope.yaml"};
+const std::set<std::string> kSwingLags{"free_motion.yaml", "hold_swung_high.yaml", "truck_loading.yaml", "truck_clay_slope.yaml"};
 
 // A saturating swing in a free-motion scene (2 rad in 2.5 s where it turns 0.4 rad in 2 s), with the
 // task's `efforts:` mapping and any further edits.
