@@ -77,14 +77,6 @@ std::unique_ptr<Controller> make_controller(std::string_view name, const Model& 
 // Why the named law cannot drive `interface` ("" when it can), as a person reads it.
 std::string interface_misfit(const ControllerEntry& law, CommandInterface interface);
 
-// The machine's effort limits, as the effort laws saturate to them.
-inline EffortLimits effort_limits_of(const Machine& machine) {
-  EffortLimits l;
-  l.min = machine.effort_min();
-  l.max = machine.effort_max();
-  return l;
-}
-
 template <typename Law>
 std::unique_ptr<Controller> build_law(const Model& model, const ControllerConfig& config) {
   if constexpr (std::is_constructible_v<Law, const Model&, const ControllerConfig&, const EffortLimits&>)

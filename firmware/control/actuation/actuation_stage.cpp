@@ -1,7 +1,5 @@
 #include "control/actuation/actuation_stage.hpp"
 
-#include "control/controller_registry.hpp"
-
 namespace exc::control {
 
 ActuationStage::ActuationStage(const Machine& nominal, const ControllerConfig& config)
