@@ -52,7 +52,9 @@ struct ControllerEntry {
   std::string (*task_misfit)(const Task& task) = nullptr;
 };
 
-// The factory of a law whose constructor takes (model, config, effort limits) or (config) alone.
+// The factory of a law whose constructor takes (model, config, effort limits) or (config) alone: a
+// program's or a test's own law may take the whole ControllerConfig; the shipped laws take their own
+// settings (consumer_settings.hpp), each through its factory in controller_registry.cpp.
 template <typename Law>
 std::unique_ptr<Controller> build_law(const Model& model, const ControllerConfig& config);
 
