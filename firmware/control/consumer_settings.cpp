@@ -48,4 +48,24 @@ FlowLawSettings flow_law_settings(const ControllerConfig& c) {
   return s;
 }
 
+ActuationSettings actuation_settings(const ControllerConfig& c) {
+  ActuationSettings s;
+  s.period = c.period;
+  s.command_interface = c.command_interface;
+  s.blend_time = c.blend_time;
+  s.actuator_lag = c.actuator_lag;
+  s.actuator_lag_target = c.actuator_lag_target;
+  s.valves = c.valves;
+  return s;
+}
+
+PathClockSettings path_clock_settings(const ControllerConfig& c) {
+  PathClockSettings s;
+  s.period = c.period;
+  s.stop_ramp_time = c.stop_ramp_time;
+  s.pump_pacing = c.pump_pacing;
+  s.pump_pacing_share = c.pump_pacing_share;
+  return s;
+}
+
 }  // namespace exc::control

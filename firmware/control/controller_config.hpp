@@ -3,33 +3,27 @@
 // bounds, filter cut-offs, watchdog) as the cycle takes it. Every field is optional: a scene without
 // `controller:` gets the embedded defaults below (docs/control.md lists them); the reader
 // (controller_config_reader.hpp) declares each field's unit and range once and validates them at
-// start-up on the host. Nothing here reads a file, so the firmware's image compiles it.
+// start-up on the host. Nothing here reads a file, so the firmware's image compiles it. The aggregate
+// of every consumer's settings: each law, the actuation stage and the path's clock takes its own part
+// (consumer_settings.hpp), so this file sits at control/'s top and no room includes it.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include "control/actuation/command_interface.hpp"
+#include "control/actuation/valve_inner_loop.hpp"
 #include "control/control_types.hpp"
-#include "control/laws/adaptive_law_settings.hpp"
-#include "control/laws/pid.hpp"
-#include "safety/pressure_plausibility.hpp"
-#include "safety/spool_monitor.hpp"
 #include "control/estimation/soil_contact.hpp"
 #include "control/estimation/state_estimator.hpp"
-#include "control/actuation/valve_inner_loop.hpp"
-#include "safety/velocity_plausibility.hpp"
+#include "control/laws/adaptive_law_settings.hpp"
+#include "control/laws/pid.hpp"
 #include "model/machine.hpp"
+#include "safety/pressure_plausibility.hpp"
+#include "safety/spool_monitor.hpp"
+#include "safety/velocity_plausibility.hpp"
 #include "settings/enum_table.hpp"
 
 namespace exc::control {
-
-// What the firmware commands on the bus: the efforts (a force-commanded machine, the paper's) or
-// the valves of a hydraulic machine through the valve stage (valve_inner_loop.hpp).
-enum class CommandInterface : std::uint8_t { effort = 0, valve = 1 };
-inline constexpr settings::EnumTable<CommandInterface, 2> kCommandInterfaces{{{
-    {CommandInterface::effort, "effort", "swing torque and cylinder forces (CMD_EFFORT): force-commanded actuators"},
-    {CommandInterface::valve, "valve",
-     "pilot pressures per spool end (CMD_PILOT) from the valve stage: a hydraulic machine's main valves"},
-}}};
 
 // Which of the values that follow the machine, the command interface and other settings the scene
 // gave itself; the others derive_defaults fills. The host's business: not in the settings blob.
