@@ -4,6 +4,7 @@
 #include <string>
 
 #include "app/firmware_node_config.hpp"
+#include "control/consumer_settings.hpp"
 #include "control/controller_registry.hpp"
 #include "hal/clock.hpp"
 
@@ -37,7 +38,7 @@ ControlStep::ControlStep(const Model& model, const FirmwareNodeConfig& config, s
       controller_(checked_controller(model, config.controller)),
       controller_id_(control::controller_registry().id_of(config.controller.law)),
       estimator_(config.controller.filter),
-      stage_(model.machine, config.controller) {}
+      stage_(model.machine, control::actuation_settings(config.controller)) {}
 
 ControlStep::~ControlStep() = default;
 

@@ -3,61 +3,27 @@
 // bounds, filter cut-offs, watchdog) as the cycle takes it. Every field is optional: a scene without
 // `controller:` gets the embedded defaults below (docs/control.md lists them); the reader
 // (controller_config_reader.hpp) declares each field's unit and range once and validates them at
-// start-up on the host. Nothing here reads a file, so the firmware's image compiles it.
+// start-up on the host. Nothing here reads a file, so the firmware's image compiles it. The aggregate
+// of every consumer's settings: each law, the actuation stage and the path's clock takes its own part
+// (consumer_settings.hpp), so this file sits at control/'s top and no room includes it.
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include "control/actuation/command_interface.hpp"
+#include "control/actuation/valve_inner_loop.hpp"
 #include "control/control_types.hpp"
-#include "control/laws/pid.hpp"
-#include "safety/pressure_plausibility.hpp"
-#include "safety/spool_monitor.hpp"
 #include "control/estimation/soil_contact.hpp"
 #include "control/estimation/state_estimator.hpp"
-#include "control/actuation/valve_inner_loop.hpp"
-#include "safety/velocity_plausibility.hpp"
+#include "control/laws/adaptive_law_settings.hpp"
+#include "control/laws/pid.hpp"
 #include "model/machine.hpp"
+#include "safety/pressure_plausibility.hpp"
+#include "safety/spool_monitor.hpp"
+#include "safety/velocity_plausibility.hpp"
 #include "settings/enum_table.hpp"
 
 namespace exc::control {
-
-// Where the adaptive law's regressor takes the joint acceleration for the soil's M_t rhodd term.
-enum class RegressorAcceleration : std::uint8_t { filtered = 0, desired = 1 };
-inline constexpr settings::EnumTable<RegressorAcceleration, 2> kRegressorAccelerations{{{
-    {RegressorAcceleration::filtered, "filtered", "the estimator's filtered joint acceleration"},
-    {RegressorAcceleration::desired, "desired", "the trajectory's desired acceleration"},
-}}};
-
-// What the firmware commands on the bus: the efforts (a force-commanded machine, the paper's) or
-// the valves of a hydraulic machine through the valve stage (valve_inner_loop.hpp).
-enum class CommandInterface : std::uint8_t { effort = 0, valve = 1 };
-inline constexpr settings::EnumTable<CommandInterface, 2> kCommandInterfaces{{{
-    {CommandInterface::effort, "effort", "swing torque and cylinder forces (CMD_EFFORT): force-commanded actuators"},
-    {CommandInterface::valve, "valve",
-     "pilot pressures per spool end (CMD_PILOT) from the valve stage: a hydraulic machine's main valves"},
-}}};
-
-// The external force observer and the composite update of the adaptive law (beyond the paper:
-// external_force_observer.hpp, adaptive_computed_torque.hpp). The paper's own law is observer: false,
-// identification_memory: 0.
-struct ExternalForceSettings {
-  bool observer = true;        // add the observer's estimate of what the model misses to the command
-  double cutoff_hz = 5;        // the observer's low-pass; default a third of filters.acceleration_cutoff_hz
-  // s: the composite update's memory, least squares on the residual of the applied efforts
-  // (soil_identification.hpp); 0: eq. 27 alone.
-  double identification_memory = 20;
-  double force_scale = 30000;  // N: the residual's noise n0 per sample (least squares' measurement noise)
-  double dead_zone = 300;      // N: of each cylinder's residual, no update below it (noise, friction)
-};
-// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
-template <typename Visitor>
-void visit_fields(Visitor& v, ExternalForceSettings& e) {
-  v("observer", e.observer);
-  v("cutoff_hz", e.cutoff_hz);
-  v("identification_memory", e.identification_memory);
-  v("force_scale", e.force_scale);
-  v("dead_zone", e.dead_zone);
-}
 
 // Which of the values that follow the machine, the command interface and other settings the scene
 // gave itself; the others derive_defaults fills. The host's business: not in the settings blob.

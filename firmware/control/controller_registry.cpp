@@ -3,6 +3,7 @@
 
 #include <stdexcept>
 
+#include "control/consumer_settings.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "control/laws/computed_torque_pid.hpp"
 #include "control/laws/flow_position_control.hpp"
@@ -11,6 +12,20 @@
 namespace exc::control {
 namespace {
 
+// The shipped laws' factories: each law built from its own part of the settings (consumer_settings.hpp).
+std::unique_ptr<Controller> make_pid(const Model& model, const ControllerConfig& config) {
+  return std::make_unique<ComputedTorquePid>(model, pid_law_settings(config), effort_limits_of(model.machine));
+}
+std::unique_ptr<Controller> make_adaptive(const Model& model, const ControllerConfig& config) {
+  return std::make_unique<AdaptiveComputedTorque>(model, adaptive_law_settings(config), effort_limits_of(model.machine));
+}
+std::unique_ptr<Controller> make_slotine_li(const Model& model, const ControllerConfig& config) {
+  return std::make_unique<SlotineLi>(model, slotine_li_settings(config), effort_limits_of(model.machine));
+}
+std::unique_ptr<Controller> make_flow(const Model&, const ControllerConfig& config) {
+  return std::make_unique<FlowPositionControl>(flow_law_settings(config));
+}
+
 std::string flow_task_misfit(const Task& task) {
   return flow_law_fits(task) ? "" : "the task moves the swing, which flow-based control cannot accelerate (docs/control.md)";
 }
@@ -18,16 +33,16 @@ std::string flow_task_misfit(const Task& task) {
 // Their order is their telemetry number (ControllerRegistry::id_of): add new laws at the end.
 ControllerRegistry shipped_controllers() {
   ControllerRegistry r;
-  r.add({"pid", "closed-chain inverse dynamics + PID (the paper's baseline)", build_law<ComputedTorquePid>,
+  r.add({"pid", "closed-chain inverse dynamics + PID (the paper's baseline)", make_pid,
          kAnyInterface, DefaultRun::yes});
   r.add({"adaptive", "adaptive computed torque with the soil regressor (paper eqs. 12-28)",
-         build_law<AdaptiveComputedTorque>, kAnyInterface, DefaultRun::yes, Adapts::yes});
-  r.add({"slotine_li", "Slotine-Li passivity-based adaptive law (needs no acceleration)", build_law<SlotineLi>,
+         make_adaptive, kAnyInterface, DefaultRun::yes, Adapts::yes});
+  r.add({"slotine_li", "Slotine-Li passivity-based adaptive law (needs no acceleration)", make_slotine_li,
          kAnyInterface, DefaultRun::no, Adapts::yes});
   r.add({"flow",
          "flow-based position control: valve flow from the desired velocity plus position feedback, no model (the "
          "industry's baseline; valve-commanded machines only)",
-         build_law<FlowPositionControl>, kValveInterface, DefaultRun::yes, Adapts::no, flow_task_misfit});
+         make_flow, kValveInterface, DefaultRun::yes, Adapts::no, flow_task_misfit});
   return r;
 }
 

@@ -52,7 +52,9 @@ struct ControllerEntry {
   std::string (*task_misfit)(const Task& task) = nullptr;
 };
 
-// The factory of a law whose constructor takes (model, config, effort limits) or (config) alone.
+// The factory of a law whose constructor takes (model, config, effort limits) or (config) alone: a
+// program's or a test's own law may take the whole ControllerConfig; the shipped laws take their own
+// settings (consumer_settings.hpp), each through its factory in controller_registry.cpp.
 template <typename Law>
 std::unique_ptr<Controller> build_law(const Model& model, const ControllerConfig& config);
 
@@ -76,14 +78,6 @@ std::unique_ptr<Controller> make_controller(std::string_view name, const Model& 
 
 // Why the named law cannot drive `interface` ("" when it can), as a person reads it.
 std::string interface_misfit(const ControllerEntry& law, CommandInterface interface);
-
-// The machine's effort limits, as the effort laws saturate to them.
-inline EffortLimits effort_limits_of(const Machine& machine) {
-  EffortLimits l;
-  l.min = machine.effort_min();
-  l.max = machine.effort_max();
-  return l;
-}
 
 template <typename Law>
 std::unique_ptr<Controller> build_law(const Model& model, const ControllerConfig& config) {

@@ -4,6 +4,7 @@
 #include <random>
 
 #include "closed_loop.hpp"
+#include "control/consumer_settings.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "control/controller_registry.hpp"
 #include "control/estimation/state_estimator.hpp"
@@ -57,7 +58,7 @@ LyapunovRun run_lyapunov(const Vec2& anchor_error, bool integral_action = false,
   cfg.integral_action = integral_action;  // z = [int e; e; ed] with K_i = 100 (the defaults)
   cfg.lyapunov_q_integral = Vec4::Ones();
   EffortLimits unlimited;
-  AdaptiveComputedTorque ctrl(model, cfg, unlimited);
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), unlimited);
 
   Workspace ws(model);
   const Vec4 q0 = pose_in_soil(model, ws);
@@ -138,7 +139,7 @@ TEST_CASE("firmware/adaptive: the projection keeps every soil estimate inside it
   const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), m);
   ControllerConfig cfg;
   cfg.adaptation_rate *= 10.0;  // an aggressive rate, so the noise really pushes at the bounds
-  AdaptiveComputedTorque ctrl(model, cfg, effort_limits_of(m));
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), effort_limits_of(m));
   sim::ModelPlant plant(model, sim::SoilTruth{});
   Vec4 q0, qd0, qdd0;
   task.trajectory.evaluate(0, q0, qd0, qdd0);
@@ -241,7 +242,7 @@ TEST_CASE("firmware/adaptive with integral action removes the steady error of a 
   for (int with_integral = 0; with_integral < 2; ++with_integral) {
     ControllerConfig cfg;
     cfg.integral_action = with_integral == 1;
-    AdaptiveComputedTorque ctrl(light, cfg, effort_limits_of(truth.machine));
+    AdaptiveComputedTorque ctrl(light, adaptive_law_settings(cfg), effort_limits_of(truth.machine));
     sim::ModelPlant plant(truth, air);
     plant.reset(q0, Vec4::Zero());
     ControlOutput out;

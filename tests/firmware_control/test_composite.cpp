@@ -7,6 +7,7 @@
 #include <random>
 
 #include "closed_loop.hpp"
+#include "control/consumer_settings.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "control/estimation/external_force_observer.hpp"
 #include "control/estimation/soil_contact.hpp"
@@ -182,7 +183,7 @@ TEST_CASE("firmware/adaptive composite update pauses on a joint whose applied ef
   ControllerConfig cfg;
   cfg.adaptation_rate.setZero();
   EffortLimits unlimited;
-  AdaptiveComputedTorque ctrl(model, cfg, unlimited);
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), unlimited);
   Workspace ws(model);
   Vec4 q0;
   REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 0.5}, q0) == IkStatus::ok);

@@ -14,6 +14,7 @@
 #include "app/allocation_counter.hpp"
 #include "app/realtime_setup.hpp"
 #include "control/actuation/actuator_lag_compensator.hpp"
+#include "control/consumer_settings.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "diagnostics/perf_counter.hpp"
 #include "control/actuation/command_blender.hpp"
@@ -133,7 +134,7 @@ TEST_CASE("firmware/timing budget of the adaptive control step after real-time p
   const Model model = build_model(reference_machine());
   const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   const ControllerConfig cfg;
-  AdaptiveComputedTorque ctrl(model, cfg, effort_limits_of(model.machine));
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), effort_limits_of(model.machine));
   StateEstimator est(cfg.filter);
   sim::ModelPlant plant(model, sim::SoilTruth{});
   Vec4 q0, qd0, qdd0;

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "app/allocation_counter.hpp"
+#include "control/consumer_settings.hpp"
 #include "control/laws/flow_position_control.hpp"
 #include "control/actuation/valve_inner_loop.hpp"
 
@@ -317,7 +318,7 @@ TEST_CASE("firmware/valve stage counts the pumps' flow the openings ask for") {
 TEST_CASE("firmware/flow law passes the desired velocity plus K_p times the position error") {
   ControllerConfig config;
   config.flow_kp = Vec4(1, 2, 3, 4);
-  FlowPositionControl flow(config);
+  FlowPositionControl flow(flow_law_settings(config));
   ControlInput in;
   in.q = Vec4(0.1, 2.0, 2.5, 1.8);
   in.q_d = Vec4(0.15, 1.9, 2.5, 1.85);

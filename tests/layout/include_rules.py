@@ -5,18 +5,22 @@
 
 ROOT (default: two folders up) is a source tree. The rules are read from the table between the
 markers `<!-- include rules: begin -->` and `<!-- include rules: end -->` in ROOT/docs/architecture.md,
-so the map and the check cannot disagree. Each row names a folder (`hal/`), one tool folder each
-(`tools/*/`) or a file prefix (`sim_plant/plant_node`), and what its files may include besides their
-own folder: folders (`firmware/model/`, with what that folder may include in turn) or single files.
-A row may name only rows above it, so the floors cannot form a circle.
+so the map and the check cannot disagree. Each row names a folder (`hal/`), a room of a folder
+(`firmware/control/laws/`), one tool folder each (`tools/*/`) or a file prefix (`sim_plant/plant_node`),
+and what its files may include besides their own: rows (a folder or a file prefix, with what that row
+may include in turn) or single files. A row may name only rows above it, so the floors cannot form a
+circle.
 
 Every .cpp, .hpp and .h outside tests/, hidden folders and build trees is a product source. Each
 #include "..." (and each #include <...> that names one of our folders) is resolved as the compiler
 would: beside the including file, from ROOT, from ROOT/firmware (the firmware's include root), as a
 generated header (exlcm/ from lcmtypes/, message_fields.hpp from log_export/), or by its file name
 through a library's include folder. Exit 1, naming file:line, for an include its row does not allow,
-one that cannot be resolved, or a source that no row covers; exit 2 for a missing or bad table. A
-folder's row covers the rooms inside it as one floor: they may include each other.
+one that cannot be resolved, or a source that no row covers; exit 2 for a missing or bad table.
+A source belongs to the longest row that covers it: a room with a row of its own is a floor of its own
+(firmware/control/'s rooms are), and its folder's row covers the folder's own files; a folder's rooms
+without rows of their own are of its floor and include each other. A file-prefix row's own files are
+those of its prefix (`sim_plant/plant_node.hpp` and `.cpp`), not the rest of their folder.
 """
 import os
 import re
@@ -62,7 +66,7 @@ def read_rules(root):
 
 
 def allowed_targets(rows, key):
-    """The row's entries, and for each folder entry what that folder's row allows, recursively."""
+    """The row's entries, and for each entry that is a row what that row allows, recursively."""
     table = dict(rows)
     result, stack = set(), list(table[key])
     while stack:
@@ -70,9 +74,15 @@ def allowed_targets(rows, key):
         if entry in result:
             continue
         result.add(entry)
-        if entry.endswith("/") and entry in table:
+        if entry in table:
             stack.extend(table[entry])
     return result
+
+
+def is_allowed(rows, allowed, target):
+    """A single file entry allows that file; a row (a folder or a file prefix) what it covers."""
+    keys = {k for k, _ in rows}
+    return any(target == a or (target.startswith(a) and (a.endswith("/") or a in keys)) for a in allowed)
 
 
 def row_of(rows, path):
@@ -136,9 +146,13 @@ def main():
                             "rules covers its folder (add one, in floor order)")
             continue
         allowed = allowed_targets(rows, key)
-        # A folder's row covers its rooms, one floor: they include each other freely (firmware/control/'s
-        # rooms do: its settings gather every room's); a file-prefix row, its own folder only.
-        own = key if key.endswith("/") and not key.endswith("*/") else os.path.dirname(source) + "/"
+        # A folder's row covers its files and the rooms that have no row of their own (a room with a
+        # row is matched by it, the longer key); a tool folder's row, that tool's folder; a
+        # file-prefix row, the files of its prefix.
+        if key.endswith("*/"):
+            own = os.path.dirname(source) + "/"
+        else:
+            own = key
         with open(os.path.join(root, source), encoding="utf-8", errors="replace") as f:
             for number, line in enumerate(f, 1):
                 m = INCLUDE.match(line)
@@ -153,9 +167,9 @@ def main():
                     problems.append(f'{source}:{number}: #include "{name}" names no file of ours '
                                     "(nor a unique file name, nor a generated header)")
                     continue
-                if target.startswith(own) and ("/" not in target[len(own):] or own == key):
+                if target.startswith(own) and (own == key or "/" not in target[len(own):]):
                     continue
-                if any(target == a or (a.endswith("/") and target.startswith(a)) for a in allowed):
+                if is_allowed(rows, allowed, target):
                     continue
                 problems.append(f'{source}:{number}: #include "{name}" ({target}) is not allowed: '
                                 f"`{key}` may include {', '.join(sorted(allowed)) or 'nothing of ours'} "

@@ -1,15 +1,13 @@
 #include "control/actuation/actuation_stage.hpp"
 
-#include "control/controller_registry.hpp"
-
 namespace exc::control {
 
-ActuationStage::ActuationStage(const Machine& nominal, const ControllerConfig& config)
-    : valves_interface_(config.command_interface == CommandInterface::valve),
+ActuationStage::ActuationStage(const Machine& nominal, const ActuationSettings& settings)
+    : valves_interface_(settings.command_interface == CommandInterface::valve),
       friction_(actuator_friction(nominal)),
-      blender_(config.blend_time),
-      lag_(config.actuator_lag, config.actuator_lag_target, config.period, effort_limits_of(nominal)),
-      valve_stage_(valve_loop_model(nominal), config.valves, config.period) {}
+      blender_(settings.blend_time),
+      lag_(settings.actuator_lag, settings.actuator_lag_target, settings.period, effort_limits_of(nominal)),
+      valve_stage_(valve_loop_model(nominal), settings.valves, settings.period) {}
 
 Vec4 ActuationStage::efforts(double t, const Vec4& tau_law, bool restarted) {
   const Vec4 tau = blender_.apply(t, tau_law);

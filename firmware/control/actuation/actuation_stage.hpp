@@ -9,9 +9,9 @@
 
 #include "control/actuation/actuator_lag_compensator.hpp"
 #include "control/actuation/command_blender.hpp"
-#include "control/control_types.hpp"
-#include "control/controller_config.hpp"
+#include "control/actuation/command_interface.hpp"
 #include "control/actuation/valve_inner_loop.hpp"
+#include "control/control_types.hpp"
 #include "model/actuator_friction.hpp"
 #include "safety/supervisor.hpp"
 
@@ -23,9 +23,20 @@ struct ChamberPressures {
   Vec4 a = Vec4::Zero(), b = Vec4::Zero();
 };
 
+// What the stage reads, its own: ControllerConfig's members of the same names, which hold their
+// meaning and defaults (controller_config.hpp; consumer_settings.hpp hands them over).
+struct ActuationSettings {
+  double period = 1e-3;  // s
+  CommandInterface command_interface = CommandInterface::effort;
+  double blend_time = 0;           // s, bumpless switch fade
+  double actuator_lag = 0;         // s, the effort lag the lead compensates (0: none)
+  double actuator_lag_target = 0;  // s, the lag the compensated actuator should show
+  ValveLoopSettings valves;        // the valve stage's (valve interface)
+};
+
 class ActuationStage {
  public:
-  ActuationStage(const Machine& nominal, const ControllerConfig& config);
+  ActuationStage(const Machine& nominal, const ActuationSettings& settings);
 
   bool valves() const { return valves_interface_; }
   // Entering hold or track after a stop or at start-up: the valve stage forgets its filters.

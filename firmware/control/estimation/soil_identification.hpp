@@ -14,7 +14,6 @@
 
 #include <Eigen/Cholesky>
 
-#include "control/laws/regressor.hpp"
 #include "model/types.hpp"
 
 namespace exc::control {

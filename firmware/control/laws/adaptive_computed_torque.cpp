@@ -10,32 +10,32 @@
 
 namespace exc::control {
 
-AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const ControllerConfig& config,
+AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const AdaptiveLawSettings& settings,
                                                const EffortLimits& limits)
     : model_(model),
       ws_(model),
-      settings_(AdaptiveLawSettings::of(config)),
+      settings_(settings),
       limits_(limits),
-      contact_(config.soil_contact),
-      update_contact_(config.soil_contact),
-      observer_(config.period, config.external_force.cutoff_hz),
-      regression_filter_(config.filter),
-      identification_(config.theta_max, config.external_force.identification_memory, config.period,
-                      config.external_force.force_scale),
-      tip_filter_(first_order_gain(config.filter.velocity_cutoff_hz, config.period)),
-      tip_chain_filter_(first_order_gain(config.filter.velocity_cutoff_hz, config.period)) {
-  PidGains gains = config.gains;
-  if (config.integral_action) {
+      contact_(settings.soil_contact),
+      update_contact_(settings.soil_contact),
+      observer_(settings.period, settings.external_force.cutoff_hz),
+      regression_filter_(settings.filter),
+      identification_(settings.theta_max, settings.external_force.identification_memory, settings.period,
+                      settings.external_force.force_scale),
+      tip_filter_(first_order_gain(settings.filter.velocity_cutoff_hz, settings.period)),
+      tip_chain_filter_(first_order_gain(settings.filter.velocity_cutoff_hz, settings.period)) {
+  PidGains gains = settings.gains;
+  if (settings.integral_action) {
     const Mat12 A = integral_error_dynamics_matrix(gains.kp, gains.kv, gains.ki);
     Vec12 q;
-    q << config.lyapunov_q_integral, config.lyapunov_q;
+    q << settings.lyapunov_q_integral, settings.lyapunov_q;
     if (!solve_lyapunov(A, Mat12(q.asDiagonal()), P_))
       throw SettingsError("", 0, 0, "controller.ki", "A^T P + P A + Q = 0 (integral states) has no positive definite solution for kp, kv, ki and lyapunov_q_integral");
   } else {
     gains.ki.setZero();  // the paper's law: no integral state, zero rows and columns of P for it
     const Mat8 A = error_dynamics_matrix(gains.kp, gains.kv);
     Mat8 P8;
-    if (!solve_lyapunov(A, Mat8(config.lyapunov_q.asDiagonal()), P8))
+    if (!solve_lyapunov(A, Mat8(settings.lyapunov_q.asDiagonal()), P8))
       throw SettingsError("", 0, 0, "controller.kv", "A^T P + P A + Q = 0 has no positive definite solution for kp, kv and lyapunov_q");
     P_.bottomRightCorner<8, 8>() = P8;
   }

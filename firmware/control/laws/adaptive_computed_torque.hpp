@@ -41,7 +41,8 @@
 //   terms, as a saturated one is.
 // - Tip acceleration for Y: rhodd = J_t qdd_a + Jd_t qd_a with qdd_a the filtered estimate
 //   (state_estimator.hpp) or qdd_d, by config (regressor_acceleration).
-#include "control/controller_config.hpp"
+#include "control/control_types.hpp"
+#include "control/laws/adaptive_law_settings.hpp"
 #include "control/laws/effort_limits.hpp"
 #include "control/laws/pid.hpp"
 #include "control/laws/regressor.hpp"
@@ -53,25 +54,11 @@
 
 namespace exc::control {
 
-// The settings this law reads, its own copy (a law keeps no other law's settings).
-struct AdaptiveLawSettings {
-  double period = 1e-3;
-  Vec6 adaptation_rate = Vec6::Zero();
-  Vec4 tracking_dead_zone = Vec4::Zero();
-  Vec6 theta_min = Vec6::Zero(), theta_max = Vec6::Zero(), theta_initial = Vec6::Zero();
-  RegressorAcceleration regressor_acceleration = RegressorAcceleration::filtered;
-  ExternalForceSettings external_force;
-  static AdaptiveLawSettings of(const ControllerConfig& c) {
-    return {c.period, c.adaptation_rate, c.tracking_dead_zone, c.theta_min, c.theta_max, c.theta_initial,
-            c.regressor_acceleration, c.external_force};
-  }
-};
-
 class AdaptiveComputedTorque final : public Controller {
  public:
   // The model must outlive the controller. Start-up: allocates (the Workspace, the Lyapunov solve).
   // Throws SettingsError if the gains give no SPD P.
-  AdaptiveComputedTorque(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
+  AdaptiveComputedTorque(const Model& model, const AdaptiveLawSettings& settings, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
   void visit_state(StateVisitor& visitor) const override;

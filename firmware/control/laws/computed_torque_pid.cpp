@@ -5,11 +5,11 @@
 
 namespace exc::control {
 
-ComputedTorquePid::ComputedTorquePid(const Model& model, const ControllerConfig& config,
+ComputedTorquePid::ComputedTorquePid(const Model& model, const PidLawSettings& settings,
                                      const EffortLimits& limits)
-    : model_(model), ws_(model), period_(config.period), limits_(limits), pid_(config.gains) {
-  const Mat8 A = error_dynamics_matrix(config.gains.kp, config.gains.kv);
-  const Mat8 Q = config.lyapunov_q.asDiagonal();
+    : model_(model), ws_(model), period_(settings.period), limits_(limits), pid_(settings.gains) {
+  const Mat8 A = error_dynamics_matrix(settings.gains.kp, settings.gains.kv);
+  const Mat8 Q = settings.lyapunov_q.asDiagonal();
   solve_lyapunov(A, Q, P_);
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "model/machine.hpp"
 #include "model/types.hpp"
 
 namespace exc::control {
@@ -34,5 +35,13 @@ struct EffortLimits {
 };
 
 inline bool is_saturated(std::uint8_t mask, int joint) { return (mask >> joint) & 1u; }
+
+// The machine's effort limits, as the effort laws and the actuator-lag lead saturate to them.
+inline EffortLimits effort_limits_of(const Machine& machine) {
+  EffortLimits l;
+  l.min = machine.effort_min();
+  l.max = machine.effort_max();
+  return l;
+}
 
 }  // namespace exc::control

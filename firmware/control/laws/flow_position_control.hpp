@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "control/controller_config.hpp"
+#include "control/control_types.hpp"
 #include "control/task/task.hpp"
 
 namespace exc::control {
@@ -32,9 +32,14 @@ inline bool flow_law_fits(const Task& task) {
   return true;
 }
 
+// What the law reads, its own (ControllerConfig's flow_kp).
+struct FlowLawSettings {
+  Vec4 kp = Vec4::Zero();  // 1/s: position gains, u = qd_d - kp e
+};
+
 class FlowPositionControl final : public Controller {
  public:
-  explicit FlowPositionControl(const ControllerConfig& config) : gains_(config.flow_kp) {}
+  explicit FlowPositionControl(const FlowLawSettings& settings) : gains_(settings.kp) {}
   void reset() override {}
   ControlOutput update(const ControlInput& in) override {
     ControlOutput out;

@@ -8,9 +8,6 @@
 
 namespace exc::control {
 
-using Mat4x6 = Eigen::Matrix<double, 4, 6>;
-using Mat2x6 = Eigen::Matrix<double, 2, 6>;
-
 inline Mat4x6 soil_regressor(const Mat2x4& J_t, const Vec2& rho, const Vec2& rhod, const Vec2& rhodd,
                              const Vec2& rho_env, bool in_soil) {
   if (!in_soil) return Mat4x6::Zero();

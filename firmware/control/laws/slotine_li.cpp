@@ -4,8 +4,8 @@
 
 namespace exc::control {
 
-SlotineLi::SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits)
-    : model_(model), ws_(model), settings_(SlotineLiSettings::of(config)), limits_(limits) {
+SlotineLi::SlotineLi(const Model& model, const SlotineLiSettings& settings, const EffortLimits& limits)
+    : model_(model), ws_(model), settings_(settings), limits_(limits) {
   reset();
 }
 

@@ -11,7 +11,7 @@
 // C_a(q, qd_r) qd_r + g_a, not C_a(q, qd) qd_r. The difference, C_a(q, s) qd_r, is second order
 // (|s| |qd_r|) and tiny for an excavator's joint speeds; it vanishes as s -> 0. Likewise Jd_t.
 // K_D = diag(kd_j * M_a,jj(q)) so that one kd (1/s) suits joints whose inertias differ by 100x.
-#include "control/controller_config.hpp"
+#include "control/control_types.hpp"
 #include "control/laws/effort_limits.hpp"
 #include "control/laws/regressor.hpp"
 #include "control/estimation/soil_contact.hpp"
@@ -19,20 +19,18 @@
 
 namespace exc::control {
 
-// The settings this law reads, its own copy (a law keeps no other law's settings).
+// What the law reads, its own (ControllerConfig's period, sl_lambda, sl_kd, sl_adaptation_rate and
+// the soil parameters' bounds and initial estimate: controller_config.hpp says what each means).
 struct SlotineLiSettings {
-  double period = 1e-3;
+  double period = 1e-3;  // s
   Vec4 lambda = Vec4::Zero(), kd = Vec4::Zero();
   Vec6 adaptation_rate = Vec6::Zero();
   Vec6 theta_min = Vec6::Zero(), theta_max = Vec6::Zero(), theta_initial = Vec6::Zero();
-  static SlotineLiSettings of(const ControllerConfig& c) {
-    return {c.period, c.sl_lambda, c.sl_kd, c.sl_adaptation_rate, c.theta_min, c.theta_max, c.theta_initial};
-  }
 };
 
 class SlotineLi final : public Controller {
  public:
-  SlotineLi(const Model& model, const ControllerConfig& config, const EffortLimits& limits);
+  SlotineLi(const Model& model, const SlotineLiSettings& settings, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
   const Vec6& theta_hat() const { return theta_hat_; }

@@ -2,12 +2,12 @@
 
 namespace exc::control {
 
-PathClock::PathClock(const Task& task, const Machine& nominal, const ControllerConfig& config)
+PathClock::PathClock(const Task& task, const Machine& nominal, const PathClockSettings& settings)
     : task_(task),
       speed_max_(nominal.speed_max()),
-      stop_ramp_time_(config.stop_ramp_time),
-      paced_(config.pump_pacing),
-      pacing_(nominal, config.pump_pacing_share, config.period) {}
+      stop_ramp_time_(settings.stop_ramp_time),
+      paced_(settings.pump_pacing),
+      pacing_(nominal, settings.pump_pacing_share, settings.period) {}
 
 void PathClock::begin_stop(double t) {
   const double tau0 = paced_ ? pacing_.tau() : unslowed_time(t);

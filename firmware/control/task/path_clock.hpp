@@ -2,16 +2,24 @@
 // Where along the task's path the machine is told to be, cycle by cycle: the task's own clock from
 // the start of tracking, paced to the pumps (pump_pacing.hpp, controller.pump_pacing) or slowed to
 // rest by a stop along the path (path_stop.hpp). Allocation-free after construction.
-#include "control/controller_config.hpp"
 #include "control/task/path_stop.hpp"
 #include "control/task/pump_pacing.hpp"
 #include "control/task/task.hpp"
 
 namespace exc::control {
 
+// What the clock reads, its own: ControllerConfig's members of the same names, which hold their
+// meaning and defaults (controller_config.hpp; consumer_settings.hpp hands them over).
+struct PathClockSettings {
+  double period = 1e-3;          // s
+  double stop_ramp_time = 0;     // s: a function at top speed stops along the path over this time
+  bool pump_pacing = false;      // valve interface: the clock paced to the pumps
+  double pump_pacing_share = 1;  // of the pumps' flow a paced path may ask
+};
+
 class PathClock {
  public:
-  PathClock(const Task& task, const Machine& nominal, const ControllerConfig& config);
+  PathClock(const Task& task, const Machine& nominal, const PathClockSettings& settings);
 
   // Tracking begins at loop time t, at the path's first point.
   void start(double t) {
