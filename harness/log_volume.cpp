@@ -41,14 +41,14 @@ LogVolume lockstep_log_volume(std::int64_t cycles, const std::string& channel_su
   // every kCounterPeriod cycles (sim_plant/plant_node.cpp); each side's whole round once after the last.
   const std::uint64_t timing = event_bytes<exlcm::timing_t>(Channel::timing, channel_suffix);
   const std::uint64_t can = event_bytes<exlcm::can_stats_t>(Channel::can_stats, channel_suffix);
-  std::uint64_t counters = (app::kTimingStages + 1) * timing + 2 * can;  // the end's
-  counters += n / app::kCounterPeriod * (timing + can);                    // the plant's
-  for (int part = 0; part < app::kCounterParts; ++part) {
-    if (part == app::kTimingStages) continue;  // the interval: real time only
+  std::uint64_t counters = (diagnostics::kTimingStages + 1) * timing + 2 * can;  // the end's
+  counters += n / diagnostics::kCounterPeriod * (timing + can);                    // the plant's
+  for (int part = 0; part < diagnostics::kCounterParts; ++part) {
+    if (part == diagnostics::kTimingStages) continue;  // the interval: real time only
     const std::uint64_t p = static_cast<std::uint64_t>(part);
     const std::uint64_t published_at = 2 * p + 1;  // the step that publishes the part
-    const std::uint64_t rounds = n >= app::kCounterPeriod + published_at ? (n - published_at) / app::kCounterPeriod : 0;
-    counters += rounds * (part < app::kTimingStages ? timing : can);
+    const std::uint64_t rounds = n >= diagnostics::kCounterPeriod + published_at ? (n - published_at) / diagnostics::kCounterPeriod : 0;
+    counters += rounds * (part < diagnostics::kTimingStages ? timing : can);
   }
   // A run's start: init -> wait_sensors -> hold -> track, each change on EXC_FAULT (inactive).
   constexpr std::uint64_t kStartModeChanges = 3;

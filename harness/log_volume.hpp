@@ -16,7 +16,7 @@ struct LogVolume {
 
 // One controller's lockstep run of `cycles` cycles with telemetry on channels suffixed
 // `channel_suffix` ("/pid"), the per-cycle channels recorded every `per_cycle_every`th cycle: the
-// per-cycle messages, the counters every app::kCounterPeriod cycles and at the end (the firmware's
+// per-cycle messages, the counters every diagnostics::kCounterPeriod cycles and at the end (the firmware's
 // stages and CAN counters, the plant's step and CAN counters), the mode changes of a run's start
 // (EXC_FAULT) and the telemetry path's final counters. Later mode changes and faults, and the path's
 // counters once per wall-clock second, are not counted: about 250 bytes each.

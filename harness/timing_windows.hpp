@@ -12,25 +12,25 @@
 namespace exc::sim {
 
 // A counter's figures (each its bucket's upper edge).
-Timing timing_of(const control::PerfCounter& c);
+Timing timing_of(const diagnostics::PerfCounter& c);
 // The figures of the samples `after` recorded since it was `before` (a copy of the same counter
 // taken earlier).
-Timing timing_between(const control::PerfCounter& before, const control::PerfCounter& after);
+Timing timing_between(const diagnostics::PerfCounter& before, const diagnostics::PerfCounter& after);
 
 class TimingWindows {
  public:
   TimingWindows(std::int64_t cycles, double period);
   // Before cycle k, and after `cycles_run` cycles; `control` null on a target.
-  void before_cycle(std::int64_t k, const control::PerfCounter* control, const control::PerfCounter& plant);
-  void after_cycle(std::int64_t cycles_run, const control::PerfCounter* control, const control::PerfCounter& plant);
+  void before_cycle(std::int64_t k, const diagnostics::PerfCounter* control, const diagnostics::PerfCounter& plant);
+  void after_cycle(std::int64_t cycles_run, const diagnostics::PerfCounter* control, const diagnostics::PerfCounter& plant);
   // The windows of a run that lasted `cycles_run` cycles, its counters at the end, into r.
-  void finish(RunRecord& r, std::int64_t cycles_run, const control::PerfCounter* control,
-              const control::PerfCounter& plant) const;
+  void finish(RunRecord& r, std::int64_t cycles_run, const diagnostics::PerfCounter* control,
+              const diagnostics::PerfCounter& plant) const;
 
  private:
   double period_;
   std::int64_t first_end_, last_begin_;
-  control::PerfCounter control_first_end_, plant_first_end_, control_last_begin_, plant_last_begin_;
+  diagnostics::PerfCounter control_first_end_, plant_first_end_, control_last_begin_, plant_last_begin_;
   bool first_taken_ = false, last_taken_ = false;
 };
 

@@ -44,7 +44,7 @@ Vec4 PlantNode::hold_effort() {
   return tau;
 }
 
-void PlantNode::scan_state(app::SubnormalScan& scan) const {
+void PlantNode::scan_state(diagnostics::SubnormalScan& scan) const {
   // The machine (its state, circuit, sensors' reading and dynamics' workspace), then this node's
   // frames: the sensor set it sent and the command set it steps with. Each type visits its own values.
   plant_.visit_state(scan);
@@ -192,10 +192,10 @@ void PlantNode::publish_state() {
 void PlantNode::publish_counters() {
   if (telemetry_ == nullptr) return;
   const exlcm::can_stats_t cs =
-      app::can_stats_message(port_.rx_stats(), port_.tx_stats(), 1, static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5));
+      diagnostics::can_stats_message(port_.rx_stats(), port_.tx_stats(), 1, static_cast<std::int64_t>(plant_.state().time * 1e6 + 0.5));
   telemetry_->publish(telemetry::Channel::can_stats, cs);
   exlcm::timing_t m{};
-  app::fill_timing(step_timing_, 4, cs.utime, m);  // stage 4: the plant step
+  diagnostics::fill_timing(step_timing_, 4, cs.utime, m);  // stage 4: the plant step
   telemetry_->publish(telemetry::Channel::timing, m);
 }
 

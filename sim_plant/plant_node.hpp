@@ -52,11 +52,11 @@ class PlantNode {
   const plant::Plant& plant() const { return plant_; }
   void publish_counters();
   // Plant::step's wall time per call, as EXC_TIMING stage 4 reports it.
-  const control::PerfCounter& step_timing() const { return step_timing_; }
+  const diagnostics::PerfCounter& step_timing() const { return step_timing_; }
   // Every value the plant and this node carry from one step to the next (the machine's state, its
   // circuit and soil, the sensor and command sets, the dynamics' workspace), for a look for
   // subnormals (docs/floating-point.md). Not on the loop's path.
-  void scan_state(app::SubnormalScan& scan) const;
+  void scan_state(diagnostics::SubnormalScan& scan) const;
 
  private:
   void step(std::uint64_t cycle, bool answer = true);
@@ -85,7 +85,7 @@ class PlantNode {
   hal::SensorState frozen_;       // sensor_freeze, pressure_stuck: what the stuck sensor keeps reporting
   std::uint64_t fault_cycles_ = 0;  // pressure_drift: sensor sets since the fault's start
   double jammed_effort_ = 0;      // actuator_jam: the effort the stuck actuator keeps applying
-  control::PerfCounter step_timing_{"plant_step", 1000.0};
+  diagnostics::PerfCounter step_timing_{"plant_step", 1000.0};
 };
 
 }  // namespace exc::plant

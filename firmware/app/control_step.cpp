@@ -31,7 +31,7 @@ std::unique_ptr<control::Controller> checked_controller(const Model& model, cons
 
 void check_control_law(const Model& model, const control::ControllerConfig& config) { checked_controller(model, config); }
 
-ControlStep::ControlStep(const Model& model, const FirmwareNodeConfig& config, safety::Supervisor& supervisor, LoopCounters& counters)
+ControlStep::ControlStep(const Model& model, const FirmwareNodeConfig& config, safety::Supervisor& supervisor, diagnostics::LoopCounters& counters)
     : config_(config),
       supervisor_(supervisor),
       counters_(counters),

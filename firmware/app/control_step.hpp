@@ -40,7 +40,7 @@ void check_control_law(const Model& model, const control::ControllerConfig& conf
 class ControlStep {
  public:
   // Builds the law (refused with std::invalid_argument when the command interface cannot carry it).
-  ControlStep(const Model& model, const FirmwareNodeConfig& config, safety::Supervisor& supervisor, LoopCounters& counters);
+  ControlStep(const Model& model, const FirmwareNodeConfig& config, safety::Supervisor& supervisor, diagnostics::LoopCounters& counters);
   ~ControlStep();
   ControlStep(const ControlStep&) = delete;
   ControlStep& operator=(const ControlStep&) = delete;
@@ -66,7 +66,7 @@ class ControlStep {
  private:
   const FirmwareNodeConfig& config_;
   safety::Supervisor& supervisor_;
-  LoopCounters& counters_;
+  diagnostics::LoopCounters& counters_;
   std::unique_ptr<control::Controller> controller_;
   std::int8_t controller_id_;  // the law's number in telemetry (ControllerRegistry::id_of)
   control::StateEstimator estimator_;

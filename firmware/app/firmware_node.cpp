@@ -196,8 +196,8 @@ void FirmwareNode::publish_cycle(const safety::Transition& transition) {
   }
   // The cycle's scope: read to telemetry encoded, the periodic counter messages included, a step a
   // cycle from each kCounterPeriod-th on.
-  const std::uint64_t step = cycle_ % kCounterPeriod;
-  if (cycle_ >= kCounterPeriod && step < static_cast<std::uint64_t>(kCounterSteps))
+  const std::uint64_t step = cycle_ % diagnostics::kCounterPeriod;
+  if (cycle_ >= diagnostics::kCounterPeriod && step < static_cast<std::uint64_t>(diagnostics::kCounterSteps))
     counters_.publish_step(static_cast<int>(step), *telemetry_, port_, time(), this->utime());
 }
 
@@ -219,12 +219,12 @@ void FirmwareNode::publish_counters(bool after_exit_command) {
   counters_.publish(*telemetry_, port_, window_end, utime() + (after_exit_command ? std::llround(period_ * 1e6) : 0));
 }
 
-void FirmwareNode::scan_state(SubnormalScan& scan) const {
+void FirmwareNode::scan_state(diagnostics::SubnormalScan& scan) const {
   // The law, the estimator and the stages show their state through the laws' interface.
   struct Scan final : control::StateVisitor {
-    explicit Scan(SubnormalScan& s) : scan(s) {}
+    explicit Scan(diagnostics::SubnormalScan& s) : scan(s) {}
     void visit(const char* name, const double* values, std::size_t count) override { scan.visit(name, values, count); }
-    SubnormalScan& scan;
+    diagnostics::SubnormalScan& scan;
   } v(scan);
   // What came in and went out, the path and the hold: each type visits its own values.
   hal::visit_state(sensors_, scan);

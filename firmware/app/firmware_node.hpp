@@ -69,7 +69,7 @@ class FirmwareNode {
   void publish_counters(bool after_exit_command = false);
   // Every value the node carries from one cycle to the next, for a look for subnormals
   // (docs/floating-point.md). Not on the loop's path.
-  void scan_state(SubnormalScan& scan) const;
+  void scan_state(diagnostics::SubnormalScan& scan) const;
 
   // Faults, stops, monitors, the operator link: the supervisor's record.
   const safety::Supervisor& supervisor() const { return supervisor_; }
@@ -101,10 +101,10 @@ class FirmwareNode {
   const hal::CommandState& last_command() const { return command_; }
   // The loop's timing counters by stage (loop_counters.hpp); the control computation (estimate, path,
   // law, the stages after it and the monitors), the whole end_cycle and a real-time loop's interval.
-  const LoopCounters& counters() const { return counters_; }
-  const control::PerfCounter& control_timing() const { return counters_.update; }
-  const control::PerfCounter& cycle_timing() const { return counters_.cycle; }
-  const control::PerfCounter& interval_timing() const { return counters_.interval; }
+  const diagnostics::LoopCounters& counters() const { return counters_; }
+  const diagnostics::PerfCounter& control_timing() const { return counters_.update; }
+  const diagnostics::PerfCounter& cycle_timing() const { return counters_.cycle; }
+  const diagnostics::PerfCounter& interval_timing() const { return counters_.interval; }
 
  private:
   // The state machine's step for this cycle's inputs, what the transition changes (the path, the
@@ -126,7 +126,7 @@ class FirmwareNode {
   safety::ControlStateMachine machine_;
   safety::Supervisor supervisor_;
   control::PathClock path_;
-  LoopCounters counters_;
+  diagnostics::LoopCounters counters_;
   ControlStep step_;  // estimate, law, the stages after it and their checks
 
   double period_;

@@ -15,7 +15,7 @@ nlohmann::json per_joint(const TrackingMetrics& m, bool rms) {
   return j;
 }
 
-nlohmann::json timing_json(const control::PerfCounter& c) {
+nlohmann::json timing_json(const diagnostics::PerfCounter& c) {
   if (c.count() == 0) return nullptr;
   return {{"median", c.median_us()}, {"p99", c.p99_us()}, {"p99_9", c.percentile_us(0.999)}, {"max", c.max_us()},
           {"count", c.count()}};

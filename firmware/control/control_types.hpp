@@ -88,7 +88,7 @@ struct ControlOutput {
 // visit_state(const T&, Visitor&) that calls only these four (hal::SensorState, hal::CommandState,
 // app::DesiredMotion, ControlOutput below, exc::Workspace, the plant's PlantState and its parts), so a
 // floor below this one (hal, the model, the plant) needs no header of ours to be visited; the laws,
-// whose state is behind an interface, take this class. app::SubnormalScan
+// whose state is behind an interface, take this class. diagnostics::SubnormalScan
 // (firmware/diagnostics/subnormal_scan.hpp) has the same four, for the plant's node, which may not
 // include this floor (docs/architecture.md). A name is a string literal: visitors keep the pointer.
 class StateVisitor {

@@ -6,7 +6,7 @@
 #include "exlcm/can_stats_t.hpp"
 #include "hal/can_ports.hpp"
 
-namespace exc::app {
+namespace exc::diagnostics {
 
 // bus_load: the fraction of bus time used since the previous message (BusLoadWindow), or 0 where the
 // end cannot see the whole bus.
@@ -45,4 +45,4 @@ class BusLoadWindow {
   double last_time_ = 0;
 };
 
-}  // namespace exc::app
+}  // namespace exc::diagnostics

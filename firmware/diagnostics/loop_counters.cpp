@@ -3,7 +3,7 @@
 #include "diagnostics/timing_message.hpp"
 #include "telemetry/telemetry_sink.hpp"
 
-namespace exc::app {
+namespace exc::diagnostics {
 
 LoopCounters::LoopCounters(double period)
     : cycle("cycle", period * 1e6),
@@ -17,7 +17,7 @@ LoopCounters::LoopCounters(double period)
       actuation("actuation", 100.0),
       monitors("monitors", 100.0) {}
 
-control::PerfCounter& LoopCounters::counter(LoopStage s) {
+PerfCounter& LoopCounters::counter(LoopStage s) {
   switch (s) {
     case LoopStage::cycle: return cycle;
     case LoopStage::read: return read;
@@ -62,4 +62,4 @@ void LoopCounters::publish_step(int step, telemetry::TelemetrySink& out, const h
   }
 }
 
-}  // namespace exc::app
+}  // namespace exc::diagnostics

@@ -16,7 +16,7 @@ namespace exc::telemetry {
 class TelemetrySink;
 }
 
-namespace exc::app {
+namespace exc::diagnostics {
 
 // Cycles between the counter messages (EXC_TIMING per stage, EXC_CAN_STATS). Each round's messages
 // go out over consecutive cycles, one a cycle from cycle k x kCounterPeriod on (the parts below), so
@@ -49,8 +49,8 @@ inline constexpr int kCounterSteps = 2 * kCounterParts;
 
 struct LoopCounters {
   explicit LoopCounters(double period);
-  control::PerfCounter& operator[](LoopStage s) { return counter(s); }
-  const control::PerfCounter& operator[](LoopStage s) const { return const_cast<LoopCounters*>(this)->counter(s); }
+  PerfCounter& operator[](LoopStage s) { return counter(s); }
+  const PerfCounter& operator[](LoopStage s) const { return const_cast<LoopCounters*>(this)->counter(s); }
 
   // Step `step` of a round (0 .. kCounterSteps - 1): part step / 2 (the stages in turn, the interval
   // with the sleeper's deadline counters once a real-time loop has one, the bus's counts) made on the
@@ -65,11 +65,11 @@ struct LoopCounters {
     for (int step = 0; step < kCounterSteps; ++step) publish_step(step, telemetry, port, window_end, utime);
   }
 
-  control::PerfCounter cycle, read, update, write, interval, telemetry, estimate, law, actuation, monitors;
+  PerfCounter cycle, read, update, write, interval, telemetry, estimate, law, actuation, monitors;
   std::uint64_t deadline_overruns = 0, skipped_deadlines = 0;  // the real-time sleeper's, as last reported
 
  private:
-  control::PerfCounter& counter(LoopStage s);
+  PerfCounter& counter(LoopStage s);
   BusLoadWindow bus_load_;
   // The part made and not yet published.
   enum class Made : std::uint8_t { none, timing, can_stats } made_ = Made::none;
@@ -77,4 +77,4 @@ struct LoopCounters {
   exlcm::can_stats_t can_stats_;
 };
 
-}  // namespace exc::app
+}  // namespace exc::diagnostics

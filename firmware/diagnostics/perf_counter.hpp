@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <limits>
 
-namespace exc::control {
+namespace exc::diagnostics {
 
 class PerfCounter {
  public:
@@ -106,4 +106,4 @@ class PerfCounter {
   int top_ = 0;
 };
 
-}  // namespace exc::control
+}  // namespace exc::diagnostics

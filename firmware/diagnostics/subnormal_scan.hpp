@@ -14,7 +14,7 @@
 #include <Eigen/Core>
 
 
-namespace exc::app {
+namespace exc::diagnostics {
 
 // A subnormal, told by its bits (exponent field zero, fraction not): under DAZ a comparison reads a
 // subnormal as zero, and std::fpclassify compiles to comparisons.
@@ -78,4 +78,4 @@ class SubnormalScan {
   std::size_t named_ = 0;
 };
 
-}  // namespace exc::app
+}  // namespace exc::diagnostics

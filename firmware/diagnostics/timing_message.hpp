@@ -8,9 +8,9 @@
 #include "diagnostics/perf_counter.hpp"
 #include "exlcm/timing_t.hpp"
 
-namespace exc::app {
+namespace exc::diagnostics {
 
-inline void fill_timing(const control::PerfCounter& c, std::int8_t stage, std::int64_t utime, exlcm::timing_t& m) {
+inline void fill_timing(const PerfCounter& c, std::int8_t stage, std::int64_t utime, exlcm::timing_t& m) {
   m.utime = utime;
   m.stage = stage;
   m.count = static_cast<std::int64_t>(c.count());
@@ -28,11 +28,11 @@ inline void fill_timing(const control::PerfCounter& c, std::int8_t stage, std::i
   const auto& h = c.histogram();
   for (int b = 0; b <= c.top_bucket(); ++b) {
     if (h[b] == 0) continue;
-    const double centre = control::PerfCounter::upper_edge_us(b) / std::sqrt(control::PerfCounter::kRatio);
+    const double centre = PerfCounter::upper_edge_us(b) / std::sqrt(PerfCounter::kRatio);
     const int bin = std::min(63, static_cast<int>(centre / m.bin_width_us));
     m.bins[bin] += h[b];
   }
 }
 
 
-}  // namespace exc::app
+}  // namespace exc::diagnostics

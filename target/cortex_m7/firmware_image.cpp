@@ -75,7 +75,7 @@ void forward_outputs(TargetLink& link, exc::target::LinkCanBus& bus, exc::target
   telemetry.clear();
 }
 
-std::uint32_t instructions(const exc::control::PerfCounter& c) { return static_cast<std::uint32_t>(c.last_us() * 1e3 + 0.5); }
+std::uint32_t instructions(const exc::diagnostics::PerfCounter& c) { return static_cast<std::uint32_t>(c.last_us() * 1e3 + 0.5); }
 
 }  // namespace
 
@@ -143,7 +143,7 @@ int main(int argc, char** argv) {
   const std::uint64_t start_up = InstructionClock::instructions() - boot;
   exc::target::mark_start_up_over();
 
-  const exc::app::LoopCounters& c = node->counters();
+  const exc::diagnostics::LoopCounters& c = node->counters();
   exc::app::CycleStatus status;
   std::uint8_t payload[256];
   for (;;) {

@@ -486,7 +486,7 @@ TEST_CASE("firmware/node: the port counts every frame on the bus once, at its ex
   // SYNC, CMD_EFFORT and SENS_MACHINE every cycle, a heartbeat every 50: 21-26 % of the bus.
   CHECK(load > 0.21);
   CHECK(load < 0.26);
-  app::BusLoadWindow window;
+  diagnostics::BusLoadWindow window;
   CHECK(window.update(counted, cycles * 1e-3) == doctest::Approx(load));
 }
 

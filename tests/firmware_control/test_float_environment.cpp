@@ -15,6 +15,7 @@
 #include "diagnostics/subnormal_scan.hpp"
 
 using namespace exc::app;
+using namespace exc::diagnostics;
 
 namespace {
 // Through volatile so the compiler folds nothing: the processor computes each product in the

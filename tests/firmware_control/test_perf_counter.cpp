@@ -6,7 +6,7 @@
 
 #include "diagnostics/perf_counter.hpp"
 
-using namespace exc::control;
+using namespace exc::diagnostics;
 
 TEST_CASE("firmware/perf counter: median and p99 from the histogram match the sorted samples within 5 %") {
   PerfCounter pc("control_step", 100.0);

@@ -26,6 +26,7 @@
 
 using namespace exc;
 using namespace exc::control;
+using namespace exc::diagnostics;
 using namespace exc::safety;
 
 namespace {

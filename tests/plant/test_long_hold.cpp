@@ -23,7 +23,7 @@ namespace {
 
 struct HoldScan {
   sim::RunRecord run;
-  app::SubnormalScan firmware, plant;
+  diagnostics::SubnormalScan firmware, plant;
   std::uint64_t underflow_cycles = 0;  // cycles in which the FPU flushed (or rounded) a tiny result
   std::uint64_t cycles_not_in_mode = 0;  // cycles the loop's thread was not in the run's mode
 };
@@ -50,11 +50,11 @@ HoldScan hold(const std::string& law, double duration, app::FloatMode mode) {
 }
 
 // Each state found subnormal: where, its first value, when, how many values in all.
-std::string where(const app::SubnormalScan& s) {
+std::string where(const diagnostics::SubnormalScan& s) {
   if (s.found() == 0) return "none";
   std::string out = std::to_string(s.found()) + " subnormal values:";
   char b[200];
-  for (const app::SubnormalScan::Finding* f = s.names_begin(); f != s.names_end(); ++f) {
+  for (const diagnostics::SubnormalScan::Finding* f = s.names_begin(); f != s.names_end(); ++f) {
     std::snprintf(b, sizeof b, "\n    %s[%zu] = %g from t = %.3f s (%llu values)", f->name, f->index, f->value, f->time,
                   static_cast<unsigned long long>(f->count));
     out += b;

@@ -139,7 +139,7 @@ struct VisitAudit {
   std::vector<std::string> repeated;     // names under which a double was shown again
   std::vector<std::string> foreign;      // names under which a value not set was shown (outside the
                                          // object, a copy, or not one of its doubles)
-  std::uint64_t scan_found = 0, scan_scanned = 0;  // the same visit into app::SubnormalScan
+  std::uint64_t scan_found = 0, scan_scanned = 0;  // the same visit into diagnostics::SubnormalScan
   bool complete() const {
     return shown == set && missed.empty() && repeated.empty() && foreign.empty() && scan_found == set && scan_scanned == set;
   }
@@ -209,7 +209,7 @@ VisitAudit audit_visit(const T& object, const SubnormalFill& fill) {
     if (!inner_misses)
       a.missed.push_back(m.name + " (" + std::to_string(missing) + " of its " + std::to_string(m.last - m.first + 1) + " doubles)");
   }
-  app::SubnormalScan scan;
+  diagnostics::SubnormalScan scan;
   visit_state(object, scan);
   a.scan_found = scan.found();
   a.scan_scanned = scan.scanned();
