@@ -159,8 +159,8 @@ void configure_for_fidelity(control::ControllerConfig& c, const plant::ActuatorP
   const plant::ActuatorFidelityEntry& fidelity = plant::fidelity_of(actuators);
   control::set_command_interface(c, fidelity.takes_valves() ? control::CommandInterface::valve
                                                             : control::CommandInterface::effort, nominal);
-  c.actuator_lag = fidelity.effort_lag ? fidelity.effort_lag(actuators) : 0.0;
-  if (c.actuator_lag > 0) c.actuator_lag_target = std::clamp(c.actuator_lag_target, c.actuator_lag / 20, c.actuator_lag);
+  c.actuation.actuator_lag = fidelity.effort_lag ? fidelity.effort_lag(actuators) : 0.0;
+  if (c.actuation.actuator_lag > 0) c.actuation.actuator_lag_target = std::clamp(c.actuation.actuator_lag_target, c.actuation.actuator_lag / 20, c.actuation.actuator_lag);
 }
 
 app::FirmwareSettings bench_firmware(const BenchScene& s, const plant::Scene& scene) {

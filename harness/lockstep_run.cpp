@@ -110,7 +110,7 @@ RunRecord run_lockstep(const plant::Scene& scene, const app::FirmwareImageSettin
   if (options.telemetry) result.telemetry_per_cycle_every = options.log_every;
   LockstepRig rig(scene, firmware, options);
   const std::int64_t cycles = lockstep_cycles(scene, options.duration);
-  RunRecorder recorder(scene, firmware.task.cycle_starts, options.fault, rig.machine(), firmware.node.controller.spool_monitor);
+  RunRecorder recorder(scene, firmware.task.cycle_starts, options.fault, rig.machine(), firmware.node.controller.supervisor.spool_monitor);
   TimingWindows timing(cycles, scene.cycle);
   const auto control_timing = [&rig] { return rig.host_node() != nullptr ? &rig.host_node()->control_timing() : nullptr; };
   // A stopped run may go on past the scene's end, to see the machine come to rest (rest_horizon).

@@ -30,12 +30,12 @@ std::string describe_setup(const SceneBundle& bundle) {
   if (const auto lag = plant::fidelity_of(sc.actuators).effort_lag) o << " (effort lag " << lag(sc.actuators) * 1e3 << " ms)";
   const control::ControllerConfig& c = bundle.firmware.controller;
   if (c.command_interface == control::CommandInterface::valve) {
-    o << ", firmware commands the valves (pilot pressures; force loop T_f " << c.valves.force_time_constant * 1e3
-      << " ms, spool lead to " << c.valves.spool_lag_target * 1e3 << " ms)";
+    o << ", firmware commands the valves (pilot pressures; force loop T_f " << c.actuation.valves.force_time_constant * 1e3
+      << " ms, spool lead to " << c.actuation.valves.spool_lag_target * 1e3 << " ms)";
   } else {
     o << ", firmware commands efforts, lag compensation ";
-    if (c.actuator_lag > 0)
-      o << c.actuator_lag * 1e3 << " ms -> " << c.actuator_lag_target * 1e3 << " ms";
+    if (c.actuation.actuator_lag > 0)
+      o << c.actuation.actuator_lag * 1e3 << " ms -> " << c.actuation.actuator_lag_target * 1e3 << " ms";
     else
       o << "off";
   }

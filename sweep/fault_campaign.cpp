@@ -95,7 +95,7 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
     // A stop along the path latches once the path is at rest: it may take the deceleration's time too.
     const double allowed =
         watchdog + (safety::stops_along_path(static_cast<safety::FirmwareFault>(r.first_fault_code))
-                        ? control::PathStop::longest(firmware.controller.stop_ramp_time)
+                        ? control::PathStop::longest(firmware.controller.path_clock.stop_ramp_time)
                         : 0.0);
     const double late = r.first_safe_stop_time - r.first_fault_detected_time - allowed;
     if (late > 1e-9)
@@ -106,7 +106,7 @@ nlohmann::json run_outcome(const RunRecord& r, const app::FirmwareSettings& firm
   } else if (r.tracking_samples == 0) {
     why = r.failure;
   } else {
-    const auto& limit = firmware.controller.tracking_error_limit;
+    const auto& limit = firmware.controller.supervisor.tracking_error_limit;
     for (int j = 0; j < 4 && why.empty(); ++j)
       if (r.max_error[j] > limit[j])
         why = "joint " + std::to_string(j) + "'s true error " + std::to_string(r.max_error[j]) + " beyond its limit " +

@@ -4,7 +4,6 @@
 #include <string>
 
 #include "app/firmware_node_config.hpp"
-#include "control/consumer_settings.hpp"
 #include "control/controller_registry.hpp"
 #include "hal/clock.hpp"
 
@@ -38,7 +37,7 @@ ControlStep::ControlStep(const Model& model, const FirmwareNodeConfig& config, s
       controller_(checked_controller(model, config.controller)),
       controller_id_(control::controller_registry().id_of(config.controller.law)),
       estimator_(config.controller.filter),
-      stage_(model.machine, control::actuation_settings(config.controller)) {}
+      stage_(model.machine, config.controller.actuation, config.controller.command_interface, config.controller.period) {}
 
 ControlStep::~ControlStep() = default;
 

@@ -3,7 +3,6 @@
 #include <cstdio>
 
 #include "app/cycle_messages.hpp"
-#include "control/consumer_settings.hpp"
 #include "exlcm/fault_t.hpp"
 #include "hal/can_protocol.hpp"
 #include "hal/clock.hpp"
@@ -29,8 +28,8 @@ FirmwareNode::FirmwareNode(const Model& model, const control::Task& task, const 
       port_(port),
       telemetry_(telemetry),
       machine_(config.controller.watchdog_timeout),
-      supervisor_(model.machine, supervisor_settings(config.controller)),
-      path_(task, model.machine, control::path_clock_settings(config.controller)),
+      supervisor_(model.machine, config.controller.supervisor, config.controller.period),
+      path_(task, model.machine, config.controller.path_clock, config.controller.period),
       counters_(config.controller.period),
       step_(model, config_, supervisor_, counters_),
       period_(config.controller.period) {}

@@ -5,7 +5,6 @@
 #include "control/controller_config.hpp"
 #include "model/terrain.hpp"
 #include "model/types.hpp"
-#include "safety/supervisor.hpp"
 
 namespace exc::app {
 
@@ -29,19 +28,6 @@ void visit_fields(Visitor& v, FirmwareNodeConfig& c) {
   v("wait_for_start", c.wait_for_start);
   v("theta_known", c.theta_known);
   v("theta_true", c.theta_true);
-}
-
-// The supervisor's settings are the controller's: its period, timeouts, limits and monitors.
-inline safety::SupervisorSettings supervisor_settings(const control::ControllerConfig& c) {
-  safety::SupervisorSettings s;
-  s.period = c.period;
-  s.supervisor_timeout = c.supervisor_timeout;
-  s.max_missed_deadlines = c.max_missed_deadlines;
-  s.tracking_error_limit = c.tracking_error_limit;
-  s.plausibility = c.plausibility;
-  s.pressure_plausibility = c.pressure_plausibility;
-  s.spool_monitor = c.spool_monitor;
-  return s;
 }
 
 }  // namespace exc::app

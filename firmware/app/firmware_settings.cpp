@@ -85,10 +85,10 @@ void check_laws_build(const FirmwareSettings& s) {
 // path covers the paced one, estimated without the clock's lag, plus a tenth and the lag's settling
 // (4 T) for what the lag adds.
 void extend_for_pump_pacing(FirmwareSettings& s) {
-  if (!s.controller.pump_pacing) return;
+  if (!s.controller.path_clock.pump_pacing) return;
   const double period = s.controller.period;
   const control::JointTrajectory& path = s.task.trajectory;
-  const control::PumpPacing pacing(s.machine, s.controller.pump_pacing_share, period);
+  const control::PumpPacing pacing(s.machine, s.controller.path_clock.pump_pacing_share, period);
   const double path_time = path.end_time() - path.start_time();
   const double paced = control::paced_duration(pacing, path, period);
   // Stepped in whole periods, an unpaced path comes out up to a period longer: no time added for it.

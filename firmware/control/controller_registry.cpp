@@ -3,7 +3,6 @@
 
 #include <stdexcept>
 
-#include "control/consumer_settings.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "control/laws/computed_torque_pid.hpp"
 #include "control/laws/flow_position_control.hpp"
@@ -12,18 +11,21 @@
 namespace exc::control {
 namespace {
 
-// The shipped laws' factories: each law built from its own part of the settings (consumer_settings.hpp).
+// The shipped laws' factories: each law built from its own members of the settings, whole, and the
+// loop's period.
 std::unique_ptr<Controller> make_pid(const Model& model, const ControllerConfig& config) {
-  return std::make_unique<ComputedTorquePid>(model, pid_law_settings(config), effort_limits_of(model.machine));
+  return std::make_unique<ComputedTorquePid>(model, config.pid, config.period, effort_limits_of(model.machine));
 }
 std::unique_ptr<Controller> make_adaptive(const Model& model, const ControllerConfig& config) {
-  return std::make_unique<AdaptiveComputedTorque>(model, adaptive_law_settings(config), effort_limits_of(model.machine));
+  return std::make_unique<AdaptiveComputedTorque>(model, adaptive_law_settings(config), config.period,
+                                                  effort_limits_of(model.machine));
 }
 std::unique_ptr<Controller> make_slotine_li(const Model& model, const ControllerConfig& config) {
-  return std::make_unique<SlotineLi>(model, slotine_li_settings(config), effort_limits_of(model.machine));
+  return std::make_unique<SlotineLi>(model, config.slotine_li, config.soil_parameters, config.period,
+                                     effort_limits_of(model.machine));
 }
 std::unique_ptr<Controller> make_flow(const Model&, const ControllerConfig& config) {
-  return std::make_unique<FlowPositionControl>(flow_law_settings(config));
+  return std::make_unique<FlowPositionControl>(config.flow);
 }
 
 std::string flow_task_misfit(const Task& task) {

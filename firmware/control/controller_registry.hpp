@@ -54,7 +54,7 @@ struct ControllerEntry {
 
 // The factory of a law whose constructor takes (model, config, effort limits) or (config) alone: a
 // program's or a test's own law may take the whole ControllerConfig; the shipped laws take their own
-// settings (consumer_settings.hpp), each through its factory in controller_registry.cpp.
+// settings, ControllerConfig's members whole, each through its factory in controller_registry.cpp.
 template <typename Law>
 std::unique_ptr<Controller> build_law(const Model& model, const ControllerConfig& config);
 

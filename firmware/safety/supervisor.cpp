@@ -21,13 +21,14 @@ bool commanding(Mode mode) { return mode == Mode::hold || mode == Mode::track; }
 
 }  // namespace
 
-Supervisor::Supervisor(const Machine& nominal, const SupervisorSettings& settings)
+Supervisor::Supervisor(const Machine& nominal, const SupervisorSettings& settings, double period)
     : s_(settings),
+      period_(period),
       pump_flow_(nominal.hydraulics.pump_flow),
-      plausibility_(settings.plausibility, settings.period),
+      plausibility_(settings.plausibility, period),
       frozen_position_(settings.plausibility),
-      pressure_monitor_(nominal, settings.pressure_plausibility, settings.period),
-      spool_monitor_(settings.spool_monitor, nominal.hydraulics.valve_time_constant, settings.period) {}
+      pressure_monitor_(nominal, settings.pressure_plausibility, period),
+      spool_monitor_(settings.spool_monitor, nominal.hydraulics.valve_time_constant, period) {}
 
 char* Supervisor::raise(FirmwareFault fault, double t) {
   if (fault_) return nullptr;
@@ -156,7 +157,7 @@ Supervisor::StopAction Supervisor::on_transition(const Transition& transition, c
   safe_stop_cycle_ = in.cycle;
   fault_code_ = fault_ ? pending_fault_ : FirmwareFault::sensor_timeout;
   // A sensor timeout is detected from the first cycle of the gap that ended in it.
-  fault_detected_time_ = fault_ ? pending_time_ : last_valid_time + s_.period;
+  fault_detected_time_ = fault_ ? pending_time_ : last_valid_time + period_;
   if (fault_code_ == FirmwareFault::sensor_timeout)
     std::snprintf(fault_text_, sizeof fault_text_, "sensor timeout: no valid sensor set for %.0f ms at t = %.3f s",
                   (in.t - last_valid_time) * 1e3, in.t);
@@ -184,7 +185,7 @@ bool Supervisor::check_standstill(Mode mode, std::uint64_t cycle, bool complete,
   } else {
     plausibility_.update(false);
   }
-  const double since = static_cast<double>(cycle - safe_stop_cycle_) * s_.period;
+  const double since = static_cast<double>(cycle - safe_stop_cycle_) * period_;
   if (why[0] == 0 && since >= kStandstillDelay) {
     constexpr double kOut = std::numeric_limits<double>::infinity();
     // The cylinders on the oil they took: motion plus, with pressures, compression (a load that
@@ -192,11 +193,11 @@ bool Supervisor::check_standstill(Mode mode, std::uint64_t cycle, bool complete,
     // compresses its oil; no oil arrives). Not the swing: its motor's cross-port leakage moves a
     // swing trapped on its oil spring for seconds.
     const std::uint8_t cylinders = cylinder_creep_.update(
-        m.position + m.compression, cycle, s_.period, kStandstillWindow,
+        m.position + m.compression, cycle, period_, kStandstillWindow,
         Vec4(kOut, kStandstillCylinderRate, kStandstillCylinderRate, kStandstillCylinderRate), kStandstillSlowing, kStandstillFastFactor);
     // The swing on its motion alone, over windows as long as its oil spring's period, which its
     // ringing averages out of: a spool stuck just past its dead zone creeps on, not slowing.
-    const std::uint8_t swing = swing_creep_.update(m.position, cycle, s_.period, kStandstillSwingWindow,
+    const std::uint8_t swing = swing_creep_.update(m.position, cycle, period_, kStandstillSwingWindow,
                                                    Vec4(kStandstillSwingRate, kOut, kOut, kOut), kStandstillSlowing, kStandstillFastFactor);
     for (int j = 1; j < 4 && why[0] == 0; ++j)
       if ((cylinders >> j) & 1)

@@ -29,16 +29,44 @@
 
 namespace exc::safety {
 
+// The supervisor's own settings (ControllerConfig's `supervisor` member: controller.supervisor_timeout,
+// max_missed_deadlines, tracking_error_limit and the monitors' sections); it takes the period beside
+// them.
 struct SupervisorSettings {
-  double period = 1e-3;  // s, the cycle
-  // s without a SUPERVISOR frame, once a keep-alive was heard, that stops the machine (0: not watched).
+  // s without a SUPERVISOR frame, once the operator station has sent a keep-alive (Command none),
+  // that stops the machine as the station's stop would (FirmwareFault::operator_link_lost): five
+  // of excavator-operator keep-alive's 0.1 s frames missed. 0: the link is not monitored.
   double supervisor_timeout = 0.5;
-  int max_missed_deadlines = 5;  // real-time wake-ups in a row after their deadline that are a fault
-  Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();  // rad, m
+  // Real time: this many wake-ups in a row after their deadline are a fault (docs/safety.md, H7):
+  // one late cycle costs a cycle of latency, five in a row is a loop that lost its period.
+  int max_missed_deadlines = 5;
+  // |q_a - q_d| per joint above which the firmware faults to its safe state (hold and track): a
+  // machine far from where it was told to go must stop; rad (swing), m (cylinders). On the valve
+  // interface derive_defaults sets kTrackingLimitMultiple x what the valve machine reaches
+  // (control/controller_config.hpp); on the effort interface (the paper's force actuators, whose PID
+  // baseline errs up to 0.12 m on the bucket in its dig) about twice that baseline's worst, 0.5-1 m at
+  // the tip.
+  Vec4 tracking_error_limit = (Vec4() << 0.1, 0.2, 0.2, 0.2).finished();
+  // Commanded against measured velocity per function on the valve interface (docs/safety.md, H1).
+  // Its floors default to shares of each function's top speed and effort (derive_defaults).
   PlausibilitySettings plausibility;
+  // The chamber pressures' range, steps and stuck-at readings on the valve interface (docs/safety.md,
+  // H4); its limits come from the machine file's hydraulics section (pressure_plausibility.hpp).
   PressurePlausibilitySettings pressure_plausibility;
+  // Each measured spool against its command through the valve's lag, valve interface (spool_monitor.hpp;
+  // docs/safety.md, H1).
   SpoolMonitorSettings spool_monitor;
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, SupervisorSettings& s) {
+  v("supervisor_timeout", s.supervisor_timeout);
+  v("max_missed_deadlines", s.max_missed_deadlines);
+  v("tracking_error_limit", s.tracking_error_limit);
+  v("plausibility", s.plausibility);
+  v("pressure_plausibility", s.pressure_plausibility);
+  v("spool_monitor", s.spool_monitor);
+}
 
 // What the flow plausibility monitor measures: positions, the oil columns' compression F / K_h
 // (zero without pressures) and the functions at a relief (bit j).
@@ -77,7 +105,7 @@ inline constexpr int kPlantHoldCycles = 5;
 
 class Supervisor {
  public:
-  Supervisor(const Machine& nominal, const SupervisorSettings& settings);
+  Supervisor(const Machine& nominal, const SupervisorSettings& settings, double period);
 
   // An operator acknowledges the latched stop (on the operator's behalf: a caller, not a frame):
   // taken on the next cycle, as a SUPERVISOR acknowledge is.
@@ -167,6 +195,7 @@ class Supervisor {
   const PressurePlausibility& pressure_plausibility() const { return pressure_monitor_; }
   const SpoolMonitor& spool_monitor() const { return spool_monitor_; }
   const SupervisorSettings& settings() const { return s_; }
+  double period() const { return period_; }
 
  private:
   // A fault condition met this cycle (the first one counts): the safe state follows next cycle.
@@ -175,6 +204,7 @@ class Supervisor {
   FaultEvent& push_event(FirmwareFault code, std::int8_t severity, bool active);
 
   SupervisorSettings s_;
+  double period_;  // s, the cycle
   double pump_flow_;  // m^3/s, the nominal machine's pumps (the warning's text)
   VelocityPlausibility plausibility_;
   FrozenPosition frozen_position_;  // the reading that stops while its function is driven

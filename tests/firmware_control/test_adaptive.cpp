@@ -4,7 +4,7 @@
 #include <random>
 
 #include "closed_loop.hpp"
-#include "control/consumer_settings.hpp"
+#include "control/controller_config.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "control/controller_registry.hpp"
 #include "control/estimation/state_estimator.hpp"
@@ -50,15 +50,15 @@ LyapunovRun run_lyapunov(const Vec2& anchor_error, bool integral_action = false,
   const Model model = build_model(reference_machine());
   ControllerConfig cfg;
   cfg.period = dt;
-  cfg.theta_initial = (Vec6() << 100, 2e3, 3e4, 100, 2e3, 3e4).finished();
-  cfg.adaptation_rate = (Vec6() << 1e8, 1e11, 1e13, 1e8, 1e11, 1e13).finished();
+  cfg.soil_parameters.theta_initial = (Vec6() << 100, 2e3, 3e4, 100, 2e3, 3e4).finished();
+  cfg.adaptation.rate = (Vec6() << 1e8, 1e11, 1e13, 1e8, 1e11, 1e13).finished();
   // Vdot = -x^T Q x holds for any SPD Q; Q = I keeps the O(dt^2) residual of the explicit Euler
   // update below round-off at this step (the defaults' larger Q needs a smaller step for that).
-  cfg.lyapunov_q = Vec8::Ones();
-  cfg.integral_action = integral_action;  // z = [int e; e; ed] with K_i = 100 (the defaults)
-  cfg.lyapunov_q_integral = Vec4::Ones();
+  cfg.pid.lyapunov_q = Vec8::Ones();
+  cfg.adaptation.integral_action = integral_action;  // z = [int e; e; ed] with K_i = 100 (the defaults)
+  cfg.adaptation.lyapunov_q_integral = Vec4::Ones();
   EffortLimits unlimited;
-  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), unlimited);
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), cfg.period, unlimited);
 
   Workspace ws(model);
   const Vec4 q0 = pose_in_soil(model, ws);
@@ -138,8 +138,8 @@ TEST_CASE("firmware/adaptive: the projection keeps every soil estimate inside it
   const Machine& m = model.machine;
   const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), m);
   ControllerConfig cfg;
-  cfg.adaptation_rate *= 10.0;  // an aggressive rate, so the noise really pushes at the bounds
-  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), effort_limits_of(m));
+  cfg.adaptation.rate *= 10.0;  // an aggressive rate, so the noise really pushes at the bounds
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), cfg.period, effort_limits_of(m));
   sim::ModelPlant plant(model, sim::SoilTruth{});
   Vec4 q0, qd0, qdd0;
   task.trajectory.evaluate(0, q0, qd0, qdd0);
@@ -163,8 +163,8 @@ TEST_CASE("firmware/adaptive: the projection keeps every soil estimate inside it
     const ControlOutput out = ctrl.update(in);
     const Vec6& th = ctrl.theta_hat();
     for (int i = 0; i < 6; ++i) {
-      inside = inside && std::isfinite(th[i]) && th[i] >= cfg.theta_min[i] && th[i] <= cfg.theta_max[i];
-      at_bound += (th[i] == cfg.theta_min[i] || th[i] == cfg.theta_max[i]) ? 1 : 0;
+      inside = inside && std::isfinite(th[i]) && th[i] >= cfg.soil_parameters.theta_min[i] && th[i] <= cfg.soil_parameters.theta_max[i];
+      at_bound += (th[i] == cfg.soil_parameters.theta_min[i] || th[i] == cfg.soil_parameters.theta_max[i]) ? 1 : 0;
     }
     REQUIRE(plant.step(out.tau, load, cfg.period));
   }
@@ -201,10 +201,10 @@ TEST_CASE("firmware/adaptive and Slotine-Li leave a joint the actuator-lag stage
     const Vec6 after_free = free_law->update(in).theta_hat;
     const Vec6 after_arm = arm_law->update(arm_clamped).theta_hat;
     const Vec6 after_all = all_law->update(all_clamped).theta_hat;
-    CHECK((after_free - cfg.theta_initial).norm() > 0);
-    CHECK((after_arm - cfg.theta_initial).norm() > 0);  // the other joints still adapt
+    CHECK((after_free - cfg.soil_parameters.theta_initial).norm() > 0);
+    CHECK((after_arm - cfg.soil_parameters.theta_initial).norm() > 0);  // the other joints still adapt
     CHECK((after_arm - after_free).norm() > 0);         // without the arm's term
-    CHECK(after_all == cfg.theta_initial);
+    CHECK(after_all == cfg.soil_parameters.theta_initial);
   }
   // The adaptive law's update with the arm clamped equals its update on the same state with the
   // arm's error removed (P is block-diagonal per joint, and its regressor does not use q_d).
@@ -241,8 +241,8 @@ TEST_CASE("firmware/adaptive with integral action removes the steady error of a 
   Vec4 final_error[2];
   for (int with_integral = 0; with_integral < 2; ++with_integral) {
     ControllerConfig cfg;
-    cfg.integral_action = with_integral == 1;
-    AdaptiveComputedTorque ctrl(light, adaptive_law_settings(cfg), effort_limits_of(truth.machine));
+    cfg.adaptation.integral_action = with_integral == 1;
+    AdaptiveComputedTorque ctrl(light, adaptive_law_settings(cfg), cfg.period, effort_limits_of(truth.machine));
     sim::ModelPlant plant(truth, air);
     plant.reset(q0, Vec4::Zero());
     ControlOutput out;

@@ -7,7 +7,7 @@
 #include <random>
 
 #include "closed_loop.hpp"
-#include "control/consumer_settings.hpp"
+#include "control/controller_config.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "control/estimation/external_force_observer.hpp"
 #include "control/estimation/soil_contact.hpp"
@@ -156,7 +156,7 @@ TEST_CASE("firmware/adaptive composite update: told the applied efforts, it iden
   const Model model = build_model(reference_machine());
   const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   ControllerConfig cfg;
-  cfg.adaptation_rate.setZero();  // the composite term alone
+  cfg.adaptation.rate.setZero();  // the composite term alone
   sim::SoilTruth loam;            // theta (200, 5e3, 7e4) on both axes
   const sim::TrackingResult told = sim::run_tracking(model, task, "adaptive", cfg, loam, true);
   const sim::TrackingResult blind = sim::run_tracking(model, task, "adaptive", cfg, loam, false);
@@ -168,11 +168,11 @@ TEST_CASE("firmware/adaptive composite update: told the applied efforts, it iden
     CAPTURE(i);
     CHECK(told.theta_hat[i] == doctest::Approx(loam.theta[i]).epsilon(0.2));
   }
-  CHECK(blind.theta_hat == cfg.theta_initial);  // no applied efforts: nothing to learn from (eq. 27 is off)
+  CHECK(blind.theta_hat == cfg.soil_parameters.theta_initial);  // no applied efforts: nothing to learn from (eq. 27 is off)
   // The observer takes the soil the estimate misses: the error falls against the law without it.
   ControllerConfig no_observer = cfg;
-  no_observer.external_force.observer = false;
-  no_observer.external_force.identification_memory = 0;
+  no_observer.adaptation.external_force.observer = false;
+  no_observer.adaptation.external_force.identification_memory = 0;
   const sim::TrackingResult paper = sim::run_tracking(model, task, "adaptive", no_observer, loam, true);
   MESSAGE("RMS (mm) with observer and update: " << 1e3 * told.rms.transpose() << "; without: " << 1e3 * paper.rms.transpose());
   for (int j = 2; j < 4; ++j) CHECK(told.rms[j] < 0.5 * paper.rms[j]);
@@ -181,9 +181,9 @@ TEST_CASE("firmware/adaptive composite update: told the applied efforts, it iden
 TEST_CASE("firmware/adaptive composite update pauses on a joint whose applied effort is suspect, and the observer holds there") {
   const Model model = build_model(reference_machine());
   ControllerConfig cfg;
-  cfg.adaptation_rate.setZero();
+  cfg.adaptation.rate.setZero();
   EffortLimits unlimited;
-  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), unlimited);
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), cfg.period, unlimited);
   Workspace ws(model);
   Vec4 q0;
   REQUIRE(inverse_kinematics(model.machine, 0.0, TipPose{7.0, -0.3, 0.5}, q0) == IkStatus::ok);
@@ -198,14 +198,14 @@ TEST_CASE("firmware/adaptive composite update pauses on a joint whose applied ef
   in.applied.suspect = 0x0F;                     // but every joint's effort is known off the model
   ControlOutput out;
   for (int k = 0; k < 300; ++k) out = ctrl.update(in);
-  CHECK(ctrl.theta_hat() == cfg.theta_initial);
+  CHECK(ctrl.theta_hat() == cfg.soil_parameters.theta_initial);
   CHECK(out.disturbance == Vec4::Zero());  // the observer holds (never primed on a suspect effort)
   in.applied.suspect = 0b0100;  // only the arm's effort is suspect
   for (int k = 0; k < 300; ++k) out = ctrl.update(in);
   CHECK(out.disturbance[2] == 0.0);
   CHECK(std::abs(out.disturbance[1]) > 1e3);  // the others primed and learning
   const Vec6 arm_out = ctrl.theta_hat();
-  CHECK(arm_out != cfg.theta_initial);  // the update runs on boom and bucket
+  CHECK(arm_out != cfg.soil_parameters.theta_initial);  // the update runs on boom and bucket
   in.applied.suspect = 0;
   for (int k = 0; k < 300; ++k) out = ctrl.update(in);
   CHECK(std::abs(out.disturbance[2]) > 1e3);  // trusted again: primed at its first residual

@@ -29,8 +29,8 @@ TEST_CASE("firmware/controller config: a scene without controller gets the embed
   const ControllerConfig c = read_controller_config(settings::Document::parse("name: x", "scene.yaml"), reference_machine());
   const ControllerConfig d;
   CHECK(c.law == "adaptive");
-  CHECK(c.gains.kp == d.gains.kp);
-  CHECK(c.theta_min == d.theta_min);
+  CHECK(c.pid.gains.kp == d.pid.gains.kp);
+  CHECK(c.soil_parameters.theta_min == d.soil_parameters.theta_min);
 }
 
 TEST_CASE("firmware/controller config: the tracking-error limit defaults by command interface, 5x the valve machine's reach on valves, and a given one is kept through an interface switch") {
@@ -41,19 +41,19 @@ TEST_CASE("firmware/controller config: the tracking-error limit defaults by comm
   const ControllerConfig valve = read("controller: {command_interface: valve}");
   const ControllerConfig given = read("controller: {command_interface: valve, tracking_error_limit: [0.3, 0.4, 0.5, 0.6]}");
   // The effort interface (the paper's force actuators): the fixed limits.
-  CHECK(effort.tracking_error_limit == (Vec4() << 0.1, 0.2, 0.2, 0.2).finished());
+  CHECK(effort.supervisor.tracking_error_limit == (Vec4() << 0.1, 0.2, 0.2, 0.2).finished());
   // Valves: 5 x swing 7.8 mrad, boom 7.4 mm, arm 19.1 mm, bucket 10.4 mm (the generalisation sweeps).
-  CHECK(valve.tracking_error_limit[0] == doctest::Approx(0.039));
-  CHECK(valve.tracking_error_limit[1] == doctest::Approx(0.037));
-  CHECK(valve.tracking_error_limit[2] == doctest::Approx(0.0955));
-  CHECK(valve.tracking_error_limit[3] == doctest::Approx(0.052));
-  CHECK(given.tracking_error_limit == (Vec4() << 0.3, 0.4, 0.5, 0.6).finished());
+  CHECK(valve.supervisor.tracking_error_limit[0] == doctest::Approx(0.039));
+  CHECK(valve.supervisor.tracking_error_limit[1] == doctest::Approx(0.037));
+  CHECK(valve.supervisor.tracking_error_limit[2] == doctest::Approx(0.0955));
+  CHECK(valve.supervisor.tracking_error_limit[3] == doctest::Approx(0.052));
+  CHECK(given.supervisor.tracking_error_limit == (Vec4() << 0.3, 0.4, 0.5, 0.6).finished());
   // A bench variant switching the interface carries a derived limit with it, a given one not.
   ControllerConfig switched = effort, kept = given;
   set_command_interface(switched, CommandInterface::valve, reference_machine());
   set_command_interface(kept, CommandInterface::effort, reference_machine());
-  CHECK(switched.tracking_error_limit == valve.tracking_error_limit);
-  CHECK(kept.tracking_error_limit == given.tracking_error_limit);
+  CHECK(switched.supervisor.tracking_error_limit == valve.supervisor.tracking_error_limit);
+  CHECK(kept.supervisor.tracking_error_limit == given.supervisor.tracking_error_limit);
 }
 
 TEST_CASE("firmware/controller config parses every field") {
@@ -83,18 +83,18 @@ controller:
   CHECK(c.law == "slotine_li");
   CHECK(c.period == 0.002);
   CHECK(c.filter.period == 0.002);
-  CHECK(c.gains.kp[3] == 400);
-  CHECK(c.gains.ki[1] == 10);
-  CHECK(c.lyapunov_q[7] == 8);
-  CHECK(c.theta_initial[2] == 50000);
-  CHECK(c.regressor_acceleration == RegressorAcceleration::desired);
-  CHECK(c.sl_kd[0] == 9);
+  CHECK(c.pid.gains.kp[3] == 400);
+  CHECK(c.pid.gains.ki[1] == 10);
+  CHECK(c.pid.lyapunov_q[7] == 8);
+  CHECK(c.soil_parameters.theta_initial[2] == 50000);
+  CHECK(c.adaptation.regressor_acceleration == RegressorAcceleration::desired);
+  CHECK(c.slotine_li.kd[0] == 9);
   CHECK(c.filter.acceleration_cutoff_hz == 10);
   CHECK(c.watchdog_timeout == 0.05);
-  CHECK(c.actuator_lag == 0.03);
-  CHECK(c.actuator_lag_target == 0.006);
-  CHECK(c.integral_action);
-  CHECK(c.lyapunov_q_integral[3] == 4);
+  CHECK(c.actuation.actuator_lag == 0.03);
+  CHECK(c.actuation.actuator_lag_target == 0.006);
+  CHECK(c.adaptation.integral_action);
+  CHECK(c.adaptation.lyapunov_q_integral[3] == 4);
 }
 
 TEST_CASE("firmware/controller config errors name the field, its line and column and the allowed range") {

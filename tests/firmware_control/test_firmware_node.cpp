@@ -201,7 +201,7 @@ TEST_CASE("firmware/node: a stop request decelerates a tracking machine along it
   Vec4 q0, v0, a0;
   loop.task.trajectory.evaluate(tau0, q0, v0, a0);
   const Vec4 vmax = model.machine.speed_max();
-  const double ramp = cfg.controller.stop_ramp_time;
+  const double ramp = cfg.controller.path_clock.stop_ramp_time;
   // The closed form of path_stop.hpp: T = (pi / 2) ramp max_j |v_j| / v_max_j.
   const double T = 0.5 * M_PI * ramp * (v0.cwiseAbs().array() / vmax.array()).maxCoeff();
   REQUIRE(T > 0.05);  // the path moves at 3 s: there is a deceleration to see
@@ -265,7 +265,7 @@ TEST_CASE("firmware/node: with stop_ramp_time 0 a stop request holds at the desi
   const Model model = build_model(reference_machine());
   app::FirmwareNodeConfig cfg;
   cfg.controller.law = "pid";
-  cfg.controller.stop_ramp_time = 0;
+  cfg.controller.path_clock.stop_ramp_time = 0;
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 3.0) loop.cycle();
   REQUIRE(loop.node.mode() == Mode::track);
@@ -312,7 +312,7 @@ TEST_CASE("firmware/node: zero heap allocations in FirmwareNode's own cycle over
   for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
     app::FirmwareNodeConfig cfg;
     cfg.controller.law = kind;
-    cfg.controller.actuator_lag = 0.02;
+    cfg.controller.actuation.actuator_lag = 0.02;
     Loop loop(model, sim::kDigTask, cfg);
     loop.cycle();  // start-up cycle outside the count (first touch)
     std::size_t allocations = 0;
@@ -335,7 +335,7 @@ TEST_CASE("firmware/node: zero heap allocations through a stop along the path (r
   for (const std::string kind : {"pid", "adaptive", "slotine_li"}) {
     app::FirmwareNodeConfig cfg;
     cfg.controller.law = kind;
-    cfg.controller.pump_pacing = paced;  // control/task/pump_pacing.hpp: the clock a state stepped each cycle
+    cfg.controller.path_clock.pump_pacing = paced;  // control/task/pump_pacing.hpp: the clock a state stepped each cycle
     Loop loop(model, sim::kDigTask, cfg);
     loop.cycle();  // start-up cycle outside the count (first touch)
     std::size_t allocations = 0;
@@ -414,7 +414,7 @@ TEST_CASE("firmware/node: a swing that cannot keep up (2 rad in 2.5 s, saturated
   app::FirmwareNodeConfig cfg;
   cfg.controller.law = "pid";
   Loop loop(model, sim::kFastSwingTask, cfg);
-  const double limit = cfg.controller.tracking_error_limit[0];
+  const double limit = cfg.controller.supervisor.tracking_error_limit[0];
   double error_before = 0, desired_step = 0;
   Vec4 last_qd = loop.node.q_desired();
   int cycles = 0;
@@ -612,7 +612,7 @@ TEST_CASE("firmware/node: consecutive missed deadlines in real time are a fault 
   cfg.controller.law = "pid";
   Loop loop(model, sim::kFreeMotionTask, cfg);
   while (loop.node.time() < 1.0) loop.cycle();
-  const int limit = cfg.controller.max_missed_deadlines;
+  const int limit = cfg.controller.supervisor.max_missed_deadlines;
   REQUIRE(limit == 5);
   std::uint64_t overruns = 0;
   // limit - 1 late wake-ups, one on time, again: never limit in a row.
@@ -832,7 +832,7 @@ TEST_CASE("firmware/runner: a stop request decelerates a tracking machine along 
     // along its path (at most (pi / 2) stop_ramp_time) and holds, and the run ends stop_hold_s after
     // the hold began, so the machine stands for all of it.
     REQUIRE(bus.hold_from > 2001);
-    CHECK(static_cast<double>(bus.hold_from - 2001) * 1e-3 <= 0.5 * M_PI * cfg.controller.stop_ramp_time + 2e-3);
+    CHECK(static_cast<double>(bus.hold_from - 2001) * 1e-3 <= 0.5 * M_PI * cfg.controller.path_clock.stop_ramp_time + 2e-3);
     CHECK(out.cycles >= bus.hold_from + 500);
     CHECK(out.cycles <= bus.hold_from + 503);
     MESSAGE("stop requested at cycle 2000: in hold from " << bus.hold_from << ", run ended at " << out.cycles);

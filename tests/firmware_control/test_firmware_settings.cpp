@@ -53,14 +53,14 @@ TEST_CASE("firmware/settings read the shipped dig scene's firmware sections as w
   CHECK(s.task.path.size() == 6);           // six tip poses in the file
   CHECK(s.task.end_time() == doctest::Approx(10.0));
   CHECK(s.controller.command_interface == control::CommandInterface::valve);  // a hydraulic machine
-  CHECK(s.controller.actuator_lag == 0.0);
+  CHECK(s.controller.actuation.actuator_lag == 0.0);
   // Derived for the valves (no controller setting in the scene): eq. 27's rates at period / T_f of the
   // force-commanded defaults, the flow feedforward's position gain at 1 / (5 T_f), T_f the spools' lag.
   const double t_f = s.machine.hydraulics.valve_time_constant;
-  CHECK(s.controller.valves.force_time_constant == t_f);
-  CHECK(s.controller.adaptation_rate[2] == doctest::Approx(control::ControllerConfig{}.adaptation_rate[2] * 1e-3 / t_f));
-  CHECK(s.controller.valves.position_gain[2] == doctest::Approx(1 / (5 * t_f)));
-  CHECK(s.controller.external_force.cutoff_hz == doctest::Approx(s.controller.filter.acceleration_cutoff_hz / 3));
+  CHECK(s.controller.actuation.valves.force_time_constant == t_f);
+  CHECK(s.controller.adaptation.rate[2] == doctest::Approx(control::AdaptationSettings{}.rate[2] * 1e-3 / t_f));
+  CHECK(s.controller.actuation.valves.position_gain[2] == doctest::Approx(1 / (5 * t_f)));
+  CHECK(s.controller.adaptation.external_force.cutoff_hz == doctest::Approx(s.controller.filter.acceleration_cutoff_hz / 3));
   CHECK(s.duration == doctest::Approx(10.1));  // the path ends at 10.05 s
   CHECK(s.terrain.height == doctest::Approx(0.0));
   CHECK(s.machine_file.empty());  // no 'machine:' key: the built-in reference machine
@@ -71,7 +71,7 @@ TEST_CASE("firmware/settings read the paper's force-actuated dig with the actuat
   const app::FirmwareSettings s = app::load_firmware_settings(std::string(EXC_SOURCE_DIR) + "/scenes/paper_dig.yaml");
   CHECK(s.name == "paper_dig");
   CHECK(s.controller.command_interface == control::CommandInterface::effort);
-  CHECK(s.controller.actuator_lag == doctest::Approx(0.02));
+  CHECK(s.controller.actuation.actuator_lag == doctest::Approx(0.02));
 }
 
 TEST_CASE("firmware/settings refuse a flow law on the effort interface, naming both fields") {
@@ -86,7 +86,7 @@ TEST_CASE("firmware/settings refuse a flow law on the effort interface, naming b
 class PickyLaw final : public control::Controller {
  public:
   explicit PickyLaw(const control::ControllerConfig& c) {
-    if (c.gains.kp[0] > 500) throw SettingsError("", 0, 0, "controller.kp", "the picky law takes a swing gain of at most 500");
+    if (c.pid.gains.kp[0] > 500) throw SettingsError("", 0, 0, "controller.kp", "the picky law takes a swing gain of at most 500");
   }
   void reset() override {}
   control::ControlOutput update(const control::ControlInput&) override { return {}; }
@@ -115,29 +115,29 @@ TEST_CASE("firmware/settings derive the defaults a scene leaves out from the mac
   Machine slow = reference_machine();
   slow.hydraulics.valve_time_constant = 0.06;
   const control::ControllerConfig from_slow = control::controller_defaults(slow);
-  CHECK(from_slow.valves.force_time_constant == 0.06);
-  CHECK(from_slow.valves.spool_lag_target == doctest::Approx(0.02));
+  CHECK(from_slow.actuation.valves.force_time_constant == 0.06);
+  CHECK(from_slow.actuation.valves.spool_lag_target == doctest::Approx(0.02));
   const app::FirmwareSettings effort = read("name: x\nduration: 2\n" + std::string(kTask));
   const app::FirmwareSettings valve =
       read("name: x\nduration: 2\ncontroller: {command_interface: valve, valves: {force_time_constant: 0.05}}\n" +
            std::string(kTask));
-  CHECK(effort.controller.adaptation_rate == control::ControllerConfig{}.adaptation_rate);  // the paper's rates
-  CHECK(valve.controller.adaptation_rate[5] == doctest::Approx(control::ControllerConfig{}.adaptation_rate[5] * 1e-3 / 0.05));
-  CHECK(valve.controller.valves.position_gain[1] == doctest::Approx(1 / (5 * 0.05)));
+  CHECK(effort.controller.adaptation.rate == control::AdaptationSettings{}.rate);  // the paper's rates
+  CHECK(valve.controller.adaptation.rate[5] == doctest::Approx(control::AdaptationSettings{}.rate[5] * 1e-3 / 0.05));
+  CHECK(valve.controller.actuation.valves.position_gain[1] == doctest::Approx(1 / (5 * 0.05)));
   // Given values are kept as given.
   const app::FirmwareSettings given = read(
       "name: x\nduration: 2\ncontroller: {command_interface: valve, adaptation_rate: [1, 2, 3, 4, 5, 6], valves: "
       "{position_gain: [1, 1, 1, 1]}, filters: {acceleration_cutoff_hz: 30}, external_force: {cutoff_hz: 4}}\n" +
       std::string(kTask));
-  CHECK(given.controller.adaptation_rate[5] == 6);
-  CHECK(given.controller.valves.position_gain[3] == 1);
-  CHECK(given.controller.external_force.cutoff_hz == 4);
+  CHECK(given.controller.adaptation.rate[5] == 6);
+  CHECK(given.controller.actuation.valves.position_gain[3] == 1);
+  CHECK(given.controller.adaptation.external_force.cutoff_hz == 4);
   CHECK(read("name: x\nduration: 2\ncontroller: {filters: {acceleration_cutoff_hz: 30}}\n" + std::string(kTask))
-            .controller.external_force.cutoff_hz == doctest::Approx(10));
+            .controller.adaptation.external_force.cutoff_hz == doctest::Approx(10));
   // The effective configuration prints the derived values, so a run's dump says what it used.
   const YAML::Node dump = valve.effective["controller"];
   CHECK(dump["valves"]["position_gain"][0].as<double>() == doctest::Approx(4));
-  CHECK(dump["adaptation_rate"][2].as<double>() == doctest::Approx(control::ControllerConfig{}.adaptation_rate[2] * 0.02));
+  CHECK(dump["adaptation_rate"][2].as<double>() == doctest::Approx(control::AdaptationSettings{}.rate[2] * 0.02));
   CHECK(dump["external_force"]["cutoff_hz"].as<double>() == doctest::Approx(5));
   // An observer cut-off at or above the acceleration filter's is refused at its place.
   check_error("name: x\nduration: 2\ncontroller: {external_force: {cutoff_hz: 15}}\n" + std::string(kTask),

@@ -13,8 +13,8 @@
 
 #include "app/allocation_counter.hpp"
 #include "app/realtime_setup.hpp"
+#include "control/controller_config.hpp"
 #include "control/actuation/actuator_lag_compensator.hpp"
-#include "control/consumer_settings.hpp"
 #include "control/laws/adaptive_computed_torque.hpp"
 #include "diagnostics/perf_counter.hpp"
 #include "control/actuation/command_blender.hpp"
@@ -83,17 +83,17 @@ TEST_CASE("firmware/zero heap allocations over 100000 control steps (estimator, 
                                 Variant{"adaptive", true}, Variant{"slotine_li", false}}) {
     const std::string kind = variant.kind;
     ControllerConfig cfg;
-    cfg.integral_action = variant.integral_action;
-    cfg.actuator_lag = 0.02;  // the lag stage runs as in the dig scene (the model plant itself has no lag)
+    cfg.adaptation.integral_action = variant.integral_action;
+    cfg.actuation.actuator_lag = 0.02;  // the lag stage runs as in the dig scene (the model plant itself has no lag)
     auto ctrl = make_controller(kind, model, cfg);
-    ActuatorLagCompensator lag(cfg.actuator_lag, cfg.actuator_lag_target, cfg.period, effort_limits_of(model.machine));
+    ActuatorLagCompensator lag(cfg.actuation.actuator_lag, cfg.actuation.actuator_lag_target, cfg.period, effort_limits_of(model.machine));
     sim::ModelPlant plant(model, sim::SoilTruth{});
     Vec4 q0, qd0, qdd0;
     task.trajectory.evaluate(0, q0, qd0, qdd0);
     plant.reset(q0, qd0);
     StateEstimator est(cfg.filter);
     ControlStateMachine sm(cfg.watchdog_timeout);
-    CommandBlender blend(cfg.blend_time);
+    CommandBlender blend(cfg.actuation.blend_time);
     PerfCounter perf("control_step", 1000);
     const int steps = kind == "adaptive" && !variant.integral_action ? 100000 : 20000;
     std::size_t allocations = 0;
@@ -135,7 +135,7 @@ TEST_CASE("firmware/timing budget of the adaptive control step after real-time p
   const Model model = build_model(reference_machine());
   const Task task = read_task(settings::Document::parse(sim::kDigTask, "dig"), model.machine);
   const ControllerConfig cfg;
-  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), effort_limits_of(model.machine));
+  AdaptiveComputedTorque ctrl(model, adaptive_law_settings(cfg), cfg.period, effort_limits_of(model.machine));
   StateEstimator est(cfg.filter);
   sim::ModelPlant plant(model, sim::SoilTruth{});
   Vec4 q0, qd0, qdd0;

@@ -151,7 +151,7 @@ TEST_CASE("firmware/spool monitor: a spool stuck nearer neutral than commanded i
 }
 
 TEST_CASE("firmware/spool monitor: the supervisor raises a disagreement as a fault that takes the emergency stop, its text naming the function, the spool and the test") {
-  Supervisor sup(reference_machine(), SupervisorSettings{});
+  Supervisor sup(reference_machine(), SupervisorSettings{}, 1e-3);
   CHECK(stop_of(FirmwareFault::spool_disagreement) == StopKind::emergency);
   const SpoolMonitorSettings s;
   for (int k = 0; k < s.debounce - 1; ++k) {

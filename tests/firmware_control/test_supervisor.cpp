@@ -19,7 +19,7 @@ std::uint8_t bit(hal::SupervisorCommand c) { return static_cast<std::uint8_t>(1u
 
 // A supervisor and a clock: cycle k at t = k x period, a mode the test sets.
 struct Bench {
-  explicit Bench(SupervisorSettings s = SupervisorSettings{}) : supervisor(reference_machine(), s) {}
+  explicit Bench(SupervisorSettings s = SupervisorSettings{}) : supervisor(reference_machine(), s, 1e-3) {}
   CycleInputs next(Mode m, bool complete = true) {
     ++cycle;
     mode = m;

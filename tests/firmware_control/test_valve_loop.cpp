@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "app/allocation_counter.hpp"
-#include "control/consumer_settings.hpp"
+#include "control/controller_config.hpp"
 #include "control/laws/flow_position_control.hpp"
 #include "control/actuation/valve_inner_loop.hpp"
 
@@ -317,15 +317,15 @@ TEST_CASE("firmware/valve stage counts the pumps' flow the openings ask for") {
 
 TEST_CASE("firmware/flow law passes the desired velocity plus K_p times the position error") {
   ControllerConfig config;
-  config.flow_kp = Vec4(1, 2, 3, 4);
-  FlowPositionControl flow(flow_law_settings(config));
+  config.flow.kp = Vec4(1, 2, 3, 4);
+  FlowPositionControl flow(config.flow);
   ControlInput in;
   in.q = Vec4(0.1, 2.0, 2.5, 1.8);
   in.q_d = Vec4(0.15, 1.9, 2.5, 1.85);
   in.qd_d = Vec4(0.2, -0.1, 0.05, 0.0);
   const ControlOutput out = flow.update(in);
   CHECK(out.velocity_command);
-  for (int i = 0; i < 4; ++i) CHECK(out.velocity[i] == doctest::Approx(in.qd_d[i] - config.flow_kp[i] * (in.q[i] - in.q_d[i])));
+  for (int i = 0; i < 4; ++i) CHECK(out.velocity[i] == doctest::Approx(in.qd_d[i] - config.flow.kp[i] * (in.q[i] - in.q_d[i])));
   CHECK(out.tau.isZero());
 }
 

@@ -88,11 +88,11 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   // The valve stage's position correction at 2/s (the flow law's gain): the stronger default would
   // let the light bucket, which asks the least, catch up within the shared flow.
   Scenario s = move("[0.0, 2.10, 3.00, 2.30]", "[0.0, 2.50, 2.40, 1.90]", 2.0);
-  s.firmware.controller.valves.position_gain = Vec4::Constant(2);
+  s.firmware.controller.actuation.valves.position_gain = Vec4::Constant(2);
   // The default limit on valves (5x what the machine reaches, 37 mm on the boom) stops this path,
   // which asks the pumps for 1.8x their flow, after 1.1 s of lag: the test is about how the short
   // flow is shared, so it keeps the loose 0.1 rad / 0.2 m of the effort interface.
-  s.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
+  s.firmware.controller.supervisor.tracking_error_limit = kLooseTrackingLimit;
   const Machine& m = s.scene.machine;
   const double pumps = m.hydraulics.pump_flow, dt = s.scene.cycle;
   const fs::path log_path =
@@ -170,7 +170,7 @@ TEST_CASE("firmware/flow saturation: boom up, arm out and bucket open together a
   // With the valve machine's default limit the lag stops the path, and the fault names the pumps
   // (their warning raised before the limit is crossed) as the likely cause.
   Scenario d = move("[0.0, 2.10, 3.00, 2.30]", "[0.0, 2.50, 2.40, 1.90]", 2.0);
-  d.firmware.controller.valves.position_gain = Vec4::Constant(2);
+  d.firmware.controller.actuation.valves.position_gain = Vec4::Constant(2);
   const sim::RunRecord stopped = sim::run_lockstep(d.scene, d.firmware, {});
   MESSAGE("default limit: " << stopped.failure);
   CHECK(stopped.first_fault_code == static_cast<int>(safety::FirmwareFault::tracking_error));
@@ -201,7 +201,7 @@ TEST_CASE("firmware/pump pacing: the same path paced to the pumps runs to its en
     CHECK(r.task_finished);
     CHECK(late > 0.3);  // paced: about 1.8 / 0.9 - 1 of the peak's path time later
     CHECK(late < added);
-    const Vec4 limit = s.firmware.controller.tracking_error_limit;
+    const Vec4 limit = s.firmware.controller.supervisor.tracking_error_limit;
     for (int j = 1; j < 4; ++j) CHECK(r.max_error[j] < 0.25 * limit[j]);
     CHECK(r.flow_saturated_seconds <= 0.02);  // unpaced: over 1 s
     CHECK(r.pump_limited_cycles <= 20);
@@ -302,10 +302,10 @@ TEST_CASE("firmware/relief in hard digging: on a rock the arm's bore side peaks 
   // the arm back against its command, before the relief opens: this test is about the relief, so it
   // runs with the monitor off.
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  b.firmware.controller.plausibility.enabled = false;
+  b.firmware.controller.supervisor.plausibility.enabled = false;
   // Nor the default limit on valves (the arm's 96 mm stops the dig 0.1 s into the rock, before the
   // relief opens): the loose limit of the effort interface lets the firmware push into it.
-  b.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
+  b.firmware.controller.supervisor.tracking_error_limit = kLooseTrackingLimit;
   const Machine& m = b.scene.machine;
   const HydraulicParameters& h = m.hydraulics;
   sim::LockstepOptions o;
@@ -356,7 +356,7 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity and spool monitor
   // boom's acceleration to the stuck speed (4 mm of error): held to 5 % against the loose limit of the
   // effort interface, not the valves' default of 37 mm, which the same run crosses 0.28 s in.
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  b.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
+  b.firmware.controller.supervisor.tracking_error_limit = kLooseTrackingLimit;
   const Machine& m = b.scene.machine;
   const double d = m.hydraulics.dead_zone_extend[1], stuck = 0.5, t_stick = 3.0;
   const double v_stuck = (stuck - d) / (1 - d) * m.boom.max_speed;
@@ -368,8 +368,8 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity and spool monitor
   hal::PlantCanPort plant_port(*plant_bus);
   app::FirmwareNodeConfig fc;
   fc.controller = b.firmware.controller;
-  fc.controller.plausibility.enabled = false;
-  fc.controller.spool_monitor.enabled = false;  // it finds the spool at once: the tracking limit's and the standstill's case
+  fc.controller.supervisor.plausibility.enabled = false;
+  fc.controller.supervisor.spool_monitor.enabled = false;  // it finds the spool at once: the tracking limit's and the standstill's case
   fc.site_map = b.firmware.terrain;
   const Model model = build_model(b.firmware.machine);
   app::FirmwareNode node(model, b.firmware.task, fc, fw_port, nullptr);
@@ -416,7 +416,7 @@ TEST_CASE("firmware/a boom valve stuck half open, the velocity and spool monitor
   REQUIRE(node.supervisor().safe_stops() == 1);
   CHECK(node.supervisor().last_fault() == safety::FirmwareFault::tracking_error);
   CHECK(std::string(node.supervisor().last_fault_text()).find("boom") != std::string::npos);
-  const double limit = b.firmware.controller.tracking_error_limit[1];
+  const double limit = b.firmware.controller.supervisor.tracking_error_limit[1];
   CHECK(e_stick + predicted_error == doctest::Approx(limit).epsilon(0.05).scale(0));  // stopped where the error met it
   CHECK(others_max < 1e-3);  // the safe state centred the other spools (within 0.2 s: 30 ms lag) ...
   CHECK(end.spool[1] == stuck);  // ... not the stuck one

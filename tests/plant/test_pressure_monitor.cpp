@@ -32,7 +32,7 @@ int sets_to_detection(const sim::RunRecord& r, double start, double cycle) {
 
 TEST_CASE("firmware/pressure plausibility: a stuck, a jumping and a drifting chamber pressure are found by their test within their bound in sensor sets, the controlled stop taken") {
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  const safety::PressurePlausibilitySettings& s = b.firmware.controller.pressure_plausibility;
+  const safety::PressurePlausibilitySettings& s = b.firmware.controller.supervisor.pressure_plausibility;
   const double dt = b.scene.cycle;
   const double start = 2.0;  // s: the dig's bucket and arm are in the soil and moving
   int worst_stuck = 0, worst_jump = 0, worst_drift = 0, escalations = 0, found_cases = 0, skipped_cases = 0, found_by_motion = 0;
@@ -179,7 +179,7 @@ TEST_CASE("firmware/pressure plausibility: without a fault the pressure monitor 
       const sim::RunRecord r = sim::run_lockstep(b.scene, b.firmware, o);
       const std::string what = std::string(sc.scene) + ", " + law;
       INFO(what << ": " << r.failure);
-      const auto& limits = b.firmware.controller.pressure_plausibility;
+      const auto& limits = b.firmware.controller.supervisor.pressure_plausibility;
       MESSAGE(what << ": largest step / allowance " << worst_step << ", longest frozen run while moving " << longest_frozen
                    << " sets (of " << limits.frozen_sets << "), chamber pressures " << r.min_pressure * 1e-6 << " .. "
                    << r.peak_pressure * 1e-6 << " MPa" << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
@@ -196,7 +196,7 @@ TEST_CASE("firmware/pressure plausibility: with 5 kPa of noise on the readings a
   // region: slow paths).
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
   b.scene.sensors.pressure_noise = 5e3;
-  const safety::PressurePlausibilitySettings& s = b.firmware.controller.pressure_plausibility;
+  const safety::PressurePlausibilitySettings& s = b.firmware.controller.supervisor.pressure_plausibility;
   const double dt = b.scene.cycle, start = 2.0;
   {
     sim::LockstepOptions o;

@@ -54,7 +54,7 @@ TEST_CASE("firmware/safety: a spool stuck on any function, both ways, at opening
   // own command, through the valve's lag as this test steps it, leaves the stuck spool by more than
   // the monitor's limits (a spool stuck where the law commands it shows nothing until then).
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  const safety::SpoolMonitorSettings ms = b.firmware.controller.spool_monitor;
+  const safety::SpoolMonitorSettings ms = b.firmware.controller.supervisor.spool_monitor;
   const double tau = b.firmware.machine.hydraulics.valve_time_constant, dt = b.scene.cycle;
   const double t_stick = 3.0;
   int cases = 0, r1 = 0, r3 = 0, exempt = 0;
@@ -158,10 +158,10 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       const std::string what = std::string(sc.scene) + ", " + law;
       // The tracking limit's margin: the firmware's own error (what it judges) against its limit.
       Vec4 tracking_share;
-      for (int j = 0; j < 4; ++j) tracking_share[j] = r.measured_max_error[j] / b.firmware.controller.tracking_error_limit[j];
+      for (int j = 0; j < 4; ++j) tracking_share[j] = r.measured_max_error[j] / b.firmware.controller.supervisor.tracking_error_limit[j];
       INFO(what << ": " << r.failure);
       MESSAGE(what << ": largest test value / floor per function " << worst.transpose() << "; frozen-reading test's longest run "
-                   << longest_frozen << " of " << b.firmware.controller.plausibility.frozen_sets
+                   << longest_frozen << " of " << b.firmware.controller.supervisor.plausibility.frozen_sets
                    << " sets; spool monitor's largest test value / limit " << worst_spool
                    << "; largest tracking error / limit " << tracking_share.transpose()
                    << (r.safe_stops ? " (safe stop: " + r.failure + ")" : ""));
@@ -170,7 +170,7 @@ TEST_CASE("firmware/plausibility: without a fault the velocity monitor and the f
       CHECK(r.first_fault_code != static_cast<int>(safety::FirmwareFault::velocity_implausible));
       CHECK(r.first_fault_code != static_cast<int>(safety::FirmwareFault::spool_disagreement));
       CHECK(r.safe_stops == 0);
-      CHECK(longest_frozen < b.firmware.controller.plausibility.frozen_sets);
+      CHECK(longest_frozen < b.firmware.controller.supervisor.plausibility.frozen_sets);
       // The default limit is 5x the worst of 1300 unseen runs: a shipped scene within half of it.
       CHECK(tracking_share.maxCoeff() < 0.5);
     }
@@ -184,15 +184,15 @@ TEST_CASE("firmware/tracking limit: on the valve machine the default limit, 5x w
   // that the tracking limit is the only monitor: the default limit's 37 mm is crossed within
   // about (37 mm + the path's own motion) / 0.13 m/s, the loose one's 200 mm five times later.
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  b.firmware.controller.plausibility.enabled = false;
-  b.firmware.controller.plausibility.frozen_sets = 1000000;
-  b.firmware.controller.spool_monitor.enabled = false;  // it finds the spool at once: the limit's case
+  b.firmware.controller.supervisor.plausibility.enabled = false;
+  b.firmware.controller.supervisor.plausibility.frozen_sets = 1000000;
+  b.firmware.controller.supervisor.spool_monitor.enabled = false;  // it finds the spool at once: the limit's case
   REQUIRE(b.firmware.controller.command_interface == control::CommandInterface::valve);
-  CHECK(b.firmware.controller.tracking_error_limit[1] == doctest::Approx(5 * 0.0074));
+  CHECK(b.firmware.controller.supervisor.tracking_error_limit[1] == doctest::Approx(5 * 0.0074));
   double found[2] = {-1, -1};
   for (int loose = 0; loose < 2; ++loose) {
     sim::SceneBundle c = b;
-    if (loose) c.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
+    if (loose) c.firmware.controller.supervisor.tracking_error_limit = kLooseTrackingLimit;
     sim::LockstepOptions o;
     o.controller = "adaptive";
     o.duration = 6.0;
@@ -303,7 +303,7 @@ TEST_CASE("firmware/supervisor: an operator stop frame stops the tracking machin
   INFO(run.record.failure << " " << run.fault_text);
   // Taken on the cycle the frame arrives (the firmware's cycle 3.001 s): the machine decelerates
   // along its path, at most (pi / 2) stop_ramp_time, and the stop latches when the path is at rest.
-  const double ramp = b.firmware.controller.stop_ramp_time;
+  const double ramp = b.firmware.controller.path_clock.stop_ramp_time;
   CHECK(run.first_stop >= 3.0 + 1e-3);
   CHECK(run.first_stop <= 3.0 + 1e-3 + 0.5 * M_PI * ramp + 1e-3);
   CHECK(run.fault == safety::FirmwareFault::operator_stop);
@@ -322,7 +322,7 @@ TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and fa
   // campaign's fault kind operator_link_lost) and falls silent after its frame at 3 s; it is heard
   // again at 6 s with an acknowledge. The control keeps sending to the run's end.
   const sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/dig.yaml");
-  const double timeout = b.firmware.controller.supervisor_timeout, last = 3.0;
+  const double timeout = b.firmware.controller.supervisor.supervisor_timeout, last = 3.0;
   REQUIRE(timeout > 0);
   for (const bool falls_silent : {true, false}) {
     sim::LockstepOptions o;
@@ -344,7 +344,7 @@ TEST_CASE("firmware/supervisor: an operator station that sent keep-alives and fa
     CHECK(run.fault_text.find("operator link lost: no SUPERVISOR frame for 0.500 s") != std::string::npos);
     CHECK(run.record.first_fault_detected_time == doctest::Approx(last + 1e-3 + timeout + 1e-3).epsilon(1e-9));
     CHECK(run.first_stop > last + timeout);
-    CHECK(run.first_stop < last + timeout + b.firmware.controller.stop_ramp_time * 1.6);
+    CHECK(run.first_stop < last + timeout + b.firmware.controller.path_clock.stop_ramp_time * 1.6);
     CHECK(safety::stop_of(run.fault) == safety::StopKind::controlled);
     CHECK(run.left_stop == doctest::Approx(6.0 + 1e-3).epsilon(1e-9));
     CHECK(run.last_moving_stopped < 5.5);  // the machine at rest by the plant's truth
@@ -369,8 +369,8 @@ TEST_CASE("firmware/plausibility: a frozen position reading while its function i
       sim::SceneBundle c = b;
       // The default limit on valves (52 mm on the bucket) finds this freeze itself, 0.25 s in, as
       // a tracking error; the test is about the frozen-reading test where the limit is loose.
-      c.firmware.controller.tracking_error_limit = kLooseTrackingLimit;
-      if (!frozen_test) c.firmware.controller.plausibility.frozen_sets = 1000000;
+      c.firmware.controller.supervisor.tracking_error_limit = kLooseTrackingLimit;
+      if (!frozen_test) c.firmware.controller.supervisor.plausibility.frozen_sets = 1000000;
       sim::LockstepOptions o;
       o.controller = law;
       o.duration = 5.0;
@@ -412,7 +412,7 @@ TEST_CASE("firmware/standstill: a swing spool stuck just past its dead zone, fou
   // spool monitor, which finds this spool itself 20 ms after the stick, is off: the case is the
   // controlled stop's.
   sim::SceneBundle b = sim::load_scene_bundle(EXC_SOURCE_DIR "/scenes/free_motion.yaml");
-  b.firmware.controller.spool_monitor.enabled = false;
+  b.firmware.controller.supervisor.spool_monitor.enabled = false;
   for (const std::string law : {"pid", "adaptive"}) {
     sim::LockstepOptions o;
     o.controller = law;

@@ -128,7 +128,7 @@ TEST_CASE("tools/excavator-sim: every shipped scene, for its full duration with 
       double share = 0;
       const char* joints[4] = {"swing", "boom", "arm", "bucket"};
       for (int k = 0; k < 4; ++k)
-        share = std::max(share, j[c]["max_error"][joints[k]].get<double>() / cc.tracking_error_limit[k]);
+        share = std::max(share, j[c]["max_error"][joints[k]].get<double>() / cc.supervisor.tracking_error_limit[k]);
       MESSAGE(scene.filename().string() << " " << c << ": worst error " << share * 100 << " % of its limit");
       CHECK(share < 1);
     }

@@ -115,8 +115,8 @@ TEST_CASE("tools/settings: a shipped scene's effective configuration fills every
     const exc::sim::SceneBundle b = exc::sim::load_scene_bundle(copy.string());
     CHECK(exc::settings::emit(b.effective) == dump);
     // The same configuration, to the bit.
-    CHECK(b.firmware.controller.gains.kp == a.firmware.controller.gains.kp);
-    CHECK(b.firmware.controller.adaptation_rate == a.firmware.controller.adaptation_rate);
+    CHECK(b.firmware.controller.pid.gains.kp == a.firmware.controller.pid.gains.kp);
+    CHECK(b.firmware.controller.adaptation.rate == a.firmware.controller.adaptation.rate);
     CHECK(b.firmware.task.trajectory.times() == a.firmware.task.trajectory.times());
     CHECK(b.firmware.task.trajectory.points() == a.firmware.task.trajectory.points());
     CHECK(b.scene.q_a0 == a.scene.q_a0);

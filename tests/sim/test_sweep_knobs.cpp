@@ -113,12 +113,12 @@ TEST_CASE("tools/sweep knobs: a value set by a setting's path reaches the side t
   const SceneBundle spools = model_spools.read();
   REQUIRE(nominal.firmware.machine.hydraulics.valve_time_constant == doctest::Approx(0.03));
   CHECK(spools.firmware.machine.hydraulics.valve_time_constant == 0.1);
-  CHECK(spools.firmware.controller.valves.force_time_constant == doctest::Approx(0.1));
-  CHECK(spools.firmware.controller.valves.spool_lag_target == doctest::Approx(0.1 / 3));
-  CHECK(nominal.firmware.controller.valves.force_time_constant == doctest::Approx(0.03));
+  CHECK(spools.firmware.controller.actuation.valves.force_time_constant == doctest::Approx(0.1));
+  CHECK(spools.firmware.controller.actuation.valves.spool_lag_target == doctest::Approx(0.1 / 3));
+  CHECK(nominal.firmware.controller.actuation.valves.force_time_constant == doctest::Approx(0.03));
   SceneChanges controller(dig());
   controller.set("controller.valves.force_time_constant", YAML::Node("0.01"));
-  CHECK(controller.read().firmware.controller.valves.force_time_constant == 0.01);
+  CHECK(controller.read().firmware.controller.actuation.valves.force_time_constant == 0.01);
 
   // Refused as the scene file would be: the sensors' ring, a machine range, a cross-field rule.
   const exc::settings::SettingsError late = refusal("sensors.latency_cycles", YAML::Node("64"));
@@ -137,13 +137,13 @@ TEST_CASE("tools/sweep knobs: a value set by a setting's path reaches the side t
 TEST_CASE("tools/sweep knobs: the named knobs write the settings their rows name, from the nominal scene's values") {
   const SceneBundle& nominal = dig().nominal;
   const SceneBundle gains = with("gain_scale", number(2));
-  CHECK(gains.firmware.controller.gains.kp == nominal.firmware.controller.gains.kp * 4);
-  CHECK(gains.firmware.controller.gains.kv == nominal.firmware.controller.gains.kv * 2);
-  CHECK(gains.firmware.controller.gains.ki == nominal.firmware.controller.gains.ki * 8);
-  CHECK(gains.firmware.controller.sl_lambda == nominal.firmware.controller.sl_lambda * 2);
+  CHECK(gains.firmware.controller.pid.gains.kp == nominal.firmware.controller.pid.gains.kp * 4);
+  CHECK(gains.firmware.controller.pid.gains.kv == nominal.firmware.controller.pid.gains.kv * 2);
+  CHECK(gains.firmware.controller.pid.gains.ki == nominal.firmware.controller.pid.gains.ki * 8);
+  CHECK(gains.firmware.controller.slotine_li.lambda == nominal.firmware.controller.slotine_li.lambda * 2);
   const SceneBundle rates = with("adaptation_scale", number(0.01));
-  CHECK(rates.firmware.controller.adaptation_rate == nominal.firmware.controller.adaptation_rate * 0.01);
-  CHECK(rates.firmware.controller.sl_adaptation_rate == nominal.firmware.controller.sl_adaptation_rate * 0.01);
+  CHECK(rates.firmware.controller.adaptation.rate == nominal.firmware.controller.adaptation.rate * 0.01);
+  CHECK(rates.firmware.controller.slotine_li.adaptation_rate == nominal.firmware.controller.slotine_li.adaptation_rate * 0.01);
   const SceneBundle heavy = with("model_mass", number(0.2));
   for (std::size_t i = 0; i < heavy.firmware.machine.bodies.size(); ++i) {
     CHECK(heavy.firmware.machine.bodies[i].mass == nominal.firmware.machine.bodies[i].mass * 1.2);

@@ -183,7 +183,7 @@ int main(int argc, char** argv) {
     run.sensor_wait_ns = static_cast<std::int64_t>(wait_ms * 1e6);
     run.startup_wait_ns = static_cast<std::int64_t>(startup_s * 1e9);
     run.max_overrun_fraction = max_overrun_fraction;
-    run.stop_hold_s = fc.controller.blend_time;
+    run.stop_hold_s = fc.controller.actuation.blend_time;
     std::printf("excavator-firmware: %s on %s, %lld cycles of %.3g ms, %s; sensor wait %.3g ms; floating point: %s%s%s\n",
                 law_name, iface.c_str(), static_cast<long long>(run.cycles), period_s * 1e3,
                 realtime ? "real time (absolute deadlines)" : "lockstep with the plant", wait_ms,

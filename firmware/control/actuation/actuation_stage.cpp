@@ -2,12 +2,13 @@
 
 namespace exc::control {
 
-ActuationStage::ActuationStage(const Machine& nominal, const ActuationSettings& settings)
-    : valves_interface_(settings.command_interface == CommandInterface::valve),
+ActuationStage::ActuationStage(const Machine& nominal, const ActuationSettings& settings, CommandInterface interface,
+                               double period)
+    : valves_interface_(interface == CommandInterface::valve),
       friction_(actuator_friction(nominal)),
       blender_(settings.blend_time),
-      lag_(settings.actuator_lag, settings.actuator_lag_target, settings.period, effort_limits_of(nominal)),
-      valve_stage_(valve_loop_model(nominal), settings.valves, settings.period) {}
+      lag_(settings.actuator_lag, settings.actuator_lag_target, period, effort_limits_of(nominal)),
+      valve_stage_(valve_loop_model(nominal), settings.valves, period) {}
 
 Vec4 ActuationStage::efforts(double t, const Vec4& tau_law, bool restarted) {
   const Vec4 tau = blender_.apply(t, tau_law);

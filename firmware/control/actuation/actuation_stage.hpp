@@ -23,20 +23,29 @@ struct ChamberPressures {
   Vec4 a = Vec4::Zero(), b = Vec4::Zero();
 };
 
-// What the stage reads, its own: ControllerConfig's members of the same names, which hold their
-// meaning and defaults (controller_config.hpp; consumer_settings.hpp hands them over).
+// The stage's own settings (ControllerConfig's `actuation` member). It takes the command interface
+// and the period beside them: those are the bus's and the loop's, which other consumers read too.
 struct ActuationSettings {
-  double period = 1e-3;  // s
-  CommandInterface command_interface = CommandInterface::effort;
-  double blend_time = 0;           // s, bumpless switch fade
-  double actuator_lag = 0;         // s, the effort lag the lead compensates (0: none)
-  double actuator_lag_target = 0;  // s, the lag the compensated actuator should show
-  ValveLoopSettings valves;        // the valve stage's (valve interface)
+  double blend_time = 0.2;  // s, bumpless switch fade
+  // Actuator lag the firmware compensates (actuator_lag_compensator.hpp): the time constant of the
+  // machine's effort response (0: ideal force actuators, the paper's; no compensation) and the one
+  // the compensated actuator should show. lag / target is the lead's high-frequency gain.
+  double actuator_lag = 0;             // s
+  double actuator_lag_target = 0.005;  // s
+  ValveLoopSettings valves;  // the valve stage's (valve interface): force loop, spool lead
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, ActuationSettings& s) {
+  v("blend_time", s.blend_time);
+  v("actuator_lag", s.actuator_lag);
+  v("actuator_lag_target", s.actuator_lag_target);
+  v("valves", s.valves);
+}
 
 class ActuationStage {
  public:
-  ActuationStage(const Machine& nominal, const ActuationSettings& settings);
+  ActuationStage(const Machine& nominal, const ActuationSettings& settings, CommandInterface interface, double period);
 
   bool valves() const { return valves_interface_; }
   // Entering hold or track after a stop or at start-up: the valve stage forgets its filters.

@@ -10,32 +10,33 @@
 
 namespace exc::control {
 
-AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const AdaptiveLawSettings& settings,
+AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const AdaptiveLawSettings& settings, double period,
                                                const EffortLimits& limits)
     : model_(model),
       ws_(model),
       settings_(settings),
+      period_(period),
       limits_(limits),
-      contact_(settings.soil_contact),
-      update_contact_(settings.soil_contact),
-      observer_(settings.period, settings.external_force.cutoff_hz),
+      contact_(settings.adaptation.soil_contact),
+      update_contact_(settings.adaptation.soil_contact),
+      observer_(period, settings.adaptation.external_force.cutoff_hz),
       regression_filter_(settings.filter),
-      identification_(settings.theta_max, settings.external_force.identification_memory, settings.period,
-                      settings.external_force.force_scale),
-      tip_filter_(first_order_gain(settings.filter.velocity_cutoff_hz, settings.period)),
-      tip_chain_filter_(first_order_gain(settings.filter.velocity_cutoff_hz, settings.period)) {
-  PidGains gains = settings.gains;
-  if (settings.integral_action) {
+      identification_(settings.soil.theta_max, settings.adaptation.external_force.identification_memory, period,
+                      settings.adaptation.external_force.force_scale),
+      tip_filter_(first_order_gain(settings.filter.velocity_cutoff_hz, period)),
+      tip_chain_filter_(first_order_gain(settings.filter.velocity_cutoff_hz, period)) {
+  PidGains gains = settings.computed_torque.gains;
+  if (settings.adaptation.integral_action) {
     const Mat12 A = integral_error_dynamics_matrix(gains.kp, gains.kv, gains.ki);
     Vec12 q;
-    q << settings.lyapunov_q_integral, settings.lyapunov_q;
+    q << settings.adaptation.lyapunov_q_integral, settings.computed_torque.lyapunov_q;
     if (!solve_lyapunov(A, Mat12(q.asDiagonal()), P_))
       throw SettingsError("", 0, 0, "controller.ki", "A^T P + P A + Q = 0 (integral states) has no positive definite solution for kp, kv, ki and lyapunov_q_integral");
   } else {
     gains.ki.setZero();  // the paper's law: no integral state, zero rows and columns of P for it
     const Mat8 A = error_dynamics_matrix(gains.kp, gains.kv);
     Mat8 P8;
-    if (!solve_lyapunov(A, Mat8(settings.lyapunov_q.asDiagonal()), P8))
+    if (!solve_lyapunov(A, Mat8(settings.computed_torque.lyapunov_q.asDiagonal()), P8))
       throw SettingsError("", 0, 0, "controller.kv", "A^T P + P A + Q = 0 has no positive definite solution for kp, kv and lyapunov_q");
     P_.bottomRightCorner<8, 8>() = P8;
   }
@@ -44,7 +45,7 @@ AdaptiveComputedTorque::AdaptiveComputedTorque(const Model& model, const Adaptiv
 }
 
 void AdaptiveComputedTorque::reset() {
-  theta_hat_ = settings_.theta_initial;
+  theta_hat_ = settings_.soil.theta_initial;
   contact_.reset();
   update_contact_.reset();
   observer_.reset();
@@ -67,7 +68,7 @@ void AdaptiveComputedTorque::visit_state(StateVisitor& visitor) const {
 
 Vec6 AdaptiveComputedTorque::gamma() const {
   Vec6 g;
-  for (int i = 0; i < 6; ++i) g[i] = settings_.adaptation_rate[i] > 0 ? 1 / settings_.adaptation_rate[i] : 0;
+  for (int i = 0; i < 6; ++i) g[i] = settings_.adaptation.rate[i] > 0 ? 1 / settings_.adaptation.rate[i] : 0;
   return g;
 }
 
@@ -89,14 +90,14 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   // the spring the soil had shed as its error's cause and ran away at high rates (the projection
   // test's 10x rate).
   const Vec2& tip_filtered = tip_filter_.update(ws_.rho);
-  const bool observing = settings_.external_force.observer && in.applied.valid;
+  const bool observing = settings_.adaptation.external_force.observer && in.applied.valid;
   const Vec2& command_tip = observing ? tip_filtered : ws_.rho;
   const Vec2* tip_force = observer_.primed() ? &tip_force_ : nullptr;
   contact_.resolve(in.soil, command_tip, tip_force, out.in_soil, out.rho_env);
   bool in_soil_filtered = out.in_soil;
   Vec2 anchor_filtered = out.rho_env;
   if (!observing) update_contact_.resolve(in.soil, tip_filtered, tip_force, in_soil_filtered, anchor_filtered);
-  const Vec4& qdd_for_y = settings_.regressor_acceleration == RegressorAcceleration::desired ? in.qdd_d : in.qdd;
+  const Vec4& qdd_for_y = settings_.adaptation.regressor_acceleration == RegressorAcceleration::desired ? in.qdd_d : in.qdd;
   const Vec2 rhodd = ws_.J_t * qdd_for_y + ws_.rhodd_bias;
   const Mat4x6 Y = soil_regressor(ws_.J_t, command_tip, ws_.rhod, rhodd, out.rho_env, out.in_soil);
   const Vec4 prediction = Y * theta_hat_;
@@ -132,7 +133,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   out.disturbance = observer_.estimate();
   out.tip_force = tip_force_;
 
-  const Vec4 v = in.qdd_d - feedback_.update(out.e, out.ed, settings_.period, saturated_ | in.actuator_limited);
+  const Vec4 v = in.qdd_d - feedback_.update(out.e, out.ed, period_, saturated_ | in.actuator_limited);
   out.tau_unsaturated = M_a * v + h_a + prediction;  // eq. 12
   if (observing) out.tau_unsaturated += observer_.estimate();
   saturated_ = saturate_output(limits_, out, last_tau_);
@@ -153,19 +154,19 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
   if ((out.in_soil || Y_filtered.any()) && off_dynamics != 0x0F) {
     Vec6 theta_dot = Vec6::Zero(), theta_step = Vec6::Zero();
     // Update law (eq. 27) from the tracking error.
-    if (settings_.adaptation_rate.any()) {
+    if (settings_.adaptation.rate.any()) {
       const Eigen::LDLT<Mat4> ldlt(M_a);
       const Mat4x6 Phi = ldlt.solve(Y);                       // M_a^-1 Y
       Vec4 BtPx = P_.bottomRows<4>() * z;                     // B^T P x (or z)
       // A joint not driven as commanded: its error is the limit's, not the soil's. A joint inside the
       // dead zone: its error is what the loop below the law leaves (the valves' resolution), not soil.
       for (int j = 0; j < 4; ++j)
-        if (((off_dynamics >> j) & 1u) || std::abs(out.e[j]) < settings_.tracking_dead_zone[j]) BtPx[j] = 0;
-      theta_dot = -settings_.adaptation_rate.cwiseProduct(Phi.transpose() * BtPx);
+        if (((off_dynamics >> j) & 1u) || std::abs(out.e[j]) < settings_.adaptation.tracking_dead_zone[j]) BtPx[j] = 0;
+      theta_dot = -settings_.adaptation.rate.cwiseProduct(Phi.transpose() * BtPx);
     }
     // The composite term: least squares on the prediction error of the applied efforts, a dead zone
     // on each cylinder's residual (noise and what the model leaves out must not walk the estimates).
-    const ExternalForceSettings& ef = settings_.external_force;
+    const ExternalForceSettings& ef = settings_.adaptation.external_force;
     if (ef.identification_memory > 0 && in.applied.valid) {
       Vec4 r = Vec4::Zero();
       for (int j = 1; j < 4; ++j) {  // a dead zone on each cylinder's residual
@@ -174,7 +175,7 @@ ControlOutput AdaptiveComputedTorque::update(const ControlInput& in) {
       }
       theta_step = identification_.measure(Y_filtered, r, static_cast<std::uint8_t>(~off_dynamics & 0x0E));
     }
-    theta_hat_ = (theta_hat_ + settings_.period * theta_dot + theta_step).cwiseMax(settings_.theta_min).cwiseMin(settings_.theta_max);
+    theta_hat_ = (theta_hat_ + period_ * theta_dot + theta_step).cwiseMax(settings_.soil.theta_min).cwiseMin(settings_.soil.theta_max);
   }
   return out;
 }

@@ -58,7 +58,7 @@ class AdaptiveComputedTorque final : public Controller {
  public:
   // The model must outlive the controller. Start-up: allocates (the Workspace, the Lyapunov solve).
   // Throws SettingsError if the gains give no SPD P.
-  AdaptiveComputedTorque(const Model& model, const AdaptiveLawSettings& settings, const EffortLimits& limits);
+  AdaptiveComputedTorque(const Model& model, const AdaptiveLawSettings& settings, double period, const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
   void visit_state(StateVisitor& visitor) const override;
@@ -66,7 +66,7 @@ class AdaptiveComputedTorque final : public Controller {
   // P of V over z = [int e; e; ed] (without integral action the int e rows and columns are zero).
   const Mat12& lyapunov_p() const { return P_; }
   const Vec6& theta_hat() const { return theta_hat_; }
-  void set_theta_hat(const Vec6& th) { theta_hat_ = th.cwiseMax(settings_.theta_min).cwiseMin(settings_.theta_max); }
+  void set_theta_hat(const Vec6& th) { theta_hat_ = th.cwiseMax(settings_.soil.theta_min).cwiseMin(settings_.soil.theta_max); }
   // The integral of e (with integral action; tests start from a given one).
   void set_error_integral(const Vec4& i) { feedback_.set_integral(i); }
   // Gamma of V (the inverse of the adaptation rates; a zero rate gives an infinite weight, so V is
@@ -83,6 +83,7 @@ class AdaptiveComputedTorque final : public Controller {
   const Model& model_;
   Workspace ws_;
   AdaptiveLawSettings settings_;
+  double period_;  // s, the control period the update is integrated at
   EffortLimits limits_;
   Mat12 P_ = Mat12::Zero();
   Pid feedback_;                      // K_p e + K_v ed (+ K_i int e), the integral frozen on saturation

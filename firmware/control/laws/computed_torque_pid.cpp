@@ -5,9 +5,9 @@
 
 namespace exc::control {
 
-ComputedTorquePid::ComputedTorquePid(const Model& model, const PidLawSettings& settings,
+ComputedTorquePid::ComputedTorquePid(const Model& model, const PidLawSettings& settings, double period,
                                      const EffortLimits& limits)
-    : model_(model), ws_(model), period_(settings.period), limits_(limits), pid_(settings.gains) {
+    : model_(model), ws_(model), period_(period), limits_(limits), pid_(settings.gains) {
   const Mat8 A = error_dynamics_matrix(settings.gains.kp, settings.gains.kv);
   const Mat8 Q = settings.lyapunov_q.asDiagonal();
   solve_lyapunov(A, Q, P_);

@@ -32,10 +32,17 @@ inline bool flow_law_fits(const Task& task) {
   return true;
 }
 
-// What the law reads, its own (ControllerConfig's flow_kp).
+// The law's own settings (controller.flow; ControllerConfig's `flow` member).
 struct FlowLawSettings {
-  Vec4 kp = Vec4::Zero();  // 1/s: position gains, u = qd_d - kp e
+  // 1/s: position gains, u = qd_d - kp e. 2 rad/s keeps the position loop below a third of the
+  // boom's 2-3 Hz oil column (hydraulics.md).
+  Vec4 kp = Vec4::Constant(2);
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, FlowLawSettings& s) {
+  v("kp", s.kp);
+}
 
 class FlowPositionControl final : public Controller {
  public:

@@ -4,13 +4,14 @@
 
 namespace exc::control {
 
-SlotineLi::SlotineLi(const Model& model, const SlotineLiSettings& settings, const EffortLimits& limits)
-    : model_(model), ws_(model), settings_(settings), limits_(limits) {
+SlotineLi::SlotineLi(const Model& model, const SlotineLiSettings& settings, const SoilParameterBounds& soil,
+                     double period, const EffortLimits& limits)
+    : model_(model), ws_(model), settings_(settings), soil_(soil), period_(period), limits_(limits) {
   reset();
 }
 
 void SlotineLi::reset() {
-  theta_hat_ = settings_.theta_initial;
+  theta_hat_ = soil_.theta_initial;
   anchor_.reset();
 }
 
@@ -53,7 +54,7 @@ ControlOutput SlotineLi::update(const ControlInput& in) {
     for (int j = 0; j < 4; ++j)
       if ((off_dynamics >> j) & 1u) s_used[j] = 0;
     const Vec6 theta_dot = -settings_.adaptation_rate.cwiseProduct(Y.transpose() * s_used);
-    theta_hat_ = (theta_hat_ + settings_.period * theta_dot).cwiseMax(settings_.theta_min).cwiseMin(settings_.theta_max);
+    theta_hat_ = (theta_hat_ + period_ * theta_dot).cwiseMax(soil_.theta_min).cwiseMin(soil_.theta_max);
   }
   return out;
 }

@@ -14,23 +14,32 @@
 #include "control/control_types.hpp"
 #include "control/laws/effort_limits.hpp"
 #include "control/laws/regressor.hpp"
+#include "control/laws/soil_parameter_bounds.hpp"
 #include "control/estimation/soil_contact.hpp"
 #include "model/closed_chain.hpp"
 
 namespace exc::control {
 
-// What the law reads, its own (ControllerConfig's period, sl_lambda, sl_kd, sl_adaptation_rate and
-// the soil parameters' bounds and initial estimate: controller_config.hpp says what each means).
+// The law's own settings (controller.slotine_li; ControllerConfig's `slotine_li` member). It takes
+// the soil parameters' bounds beside them (soil_parameter_bounds.hpp), shared with the adaptive law.
+// Defaults: the same error bandwidth as the computed-torque laws, kv = lambda + kd, kp = lambda kd.
 struct SlotineLiSettings {
-  double period = 1e-3;  // s
-  Vec4 lambda = Vec4::Zero(), kd = Vec4::Zero();
-  Vec6 adaptation_rate = Vec6::Zero();
-  Vec6 theta_min = Vec6::Zero(), theta_max = Vec6::Zero(), theta_initial = Vec6::Zero();
+  Vec4 lambda = Vec4::Constant(8);  // 1/s: s = ed + lambda e
+  Vec4 kd = Vec4::Constant(8);      // 1/s: the damping of s, scaled by M_a
+  Vec6 adaptation_rate = (Vec6() << 3e3, 3e5, 3e7, 3e3, 3e5, 3e7).finished();  // Gamma^-1 of its update
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, SlotineLiSettings& s) {
+  v("lambda", s.lambda);
+  v("kd", s.kd);
+  v("adaptation_rate", s.adaptation_rate);
+}
 
 class SlotineLi final : public Controller {
  public:
-  SlotineLi(const Model& model, const SlotineLiSettings& settings, const EffortLimits& limits);
+  SlotineLi(const Model& model, const SlotineLiSettings& settings, const SoilParameterBounds& soil, double period,
+            const EffortLimits& limits);
   void reset() override;
   ControlOutput update(const ControlInput& in) override;
   const Vec6& theta_hat() const { return theta_hat_; }
@@ -39,6 +48,8 @@ class SlotineLi final : public Controller {
   const Model& model_;
   Workspace ws_;
   SlotineLiSettings settings_;
+  SoilParameterBounds soil_;
+  double period_;  // s
   EffortLimits limits_;
   Vec6 theta_hat_ = Vec6::Zero();
   SoilContactEstimator anchor_;

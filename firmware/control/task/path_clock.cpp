@@ -2,12 +2,12 @@
 
 namespace exc::control {
 
-PathClock::PathClock(const Task& task, const Machine& nominal, const PathClockSettings& settings)
+PathClock::PathClock(const Task& task, const Machine& nominal, const PathClockSettings& settings, double period)
     : task_(task),
       speed_max_(nominal.speed_max()),
       stop_ramp_time_(settings.stop_ramp_time),
       paced_(settings.pump_pacing),
-      pacing_(nominal, settings.pump_pacing_share, settings.period) {}
+      pacing_(nominal, settings.pump_pacing_share, period) {}
 
 void PathClock::begin_stop(double t) {
   const double tau0 = paced_ ? pacing_.tau() : unslowed_time(t);

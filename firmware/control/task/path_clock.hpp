@@ -8,18 +8,30 @@
 
 namespace exc::control {
 
-// What the clock reads, its own: ControllerConfig's members of the same names, which hold their
-// meaning and defaults (controller_config.hpp; consumer_settings.hpp hands them over).
+// The clock's own settings (ControllerConfig's `path_clock` member); it takes the period beside them.
 struct PathClockSettings {
-  double period = 1e-3;          // s
-  double stop_ramp_time = 0;     // s: a function at top speed stops along the path over this time
-  bool pump_pacing = false;      // valve interface: the clock paced to the pumps
-  double pump_pacing_share = 1;  // of the pumps' flow a paced path may ask
+  // A stop along the path (an operator's stop, a stop request) slows the path so that each function
+  // decelerates at most its top speed per this time (path_stop.hpp): a function at top speed stops
+  // in 0.63 s over its path, a slower one sooner. About the ramp an operator's joystick release gives.
+  double stop_ramp_time = 0.4;  // s
+  // Valve interface: the path's clock slowed while the path asks the pumps for more than
+  // pump_pacing_share of their flow (pump_pacing.hpp), the run lengthened by what that costs. Off by
+  // default: the path's times are then the task's, and a path the pumps cannot follow lags until the
+  // tracking limit stops it.
+  bool pump_pacing = false;
+  double pump_pacing_share = 0.9;
 };
+// The settings blob's field list (app/settings_blob.hpp): a field added above is added here too.
+template <typename Visitor>
+void visit_fields(Visitor& v, PathClockSettings& s) {
+  v("stop_ramp_time", s.stop_ramp_time);
+  v("pump_pacing", s.pump_pacing);
+  v("pump_pacing_share", s.pump_pacing_share);
+}
 
 class PathClock {
  public:
-  PathClock(const Task& task, const Machine& nominal, const PathClockSettings& settings);
+  PathClock(const Task& task, const Machine& nominal, const PathClockSettings& settings, double period);
 
   // Tracking begins at loop time t, at the path's first point.
   void start(double t) {
