@@ -110,7 +110,7 @@ inline constexpr double kValveMachineReach[4] = {0.0078, 0.0074, 0.0191, 0.0104}
 // every fault-free run (the worst is a fifth of it by construction), and far closer than the fixed
 // 0.1 rad / 0.2 m (10-27x the reach) that let a stuck spool run 1.45 s.
 inline constexpr double kTrackingLimitMultiple = 5;
-// The default tracking-error limit for a command interface (ControllerConfig::tracking_error_limit).
+// The default tracking-error limit for a command interface (SupervisorSettings::tracking_error_limit).
 Vec4 default_tracking_error_limit(CommandInterface interface);
 // Through the valves eq. 27's default rates are the force-commanded machine's times this (period / T_f).
 double valve_adaptation_scale(const ControllerConfig& c);

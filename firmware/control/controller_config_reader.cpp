@@ -1,5 +1,5 @@
 // The `controller:` section: every field declared once (unit, range; the default is the
-// ControllerConfig member's), then the cross-field rules at the offending field's place.
+// field's own, in its consumer's settings struct), then the cross-field rules at the offending field's place.
 #include "control/controller_config_reader.hpp"
 
 #include <algorithm>

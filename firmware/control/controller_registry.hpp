@@ -36,7 +36,7 @@ enum InterfaceSet : std::uint8_t { kEffortInterface = 1, kValveInterface = 2, kA
 // valve-commanded machine, the industry's baseline).
 enum class DefaultRun : std::uint8_t { no, yes };
 
-// Whether the law adapts parameter estimates at ControllerConfig::adaptation_rate (what a sweep's
+// Whether the law adapts parameter estimates at controller.adaptation_rate (what a sweep's
 // adaptation_scale changes; the stability map leaves a law that adapts nothing out of that axis).
 enum class Adapts : std::uint8_t { no, yes };
 
