@@ -8,7 +8,7 @@
 
 #include "model/types.hpp"
 
-namespace exc {
+namespace exc::app {
 
 class TrackingMetrics {
  public:
@@ -30,4 +30,4 @@ class TrackingMetrics {
   std::int64_t samples_ = 0;
 };
 
-}  // namespace exc
+}  // namespace exc::app

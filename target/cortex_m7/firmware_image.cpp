@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
   node->publish_counters();
   forward_outputs(link, bus, telemetry);
   exc::app::RunSummaryRecord summary;
-  const exc::TrackingMetrics& m = node->measured_tracking();
+  const exc::app::TrackingMetrics& m = node->measured_tracking();
   summary.emergency_sent = node->supervisor().emergency_sent();
   summary.tracking_samples = m.samples();
   for (int j = 0; j < 4; ++j) {

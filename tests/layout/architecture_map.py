@@ -19,6 +19,11 @@ so that moving a folder needs only the doc updated:
   the name an install(PROGRAMS ... RENAME name) gives it.
 - the include rules' table (read as include_rules.py reads it): every folder row is a floor, a room
   or a program's folder of the map.
+- the table of namespaces, between `<!-- namespaces: begin -->` and `<!-- namespaces: end -->`: rows
+  `| `folder/` | `exc::name`, ... |`. Every C++ source of ROOT (outside tests/ and build trees) that
+  opens a `namespace exc...` block holding more than forward declarations lies under a row (the
+  longest that holds it), and every such block is one of that row's namespaces; every row's folder
+  exists and opens each of its namespaces somewhere.
 - every path the doc names in backquotes (`sim_plant/plant.cpp`; the firmware's from firmware/,
   `control/laws/pid.hpp`; a file prefix, `sim_plant/plant_node`), the include rules' arrows among them,
   names a file or folder of ROOT.
@@ -37,6 +42,10 @@ import include_rules  # noqa: E402  (the include-rules table's reader, beside th
 DOC = "docs/architecture.md"
 FLOORS = ("<!-- floors: begin -->", "<!-- floors: end -->")
 PROGRAMS = ("<!-- programs: begin -->", "<!-- programs: end -->")
+NAMESPACES = ("<!-- namespaces: begin -->", "<!-- namespaces: end -->")
+CPP_SUFFIXES = (".cpp", ".hpp", ".h", ".cpp.in", ".hpp.in")
+NAMESPACE_OPEN = re.compile(r"^namespace (exc(?:::[a-z_]+)*) \{\s*$")
+FORWARD_DECLARATION = re.compile(r"^(class|struct) [A-Za-z_][A-Za-z0-9_]*;$")
 # Files that make a folder one of product sources: code, assembly, linker scripts, LCM types, Python,
 # a build file; executable scripts are found by their mode.
 SOURCE_SUFFIXES = (".cpp", ".hpp", ".h", ".c", ".S", ".ld", ".lcm", ".py")
@@ -97,6 +106,56 @@ def read_programs(text):
     if not programs:
         fail_doc("the table of programs has no rows")
     return programs
+
+
+def read_namespaces(text):
+    """{folder/: (line, [namespace, ...])} from the table of namespaces."""
+    first, lines = block(text, NAMESPACES, "table of namespaces")
+    rows = {}
+    for offset, line in enumerate(lines):
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) < 2 or not cells[0].startswith("`"):
+            continue  # header, separator or prose
+        names = re.findall(r"`(exc(?:::[a-z_]+)*)`", cells[1])
+        rows[cells[0].strip("`")] = (first + offset, names)
+    if not rows:
+        fail_doc("the table of namespaces has no rows")
+    return rows
+
+
+def namespace_blocks(path):
+    """[(line, namespace)] of each `namespace exc...` block of a source that holds more than forward
+    declarations (a block ends at the first `}` in column 0 after it)."""
+    found = []
+    lines = open(path, encoding="utf-8", errors="replace").read().splitlines()
+    i = 0
+    while i < len(lines):
+        m = NAMESPACE_OPEN.match(lines[i])
+        if not m:
+            i += 1
+            continue
+        start, body = i, []
+        i += 1
+        while i < len(lines) and not lines[i].startswith("}"):
+            code = lines[i].split("//", 1)[0].strip()
+            if code:
+                body.append(code)
+            i += 1
+        if not all(FORWARD_DECLARATION.match(b) for b in body):
+            found.append((start + 1, m.group(1)))
+    return found
+
+
+def cpp_sources(root):
+    """Every C++ source of ROOT outside tests/, hidden folders and build trees, relative."""
+    for folder, subfolders, names in os.walk(root):
+        rel = os.path.relpath(folder, root)
+        subfolders[:] = sorted(d for d in subfolders
+                               if not d.startswith(".") and not (rel == "." and d == "tests")
+                               and not is_build_tree(os.path.join(folder, d)))
+        for name in sorted(names):
+            if name.endswith(CPP_SUFFIXES):
+                yield os.path.relpath(os.path.join(folder, name), root).replace(os.sep, "/")
 
 
 def is_build_tree(path):
@@ -218,6 +277,32 @@ def main():
                 and key not in program_folders:
             problems.append(f"{DOC}: include rules: row `{key}` is no floor, room or program's folder of the map")
 
+    # Namespaces: each source's defining blocks are its folder's, and each row is used.
+    namespace_rows = read_namespaces(text)
+    opened = {}
+    for source in cpp_sources(root):
+        blocks = namespace_blocks(os.path.join(root, source))
+        if not blocks:
+            continue
+        row = max((f for f in namespace_rows if source.startswith(f)), key=len, default=None)
+        if row is None:
+            problems.append(f"{source}:{blocks[0][0]}: opens `{blocks[0][1]}` but its folder has no row in {DOC}'s "
+                            "table of namespaces")
+            continue
+        line, allowed = namespace_rows[row]
+        for number, name in blocks:
+            opened.setdefault(row, set()).add(name)
+            if name not in allowed:
+                problems.append(f"{source}:{number}: opens `{name}`; {DOC}:{line} gives `{row}` "
+                                f"{', '.join('`' + a + '`' for a in allowed)}")
+    for row, (line, allowed) in namespace_rows.items():
+        if not os.path.isdir(os.path.join(root, row)):
+            problems.append(f"{DOC}:{line}: namespace row `{row}` names no folder of the tree")
+            continue
+        for name in allowed:
+            if name not in opened.get(row, set()):
+                problems.append(f"{DOC}:{line}: `{row}` is given `{name}`, which none of its sources opens")
+
     # Every path named in backquotes exists (the firmware's from firmware/).
     paths = 0
     for number, line in enumerate(text.splitlines(), 1):
@@ -232,7 +317,8 @@ def main():
     for p in problems:
         print(p)
     print(f"architecture map: {len(floors)} floors, {len(rooms)} rooms, {len(sources)} folders with sources, "
-          f"{len(programs)} programs on the map against {len(made)} in tools/, {paths} paths named: "
+          f"{len(programs)} programs on the map against {len(made)} in tools/, {len(namespace_rows)} namespace rows, "
+          f"{paths} paths named: "
           f"{len(problems)} false")
     return 1 if problems else 0
 

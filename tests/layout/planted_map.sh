@@ -3,8 +3,10 @@
 # (its folders but hidden ones and build trees, with docs/architecture.md) passes (the
 # control); then a room on the map that does not exist, a program of tools/ missing from the map (an
 # executable target and a script), a program on the map that tools/ does not make, a folder of sources
-# off the map, a path the doc names that does not exist and an include rule for a folder that is
-# neither in the tree nor on the map must each fail the check, named.
+# off the map, a path the doc names that does not exist, an include rule for a folder that is
+# neither in the tree nor on the map, a source defining in another floor's namespace (the plant's node
+# in the firmware's app), a source whose folder has no namespace row and a namespace row none of its
+# folder's sources opens must each fail the check, named.
 set -u
 checker=$1 source=$2 work=$3
 rm -rf "$work" && mkdir -p "$work" || exit 1
@@ -34,6 +36,8 @@ lines.insert(at + 1, "               no_such_room/  a room planted on the map th
 text = "\n".join(lines) + "\nThe planted path `firmware/control/no_such_law.hpp`.\n"
 end = "<!-- include rules: end -->"
 text = text.replace(end, "| `firmware/estimation/` | `firmware/model/` |\n" + end)
+end = "<!-- namespaces: end -->"
+text = text.replace(end, "| `lcmtypes/` | `exc::lcm` |\n" + end)
 open(path, "w", encoding="utf-8").write(text)
 EOF
 # Programs missing from the map: an executable target and an executable script.
@@ -42,7 +46,9 @@ printf '#!/bin/sh\necho planted\n' > "$work/tools/sweep/planted-sweep" && chmod 
 # A program on the map that tools/ no longer makes.
 rm "$work/tools/report_memory_bench/report-memory-bench"
 # A folder of sources off the map.
-mkdir -p "$work/firmware/off_the_map" && printf '#pragma once\n' > "$work/firmware/off_the_map/thing.hpp"
+mkdir -p "$work/firmware/off_the_map" && printf '#pragma once\nnamespace exc::off {\nint thing();\n}\n' > "$work/firmware/off_the_map/thing.hpp"
+# The plant's node in the firmware's namespace, as it once was (a forward declaration beside it is not counted).
+printf 'namespace exc::app {\nclass Ahead;\n}\nnamespace exc::app {\nstruct PlantNodePlanted {};\n}\n' > "$work/sim_plant/planted_node.hpp"
 
 out=$(/usr/bin/python3 "$checker" "$work" 2>&1); rc=$?
 printf 'planted copy (rc %d):\n%s\n' "$rc" "$out"
@@ -56,7 +62,10 @@ for expected in 'room `firmware/no_such_room/` is on the map but no such folder 
                 '`firmware/control/no_such_law.hpp` names no file or folder of the tree' \
                 '`firmware/estimation/` names no file or folder of the tree' \
                 'include rules: row `firmware/estimation/` is no floor, room or program' \
-                ': 8 false'; do
+                'firmware/off_the_map/thing.hpp:2: opens `exc::off` but its folder has no row' \
+                'sim_plant/planted_node.hpp:4: opens `exc::app`; docs/architecture.md' \
+                '`lcmtypes/` is given `exc::lcm`, which none of its sources opens' \
+                ': 11 false'; do
   grep -qF -- "$expected" <<< "$out" || { echo "FAIL: the report does not name: $expected"; status=1; }
 done
 exit $status
