@@ -68,11 +68,6 @@ using app::kHoldingTolerance;
 using app::kHoldSettleLimit;
 using app::kHoldSettleDwell;
 
-// "At rest" (docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s.
-inline constexpr double kRestCylinderRate = 1e-3;  // m/s
-inline constexpr double kRestSwingRate = 1e-3;     // rad/s
-inline constexpr double kRestSettle = 1.0;          // s at rest that ends a run past its scene (rest_horizon)
-
 // One closed-loop run, as every report reads it.
 struct RunRecord {
   std::string controller;

@@ -7,15 +7,11 @@
 namespace exc::sim {
 namespace {
 
-constexpr double kRestRate = 1e-3;       // m/s, rad/s: "at rest" (docs/safety.md)
 // m/s, rad/s: a ring's peak below "at rest" is no ring to fit (a function creeping or stick-slipping
 // below it is at rest by the safety concept's measure).
-constexpr double kRingFloor = kRestRate;
+constexpr double kRingFloor = kRestCylinderRate;
+static_assert(kRestCylinderRate == kRestSwingRate, "one floor for every function's ring");
 constexpr int kRingPeaks = 3;            // peaks the envelope's fit needs
-// s below the floor that end a ring: "at rest" for as long as a stopped run must be at rest before it
-// ends (harness/lockstep_run.hpp's kRestSettle), longer than any half period of the machine's rings
-// (1.3-5 Hz) and than the stick at a turning point.
-constexpr double kRingRest = 1.0;
 constexpr int kMaxPeaks = 512;           // half periods fitted at most (a 2.5 Hz ring over 100 s)
 const char* const kFunctions[] = {"swing", "boom", "arm", "bucket"};
 
@@ -30,7 +26,7 @@ std::string format(const char* fmt, double a, double b) {
 // on one side of zero, judged by its samples above the floor: a sample at or below it (a function its
 // dry friction holds at a turning point, for a cycle or more at nearly every reversal once slow; or a
 // creep too slow to count) belongs to neither side and ends no half period. Its peak is the largest
-// |velocity| in it. A ring ends once the function has been below the floor for kRingRest: motion after
+// |velocity| in it. A ring ends once the function has been below the floor for kRestSettle: motion after
 // that is a new ring (excited afresh, e.g. by a draining bucket reaching its end stop), judged apart.
 // A ring is judged from its crest (its largest peak; the peaks before it are the ring building up).
 // One that has ended decayed from its crest A_c at t_c to the floor by its last sample above it, t_e:
@@ -75,7 +71,7 @@ double ring_envelope_tau(const Samples& samples, std::size_t from, int f) {
     const double t = samples[k].t;
     if (std::abs(v) <= kRingFloor) continue;
     const int sign = v > 0 ? 1 : -1;
-    const bool new_ring = t - last_above > kRingRest;
+    const bool new_ring = t - last_above > kRestSettle;
     if (side != 0 && (sign != side || new_ring) && peaks < kMaxPeaks) {
       peak_t[peaks] = half_time;  // the half period closed: the velocity came back through the floor
       peak_a[peaks] = half_peak;
@@ -94,14 +90,14 @@ double ring_envelope_tau(const Samples& samples, std::size_t from, int f) {
   }
   // The last half period counts once the velocity has come back to the floor before the record's end
   // (a half period cut by the record's end may not have reached its peak); the last ring has ended
-  // when the record ends kRingRest after its last sample above the floor.
+  // when the record ends kRestSettle after its last sample above the floor.
   const bool back = n > 0 && std::abs(samples[n - 1].qd[f]) <= kRingFloor;
   if (side != 0 && back && peaks < kMaxPeaks) {
     peak_t[peaks] = half_time;
     peak_a[peaks] = half_peak;
     ++peaks;
   }
-  judge_ring(back && samples[n - 1].t - last_above >= kRingRest, last_above);
+  judge_ring(back && samples[n - 1].t - last_above >= kRestSettle, last_above);
   return worst;
 }
 
@@ -149,7 +145,7 @@ StopJudgement StopJudge::judge(double detected, double spool_onset, double safe_
     const double v0 = samples_[d].qd[f];
     double peak = std::abs(v0);
     std::size_t s = d;
-    while (s + 1 < n && std::abs(samples_[s].qd[f]) >= kRestRate && samples_[s].qd[f] * v0 > 0) {
+    while (s + 1 < n && std::abs(samples_[s].qd[f]) >= (f == 0 ? kRestSwingRate : kRestCylinderRate) && samples_[s].qd[f] * v0 > 0) {
       ++s;
       peak = std::max(peak, std::abs(samples_[s].qd[f]));
     }

@@ -21,6 +21,11 @@ namespace exc::sim {
 
 // R3's figures (docs/safety.md): drift below 1 mm/s (1 mrad/s swing) from 1.5 s after the onset over
 // at least 2 s, a ring's envelope time constant at most 3.5 s, the swing's brake within 0.3 s.
+// "At rest" (docs/safety.md): every cylinder under 1 mm/s, the swing under 1 mrad/s; a run past its
+// scene ends, and a ring is over, once the machine has been at rest for kRestSettle.
+inline constexpr double kRestCylinderRate = 1e-3;  // m/s
+inline constexpr double kRestSwingRate = 1e-3;     // rad/s
+inline constexpr double kRestSettle = 1.0;         // s
 inline constexpr double kDriftFrom = 1.5;          // s after the onset (StopJudge::fit_onset)
 inline constexpr double kDriftSpan = 2.0;          // s, the fit's least span
 inline constexpr double kDriftLimit = 1e-3;        // m/s, rad/s

@@ -62,16 +62,29 @@ void RunPhases::add(double t, double dt, safety::Mode mode, bool tracking, const
 }
 
 std::string hold_failure(const PhaseErrors& hold) {
-  for (int j = 0; j < 4; ++j)
-    if (hold.max_error[j] > kHoldingTolerance[j]) {
-      char text[240];
-      std::snprintf(text, sizeof text,
-                    "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s once settled; %llu excursion(s))",
-                    kActiveNames[j], hold.max_error[j] * 1e3, j == 0 ? "mrad" : "mm", hold.worst_time[j],
-                    kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm", static_cast<unsigned long long>(hold.excursions[j]));
-      return text;
+  // The function furthest past its tolerance (in multiples of it), and how many others left theirs.
+  int worst = -1, others = 0;
+  for (int j = 0; j < 4; ++j) {
+    if (!(hold.max_error[j] > kHoldingTolerance[j])) continue;
+    if (worst < 0) {
+      worst = j;
+      continue;
     }
-  return "";
+    ++others;
+    if (hold.max_error[j] / kHoldingTolerance[j] > hold.max_error[worst] / kHoldingTolerance[worst]) worst = j;
+  }
+  if (worst < 0) return "";
+  const int j = worst;
+  char others_text[64] = "";
+  if (others > 0)
+    std::snprintf(others_text, sizeof others_text, ", and %d other function%s left %s own", others, others == 1 ? "" : "s",
+                  others == 1 ? "its" : "their");
+  char text[280];
+  std::snprintf(text, sizeof text,
+                "the %s left its held pose by %.2f %s at %.2f s (holding tolerance %.2f %s once settled; %llu excursion(s))%s",
+                kActiveNames[j], hold.max_error[j] * 1e3, j == 0 ? "mrad" : "mm", hold.worst_time[j],
+                kHoldingTolerance[j] * 1e3, j == 0 ? "mrad" : "mm", static_cast<unsigned long long>(hold.excursions[j]), others_text);
+  return text;
 }
 
 }  // namespace exc::app

@@ -75,7 +75,8 @@ class RunPhases {
 };
 
 // The hold's verdict: "" when every function stayed within the holding tolerance once settled, else
-// which function left its held pose, by how much, when, and how many excursions.
+// the function furthest past its tolerance (in multiples of it): by how much, when, how many
+// excursions, and how many other functions left theirs.
 std::string hold_failure(const PhaseErrors& hold);
 
 }  // namespace exc::app

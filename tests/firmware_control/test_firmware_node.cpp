@@ -930,3 +930,30 @@ TEST_CASE("firmware/runner: in real time a stalled cycle is a late wake-up, and 
     }
   }
 }
+
+TEST_CASE("firmware/hold verdict names the function furthest past its tolerance, in multiples of it, and counts the others") {
+  app::PhaseErrors hold;
+  CHECK(app::hold_failure(hold).empty());  // every function within its tolerance
+  // The swing 1.2 x its tolerance, first in order; the arm 3 x its own, later in order: the arm is named.
+  hold.max_error[0] = 1.2 * app::kHoldingTolerance[0];
+  hold.worst_time[0] = 4.0;
+  hold.max_error[2] = 3.0 * app::kHoldingTolerance[2];
+  hold.worst_time[2] = 7.5;
+  hold.excursions[2] = 2;
+  const std::string two = app::hold_failure(hold);
+  CHECK(two.find("the arm left its held pose by 7.50 mm at 7.50 s") == 0);
+  CHECK(two.find("2 excursion(s)") != std::string::npos);
+  CHECK(two.find("and 1 other function left its own") != std::string::npos);
+  // The bucket past its tolerance too, 1.5 x: the arm is still the furthest, two others counted.
+  hold.max_error[3] = 1.5 * app::kHoldingTolerance[3];
+  const std::string three = app::hold_failure(hold);
+  CHECK(three.find("the arm left") == 0);
+  CHECK(three.find("and 2 other functions left their own") != std::string::npos);
+  // The swing alone: named, no others.
+  app::PhaseErrors swing;
+  swing.max_error[0] = 2 * app::kHoldingTolerance[0];
+  swing.worst_time[0] = 1.0;
+  const std::string one = app::hold_failure(swing);
+  CHECK(one.find("the swing left its held pose by 5.00 mrad at 1.00 s") == 0);
+  CHECK(one.find("other") == std::string::npos);
+}
