@@ -18,7 +18,7 @@ SoilParameters soil_preset(SoilPreset preset) {
 
 TipLoad SoilModel::load(const Vec2& rho, const Vec2& rhod) const {
   TipLoad out;
-  if (depth(rho) <= 0.0) return out;
+  if (!present() || depth(rho) <= 0.0) return out;
   // eq. 9 without the inertial term; an entering tip has no spring stretch yet.
   const Vec2 anchor = in_soil_ ? anchor_ : rho;
   out.force = params_.damping.cwiseProduct(rhod) + params_.stiffness.cwiseProduct(rho - anchor);
@@ -33,7 +33,7 @@ Vec2 SoilModel::total_force(const Vec2& rho, const Vec2& rhod, const Vec2& rhodd
 
 bool SoilModel::commit(const Vec2& rho) {
   const double h = depth(rho);
-  if (h <= 0.0) {
+  if (!present() || h <= 0.0) {
     in_soil_ = false;
     return false;
   }

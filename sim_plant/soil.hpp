@@ -63,6 +63,9 @@ class SoilModel {
   // re-anchoring (a shear failure).
   bool commit(const Vec2& rho);
 
+  // Whether there is soil at all: a preset none (every parameter zero) has no spring to anchor or
+  // shear, so a tip below its terrain is in the air, not in soil (the terrain stays the ground's height).
+  bool present() const { return !(params_.stiffness.isZero(0) && params_.damping.isZero(0) && params_.mass.isZero(0)); }
   bool in_soil() const { return in_soil_; }
   const Vec2& anchor() const { return anchor_; }
   int reanchor_count() const { return reanchor_count_; }

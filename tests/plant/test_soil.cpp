@@ -69,6 +69,27 @@ TEST_CASE("plant/soil acts only below the surface and anchors at the entry point
   CHECK_FALSE(soil.in_soil());
 }
 
+TEST_CASE("plant/soil of preset none engages nothing: a tip below the terrain is not in soil and never shears") {
+  Terrain t;
+  t.height = 0.0;
+  SoilModel none(t, soil_preset(SoilPreset::none));
+  CHECK_FALSE(none.present());
+  CHECK(SoilModel(t, soil_preset(SoilPreset::loose_sand)).present());
+  // Buried 0.5 m and dragged 1 m up and back, as a scene that starts with its bucket below the
+  // terrain's height: loam would shear many times over that path.
+  SoilModel loam(t, soil_preset(SoilPreset::loam));
+  for (int i = 0; i <= 1000; ++i) {
+    const Vec2 rho(7.6 - 1e-3 * i, -0.5 + 5e-4 * i);
+    CHECK(none.load(rho, Vec2(-1, 0.5)).force.norm() == 0);
+    CHECK(none.load(rho, Vec2(-1, 0.5)).added_mass.norm() == 0);
+    CHECK_FALSE(none.commit(rho));
+    CHECK_FALSE(none.in_soil());
+    loam.commit(rho);
+  }
+  CHECK(none.reanchor_count() == 0);
+  CHECK(loam.reanchor_count() > 3);  // the control: the same path through soil shears
+}
+
 TEST_CASE("plant/soil re-anchors at S_dist = 0.365 h + 0.00754 and the force zig-zags") {
   for (double h : {0.1, 0.3, 0.5}) {
     CAPTURE(h);
