@@ -91,36 +91,34 @@ def read_floors(text):
     return floors, rooms
 
 
-def read_programs(text):
-    """{(name, folder): line} from the table of programs."""
-    first, lines = block(text, PROGRAMS, "table of programs")
-    programs = {}
+def table_rows(text, markers, what):
+    """[(line, cells)] of a table's rows between markers whose first cell is backquoted."""
+    first, lines = block(text, markers, what)
+    rows = []
     for offset, line in enumerate(lines):
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) < 2 or not cells[0].startswith("`"):
-            continue  # header, separator or prose
+        if len(cells) >= 2 and cells[0].startswith("`"):  # not the header, the separator or prose
+            rows.append((first + offset, cells))
+    if not rows:
+        fail_doc(f"the {what} has no rows")
+    return rows
+
+
+def read_programs(text):
+    """{(name, folder): line} from the table of programs."""
+    programs = {}
+    for number, cells in table_rows(text, PROGRAMS, "table of programs"):
         folder = cells[1].strip("`")
         if not folder.endswith("/"):
             folder += "/"
-        programs[(cells[0].strip("`"), folder)] = first + offset
-    if not programs:
-        fail_doc("the table of programs has no rows")
+        programs[(cells[0].strip("`"), folder)] = number
     return programs
 
 
 def read_namespaces(text):
     """{folder/: (line, [namespace, ...])} from the table of namespaces."""
-    first, lines = block(text, NAMESPACES, "table of namespaces")
-    rows = {}
-    for offset, line in enumerate(lines):
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) < 2 or not cells[0].startswith("`"):
-            continue  # header, separator or prose
-        names = re.findall(r"`(exc(?:::[a-z_]+)*)`", cells[1])
-        rows[cells[0].strip("`")] = (first + offset, names)
-    if not rows:
-        fail_doc("the table of namespaces has no rows")
-    return rows
+    return {cells[0].strip("`"): (number, re.findall(r"`(exc(?:::[a-z_]+)*)`", cells[1]))
+            for number, cells in table_rows(text, NAMESPACES, "table of namespaces")}
 
 
 def namespace_blocks(path):
