@@ -63,18 +63,15 @@ void RunPhases::add(double t, double dt, safety::Mode mode, bool tracking, const
 
 std::string hold_failure(const PhaseErrors& hold) {
   // The function furthest past its tolerance (in multiples of it), and how many others left theirs.
-  int worst = -1, others = 0;
+  int worst = -1, past = 0;
   for (int j = 0; j < 4; ++j) {
     if (!(hold.max_error[j] > kHoldingTolerance[j])) continue;
-    if (worst < 0) {
-      worst = j;
-      continue;
-    }
-    ++others;
-    if (hold.max_error[j] / kHoldingTolerance[j] > hold.max_error[worst] / kHoldingTolerance[worst]) worst = j;
+    ++past;
+    if (worst < 0 || hold.max_error[j] / kHoldingTolerance[j] > hold.max_error[worst] / kHoldingTolerance[worst]) worst = j;
   }
   if (worst < 0) return "";
   const int j = worst;
+  const int others = past - 1;
   char others_text[64] = "";
   if (others > 0)
     std::snprintf(others_text, sizeof others_text, ", and %d other function%s left %s own", others, others == 1 ? "" : "s",

@@ -2,9 +2,8 @@
 // The scene's `controller:` section (gains, Lyapunov weights, adaptation rates, soil-parameter
 // bounds, filter cut-offs, watchdog) as the cycle takes it. Every field is optional: a scene without
 // `controller:` gets the embedded defaults, each written beside its field in its consumer's struct
-// (docs/control.md lists them); the reader
-// (controller_config_reader.hpp) declares each field's unit and range once and validates them at
-// start-up on the host. Nothing here reads a file, so the firmware's image compiles it. It holds each
+// (docs/control.md lists them); the reader (controller_config_reader.hpp) declares each field's unit
+// and range once and validates them at start-up on the host. Nothing here reads a file, so the firmware's image compiles it. It holds each
 // consumer's settings struct whole, declared in the consumer's room (each law, the actuation stage,
 // the path's clock, the supervisor), so that each value and its default is written once and no room
 // includes this file: it sits at control/'s top.

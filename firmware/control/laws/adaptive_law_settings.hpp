@@ -74,7 +74,8 @@ void visit_fields(Visitor& v, AdaptationSettings& a) {
 
 // What the adaptive law reads: the computed-torque law's settings it builds on, its adaptation, the
 // soil parameters' bounds it shares with Slotine-Li and the estimator's cut-offs its update's signal
-// filters take. Each is ControllerConfig's member, whole (adaptive_law_settings(ControllerConfig) puts them together).
+// filters take. Each is a ControllerConfig member, whole (adaptive_law_settings() in
+// controller_config.hpp puts them together).
 struct AdaptiveLawSettings {
   PidLawSettings computed_torque;
   AdaptationSettings adaptation;
