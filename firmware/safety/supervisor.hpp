@@ -195,7 +195,6 @@ class Supervisor {
   const PressurePlausibility& pressure_plausibility() const { return pressure_monitor_; }
   const SpoolMonitor& spool_monitor() const { return spool_monitor_; }
   const SupervisorSettings& settings() const { return s_; }
-  double period() const { return period_; }
 
  private:
   // A fault condition met this cycle (the first one counts): the safe state follows next cycle.
